@@ -1,0 +1,75 @@
+"""polycontact: whether, when and where two 2D polygons collide.
+
+Built on the entrance block of Shi's Contact Theory. The public names are re-exported
+here; they are loaded on first use so that ``import polycontact`` stays fast (no Numba,
+no matplotlib, no compilation at import).
+
+Examples
+--------
+>>> import polycontact as pc
+>>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+>>> b = pc.Shape([(1, 0), (2, 0), (2, 1), (1, 1)])
+>>> pc.classify(a, b).state
+<State.CONTACT: 'contact'>
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from .errors import InvalidSceneError, InvalidShapeError, PolycontactError
+from .shape import Shape
+
+__version__ = "0.1.0"
+
+# public name -> module that defines it
+_LAZY = {
+    "RELATIVE_TOLERANCE": "tolerances",
+    "default_tolerance": "tolerances",
+    # classification of a pair
+    "State": "relation",
+    "Feature": "relation",
+    "Relation": "relation",
+    "classify": "relation",
+    "classify_many": "relation",
+    "warmup": "relation",
+    # entrance block
+    "EntranceBlock": "entrance_block",
+    "Component": "entrance_block",
+    "entrance_block": "entrance_block",
+    # motion and time of impact
+    "Motion": "motion",
+    "broad_phase_intervals": "broad_phase",
+    "Impact": "impact",
+    "ImpactStatus": "impact",
+    "time_of_impact": "impact",
+    "Scene": "scene",
+    "Body": "scene",
+    "load_scene": "scene",
+    # no-fit polygon
+    "NoFitPolygon": "nfp",
+    "no_fit_polygon": "nfp",
+    "inner_fit_polygon": "nfp",
+}
+
+__all__ = [
+    "PolycontactError",
+    "InvalidShapeError",
+    "InvalidSceneError",
+    "Shape",
+    *_LAZY,
+]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'polycontact' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

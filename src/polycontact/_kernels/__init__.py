@@ -1,0 +1,12 @@
+"""Private compiled kernels: plain functions over float64 arrays and scalars.
+
+Conventions shared by every kernel:
+
+- A shape is packed as ``xy`` (float64, shape (V, 2)) holding every loop's vertices one
+  loop after another (outer loop first, counter-clockwise; holes after it, clockwise),
+  and ``starts`` (int64, shape (L + 1,)) with loop ``k`` occupying rows
+  ``starts[k]:starts[k + 1]``. Edge ``e`` of loop ``k`` joins its vertex ``e`` and vertex
+  ``(e + 1) % n_k``.
+- Tolerances arrive as arguments, never from module globals.
+- Kernels are compiled on first use (``cache=True``), never at import.
+"""

@@ -1,0 +1,46 @@
+"""Reading shapes for the command line: JSON body, GeoJSON or WKT files."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import InvalidShapeError, PolycontactError
+from ..shape import Shape
+
+
+class CommandError(PolycontactError):
+    """A problem with what the user gave the command (file, option); exit status 2."""
+
+
+def read_shape(path: str, *, repair: bool = False) -> Shape:
+    """Read one shape from ``path``.
+
+    Accepted: a JSON body ``{"vertices": [[x, y], ...], "holes": [...]}``, a GeoJSON
+    Polygon/Feature, or WKT text (``POLYGON ((...))``). Any problem is raised as a
+    :class:`CommandError` whose message starts with the file name.
+    """
+    try:
+        text = Path(path).read_text()
+    except OSError as exc:
+        raise CommandError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        stripped = text.lstrip()
+        if stripped.startswith("{"):
+            try:
+                data = json.loads(text)
+            except json.JSONDecodeError as exc:
+                raise CommandError(f"{path}: not valid JSON ({exc})") from None
+            if "vertices" in data:
+                unknown = set(data) - {"vertices", "holes", "name"}
+                if unknown:
+                    raise CommandError(f"{path}: unknown key {sorted(unknown)[0]!r}")
+                return Shape(data["vertices"], data.get("holes", ()), repair=repair)
+            if "type" in data:
+                return Shape.from_geojson(data, repair=repair)
+            raise CommandError(
+                f"{path}: expected a body with 'vertices' or a GeoJSON Polygon"
+            )
+        return Shape.from_wkt(text, repair=repair)
+    except InvalidShapeError as exc:
+        raise CommandError(f"{path}: {exc}") from None

@@ -1,0 +1,26 @@
+"""Figures (matplotlib, imported only when a plot function is called).
+
+- :func:`plot_entrance_block`: the two bodies, the three families of entrance-block
+  components and the reference point (like the paper's Fig. 5).
+- :func:`plot_impact`: both bodies at t = 0 and at the impact, centroid paths, contact.
+- :func:`plot_nfp`: B, A at one placement, the no-fit polygon with holes and exact fits.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_LAZY = {
+    "plot_entrance_block": "entrance_block",
+    "plot_impact": "impact",
+    "plot_nfp": "nfp",
+}
+__all__ = list(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'polycontact.plotting' has no attribute {name!r}")
+    return getattr(importlib.import_module(f".{module}", __name__), name)

@@ -1,0 +1,416 @@
+"""Shapes: an outer loop and any number of holes, validated and normalised.
+
+Frame convention (followed everywhere in polycontact): coordinates are float64 in one
+fixed world frame, x to the right and y up; angles are radians, counter-clockwise
+positive. Outer loops are stored counter-clockwise and holes clockwise, whatever order
+the caller gave, so "interior on the left" holds for every edge. Loop 0 is the outer
+loop, loops 1.. are the holes in the order given. Vertex and edge indices are 0-based;
+edge ``k`` of a loop joins its vertex ``k`` and vertex ``(k + 1) % n``. If a loop had to
+be reversed, the indices refer to the stored (reversed) order: see
+:attr:`Shape.loops`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidShapeError
+from .tolerances import default_tolerance
+
+__all__ = ["Shape", "as_shape"]
+
+ArrayLike = Any
+
+
+def _signed_area(ring: np.ndarray) -> float:
+    x = ring[:, 0]
+    y = ring[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
+    """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
+    try:
+        arr = np.array(ring, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise InvalidShapeError(
+            f"{what}: expected an array of shape (N, 2), got shape {arr.shape}"
+        )
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidShapeError(
+            f"{what}: vertex {i} has a non-finite coordinate {arr[i].tolist()}"
+        )
+    if len(arr) == 0:
+        raise InvalidShapeError(f"{what}: no vertices")
+    keep = np.ones(len(arr), dtype=bool)
+    keep[1:] = np.any(arr[1:] != arr[:-1], axis=1)
+    arr = arr[keep]
+    while len(arr) > 1 and np.all(arr[-1] == arr[0]):
+        arr = arr[:-1]
+    if len(arr) < 3:
+        raise InvalidShapeError(
+            f"{what}: fewer than 3 distinct vertices ({len(arr)} after dropping repeats)"
+        )
+    return arr
+
+
+def _loop_name(k: int) -> str:
+    return "outer loop" if k == 0 else f"hole {k - 1}"
+
+
+class Shape:
+    """A closed polygonal region: an outer loop and zero or more holes.
+
+    Parameters
+    ----------
+    vertices : array_like of shape (N, 2)
+        The outer loop, closed or not, in either orientation.
+    holes : sequence of array_like of shape (M, 2)
+        Hole loops, closed or not, in either orientation.
+    repair : bool, default False
+        If the loops are invalid, try ``shapely.make_valid`` and keep the result when it
+        is a single polygon; :attr:`repairs` then says what changed (vertex indices
+        refer to the repaired loops).
+
+    Raises
+    ------
+    InvalidShapeError
+        Fewer than 3 distinct vertices, a non-finite coordinate, zero area, a
+        self-intersection (with its point and the two edges), a hole outside or crossing
+        its outer loop, overlapping holes.
+
+    Examples
+    --------
+    >>> sq = Shape([(0, 0), (0, 2), (2, 2), (2, 0)])    # clockwise: stored reversed
+    >>> sq.area, sq.centroid.tolist(), sq.exterior[1].tolist()
+    (4.0, [1.0, 1.0], [2.0, 2.0])
+    >>> Shape([(0, 0), (2, 2), (2, 0), (0, 2)])
+    Traceback (most recent call last):
+    ...
+    polycontact.errors.InvalidShapeError: outer loop: self-intersection at (1, 1) between edge 0 and edge 2
+    """
+
+    __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs")
+
+    def __init__(
+        self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
+    ) -> None:
+        if isinstance(holes, np.ndarray) and holes.ndim == 2:
+            raise InvalidShapeError(
+                "holes: expected a sequence of (M, 2) loops, got a single (M, 2) array; "
+                "wrap it in a list"
+            )
+        try:
+            loops = [_clean_ring(vertices, "outer loop")]
+            loops += [_clean_ring(h, f"hole {i}") for i, h in enumerate(holes)]
+            self._init_from_loops(loops, repairs=())
+        except InvalidShapeError as exc:
+            if not repair:
+                raise
+            self._init_repaired(vertices, holes, str(exc))
+
+    # -- construction -------------------------------------------------------------
+    @classmethod
+    def _trusted(cls, loops: Sequence[np.ndarray], repairs: tuple[str, ...] = ()) -> Shape:
+        """Build from loops already oriented and valid (e.g. a rigid motion of a Shape)."""
+        self = cls.__new__(cls)
+        self._set(loops, repairs)
+        return self
+
+    def _set(self, loops: Sequence[np.ndarray], repairs: tuple[str, ...]) -> None:
+        lens = [len(r) for r in loops]
+        xy = np.ascontiguousarray(np.concatenate(loops), dtype=np.float64)
+        starts = np.zeros(len(loops) + 1, dtype=np.int64)
+        starts[1:] = np.cumsum(lens)
+        xy.flags.writeable = False
+        starts.flags.writeable = False
+        self._xy = xy
+        self._starts = starts
+        self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
+        # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
+        # contribute negative area, which removes them.
+        x = xy[:, 0]
+        y = xy[:, 1]
+        nxt = np.empty(len(xy), dtype=np.int64)
+        for k in range(len(loops)):
+            s, e = starts[k], starts[k + 1]
+            nxt[s:e] = np.roll(np.arange(s, e), -1)
+        cross = x * y[nxt] - x[nxt] * y
+        a2 = float(cross.sum())
+        self._area = 0.5 * a2
+        self._centroid = np.array(
+            [float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
+             float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
+        )
+        self._centroid.flags.writeable = False
+        self._radius = float(np.max(np.hypot(x - self._centroid[0], y - self._centroid[1])))
+        self.repairs = repairs
+
+    def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
+        eps = default_tolerance(*loops)
+        for k, ring in enumerate(loops):
+            if _collinear(ring, eps):
+                raise InvalidShapeError(f"{_loop_name(k)}: zero area (all vertices on one line)")
+        _check_loops(loops, eps)
+        for k, ring in enumerate(loops):
+            area = _signed_area(ring)
+            if abs(area) <= eps * max(float(np.max(np.ptp(ring, axis=0))), 1.0):
+                raise InvalidShapeError(f"{_loop_name(k)}: zero area")
+            if (k == 0) != (area > 0):
+                loops[k] = ring[::-1].copy()
+        if len(loops) > 1:
+            _check_hole_placement(loops)
+        self._set(loops, repairs)
+
+    def _init_repaired(self, vertices: ArrayLike, holes: Sequence[ArrayLike], why: str) -> None:
+        import shapely
+
+        try:
+            raw = shapely.Polygon(
+                np.asarray(vertices, dtype=float), [np.asarray(h, dtype=float) for h in holes]
+            )
+        except Exception as exc:  # shapely refuses rings it cannot even build
+            raise InvalidShapeError(f"cannot repair: {why} ({exc})") from None
+        fixed = shapely.make_valid(raw, method="structure", keep_collapsed=False)
+        polys = [g for g in shapely.get_parts(fixed) if g.geom_type == "Polygon" and g.area > 0]
+        if len(polys) != 1:
+            raise InvalidShapeError(
+                f"cannot repair: {why}; shapely.make_valid gives {len(polys)} polygons, "
+                "not one"
+            )
+        poly = polys[0]
+        loops = [_clean_ring(np.asarray(poly.exterior.coords), "outer loop")]
+        loops += [
+            _clean_ring(np.asarray(r.coords), f"hole {i}") for i, r in enumerate(poly.interiors)
+        ]
+        lost = float(raw.area) - float(poly.area) if raw.is_valid else None
+        note = f"made valid with shapely.make_valid(method='structure') because {why}"
+        note += f"; now {sum(len(r) for r in loops)} vertices in {len(loops)} loop(s)"
+        if lost is not None:
+            note += f", area changed by {lost:g}"
+        self._init_from_loops(loops, repairs=(note,))
+
+    # -- properties ---------------------------------------------------------------
+    @property
+    def exterior(self) -> np.ndarray:
+        """Outer loop, ndarray of shape (N, 2), float64, counter-clockwise, read-only."""
+        return self._loops[0]
+
+    @property
+    def holes(self) -> tuple[np.ndarray, ...]:
+        """Hole loops, each an ndarray of shape (M, 2), float64, clockwise, read-only."""
+        return self._loops[1:]
+
+    @property
+    def loops(self) -> tuple[np.ndarray, ...]:
+        """Every loop, outer first: loop index k in features refers to this tuple."""
+        return self._loops
+
+    @property
+    def packed(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(xy, starts)``: all loops stacked and the row where each starts (kernel form)."""
+        return self._xy, self._starts
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices over all loops."""
+        return int(self._xy.shape[0])
+
+    @property
+    def area(self) -> float:
+        """Area of the solid region (holes removed)."""
+        return self._area
+
+    @property
+    def centroid(self) -> np.ndarray:
+        """Area centroid (paper Eq. 3-4, holes removed), ndarray of shape (2,)."""
+        return self._centroid
+
+    @property
+    def bounding_radius(self) -> float:
+        """Largest distance from the centroid to a vertex (L_A of paper Eq. 5)."""
+        return self._radius
+
+    # -- rigid motions ------------------------------------------------------------
+    def moved(self, translation: ArrayLike = (0.0, 0.0), angle: float = 0.0) -> Shape:
+        """This shape rotated by ``angle`` (radians, CCW) about its centroid, then translated.
+
+        Examples
+        --------
+        >>> Shape([(0, 0), (2, 0), (2, 2), (0, 2)]).moved((1, 0)).centroid.tolist()
+        [2.0, 1.0]
+        """
+        c = self._centroid
+        t = np.asarray(translation, dtype=np.float64)
+        cs, sn = np.cos(angle), np.sin(angle)
+        rot = np.array([[cs, sn], [-sn, cs]])  # row-vector form of R(angle)
+        xy = (self._xy - c) @ rot + c + t
+        return Shape._trusted(
+            [xy[self._starts[k] : self._starts[k + 1]] for k in range(len(self._loops))],
+            self.repairs,
+        )
+
+    def at(self, motion: Any, t: float) -> Shape:
+        """The shape placed by ``motion`` at time ``t`` (see :class:`polycontact.Motion`)."""
+        translation, angle = motion.pose(t)
+        return self.moved(translation, angle)
+
+    # -- interchange ----------------------------------------------------------------
+    @classmethod
+    def from_shapely(cls, geom: Any, *, repair: bool = False) -> Shape:
+        """Shape from a shapely Polygon (or a MultiPolygon of exactly one part).
+
+        Examples
+        --------
+        >>> import shapely
+        >>> Shape.from_shapely(shapely.box(0, 0, 1, 1)).area
+        1.0
+        """
+        import shapely
+
+        if not isinstance(geom, shapely.Geometry):
+            raise InvalidShapeError(f"expected a shapely geometry, got {type(geom).__name__}")
+        if geom.geom_type == "MultiPolygon" and len(geom.geoms) == 1:
+            geom = geom.geoms[0]
+        if geom.geom_type != "Polygon":
+            raise InvalidShapeError(f"expected one Polygon, got a {geom.geom_type}")
+        if geom.is_empty:
+            raise InvalidShapeError("the polygon is empty")
+        return cls(
+            np.asarray(geom.exterior.coords)[:, :2],
+            [np.asarray(r.coords)[:, :2] for r in geom.interiors],
+            repair=repair,
+        )
+
+    def to_shapely(self) -> Any:
+        """The shape as a ``shapely.Polygon``."""
+        import shapely
+
+        return shapely.Polygon(self.exterior, self.holes)
+
+    @classmethod
+    def from_wkt(cls, text: str, *, repair: bool = False) -> Shape:
+        """Shape from WKT text, e.g. ``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``."""
+        import shapely
+
+        try:
+            geom = shapely.from_wkt(text)
+        except Exception as exc:
+            raise InvalidShapeError(f"not valid WKT: {exc}") from None
+        return cls.from_shapely(geom, repair=repair)
+
+    def to_wkt(self) -> str:
+        """The shape as WKT text."""
+        return self.to_shapely().wkt
+
+    @classmethod
+    def from_geojson(cls, data: str | dict, *, repair: bool = False) -> Shape:
+        """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
+        if isinstance(data, str):
+            try:
+                data = json.loads(data)
+            except json.JSONDecodeError as exc:
+                raise InvalidShapeError(f"not valid JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise InvalidShapeError("GeoJSON: expected an object")
+        if data.get("type") == "Feature":
+            data = data.get("geometry") or {}
+        if data.get("type") == "MultiPolygon" and len(data.get("coordinates", [])) == 1:
+            data = {"type": "Polygon", "coordinates": data["coordinates"][0]}
+        if data.get("type") != "Polygon":
+            raise InvalidShapeError(f"GeoJSON: expected a Polygon, got {data.get('type')!r}")
+        rings = data.get("coordinates")
+        if not isinstance(rings, list) or not rings:
+            raise InvalidShapeError("GeoJSON: 'coordinates' must be a non-empty list of rings")
+        return cls(rings[0], rings[1:], repair=repair)
+
+    @property
+    def __geo_interface__(self) -> dict:
+        """GeoJSON-like mapping (the Python geo interface), closed rings."""
+        return self.to_geojson()
+
+    def to_geojson(self) -> dict:
+        """The shape as a GeoJSON Polygon mapping with closed rings."""
+        rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
+        return {"type": "Polygon", "coordinates": rings}
+
+    def __repr__(self) -> str:
+        holes = f", {len(self.holes)} hole(s)" if self.holes else ""
+        return f"<Shape {len(self.exterior)} vertices{holes}, area {self._area:g}>"
+
+
+def as_shape(obj: Any, what: str = "shape") -> Shape:
+    """Coerce a Shape, a shapely Polygon or an (N, 2) array-like to a :class:`Shape`."""
+    if isinstance(obj, Shape):
+        return obj
+    if hasattr(obj, "geom_type"):
+        return Shape.from_shapely(obj)
+    try:
+        return Shape(obj)
+    except InvalidShapeError as exc:
+        raise InvalidShapeError(f"{what}: {exc}") from None
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.12g}"
+
+
+def _check_loops(loops: list[np.ndarray], eps: float) -> None:
+    from ._kernels import validate as kv
+
+    xy = np.ascontiguousarray(np.concatenate(loops))
+    starts = np.zeros(len(loops) + 1, dtype=np.int64)
+    starts[1:] = np.cumsum([len(r) for r in loops])
+    code, ki, ei, kj, ej, x, y = kv.first_defect(xy, starts, eps)
+    at = f"({_fmt(x)}, {_fmt(y)})"
+    if code == kv.SELF_INTERSECTION:
+        raise InvalidShapeError(
+            f"{_loop_name(ki)}: self-intersection at {at} between edge {ei} and edge {ej}"
+        )
+    if code == kv.SPIKE:
+        raise InvalidShapeError(
+            f"{_loop_name(ki)}: edges {ei} and {ej} fold back on each other at {at} "
+            "(zero-width spike)"
+        )
+    if code == kv.LOOPS_CROSS:
+        raise InvalidShapeError(
+            f"{_loop_name(kj)} crosses {'the ' if ki == 0 else ''}{_loop_name(ki)} at {at} "
+            f"(edge {ej} of {_loop_name(kj)}, edge {ei} of {_loop_name(ki)})"
+        )
+
+
+def _collinear(ring: np.ndarray, eps: float) -> bool:
+    """All vertices within eps of the line through vertex 0 and the vertex farthest from it."""
+    d = ring - ring[0]
+    far = int(np.argmax(np.hypot(d[:, 0], d[:, 1])))
+    u = d[far] / np.hypot(*d[far])
+    return bool(np.all(np.abs(d[:, 0] * u[1] - d[:, 1] * u[0]) <= eps))
+
+
+def _check_hole_placement(loops: list[np.ndarray]) -> None:
+    """Loops no longer cross; holes must lie in the outer loop and not in each other."""
+    import shapely
+
+    outer = shapely.Polygon(loops[0])
+    holes = shapely.polygons(loops[1:])
+    inside = shapely.covers(outer, holes)
+    if not inside.all():
+        i = int(np.flatnonzero(~inside)[0])
+        p = loops[i + 1][0]
+        raise InvalidShapeError(
+            f"hole {i} lies outside the outer loop (its vertex 0 is at ({_fmt(p[0])}, {_fmt(p[1])}))"
+        )
+    if len(holes) > 1:
+        tree = shapely.STRtree(holes)
+        left, right = tree.query(holes, predicate="intersects")
+        for i, j in zip(left.tolist(), right.tolist()):
+            if i < j and shapely.relate_pattern(holes[i], holes[j], "2********"):
+                raise InvalidShapeError(f"hole {i} and hole {j} overlap")
