@@ -55,9 +55,9 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     arr = arr[keep]
     while len(arr) > 1 and np.all(arr[-1] == arr[0]):
         arr = arr[:-1]
-    if len(arr) < 3:
+    if len(arr) < 3 or len(np.unique(arr, axis=0)) < 3:
         raise InvalidShapeError(
-            f"{what}: fewer than 3 distinct vertices ({len(arr)} after dropping repeats)"
+            f"{what}: fewer than 3 distinct vertices ({len(np.unique(arr, axis=0))})"
         )
     return arr
 
@@ -400,7 +400,7 @@ def _check_hole_placement(loops: list[np.ndarray]) -> None:
     import shapely
 
     outer = shapely.Polygon(loops[0])
-    holes = shapely.polygons(loops[1:])
+    holes = np.array([shapely.Polygon(h) for h in loops[1:]], dtype=object)
     inside = shapely.covers(outer, holes)
     if not inside.all():
         i = int(np.flatnonzero(~inside)[0])

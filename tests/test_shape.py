@@ -1,0 +1,173 @@
+"""Shape: normalisation, measurements against Shapely, interchange and bad input."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given
+from hypothesis import strategies as st
+
+from polycontact import InvalidShapeError, Shape
+
+SQUARE = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
+HOLE = [(1.0, 1.0), (1.0, 3.0), (3.0, 3.0), (3.0, 1.0)]
+
+
+@st.composite
+def star_polygons(draw, max_vertices=30):
+    """Random star-shaped (generally concave) simple polygons about a random centre."""
+    n = draw(st.integers(3, max_vertices))
+    angles = np.sort(
+        np.array(draw(st.lists(st.floats(0, 2 * np.pi, exclude_max=True), min_size=n,
+                               max_size=n, unique=True)))
+    )
+    if np.min(np.diff(np.r_[angles, angles[0] + 2 * np.pi])) < 1e-3 or np.max(
+        np.diff(np.r_[angles, angles[0] + 2 * np.pi])
+    ) >= np.pi:
+        angles = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    radii = np.array(draw(st.lists(st.floats(0.2, 1.0), min_size=n, max_size=n)))
+    cx, cy = draw(st.floats(-100, 100)), draw(st.floats(-100, 100))
+    scale = draw(st.floats(0.01, 100))
+    return np.c_[cx + scale * radii * np.cos(angles), cy + scale * radii * np.sin(angles)]
+
+
+def test_orientation_is_normalised_and_indices_follow_it():
+    s = Shape(SQUARE[::-1], [HOLE[::-1]])
+    assert s.exterior.tolist() == [[0, 0], [4, 0], [4, 4], [0, 4]]
+    assert shapely.LinearRing(s.exterior).is_ccw
+    assert not shapely.LinearRing(s.holes[0]).is_ccw
+    assert np.array_equal(s.loops[0], s.exterior)
+    assert np.array_equal(s.loops[1], s.holes[0])
+
+
+def test_closed_rings_and_repeated_vertices_are_dropped():
+    s = Shape(SQUARE + [SQUARE[0]])
+    assert len(s.exterior) == 4
+    s = Shape([(0, 0), (0, 0), (4, 0), (4, 0), (4, 4), (0, 4), (0, 0)])
+    assert len(s.exterior) == 4
+
+
+def test_arrays_are_read_only_and_input_untouched():
+    given_ = np.array(SQUARE[::-1])
+    before = given_.copy()
+    s = Shape(given_)
+    assert np.array_equal(given_, before)
+    with pytest.raises(ValueError):
+        s.exterior[0, 0] = 1.0
+    with pytest.raises(ValueError):
+        s.centroid[0] = 1.0
+
+
+@given(star_polygons())
+def test_area_centroid_radius_match_shapely(ring):
+    s = Shape(ring)
+    p = shapely.Polygon(ring)
+    assert s.area == pytest.approx(p.area, rel=1e-9)
+    c = p.centroid
+    scale = max(1.0, np.abs(ring).max())
+    assert np.allclose(s.centroid, (c.x, c.y), atol=1e-9 * scale)
+    assert s.bounding_radius == pytest.approx(np.hypot(*(ring - s.centroid).T).max())
+
+
+def test_centroid_with_hole_matches_shapely():
+    hole = [(0.5, 0.5), (0.5, 1.5), (2.5, 1.5), (2.5, 0.5)]
+    s = Shape(SQUARE, [hole])
+    p = shapely.Polygon(SQUARE, [hole])
+    assert s.area == pytest.approx(p.area)
+    assert np.allclose(s.centroid, (p.centroid.x, p.centroid.y))
+
+
+def test_paper_case_1_centroids_as_reported():
+    cases = json.load(open(__file__.rsplit("/", 2)[0] + "/../shared/paper/cases.json"))
+    reported = cases["case1"]["paper_reports"]["centroids"]
+    for body, c in zip(cases["case1"]["bodies"], reported):
+        assert np.allclose(Shape(body["vertices"]).centroid, c, atol=0.005)
+
+
+@pytest.mark.parametrize(
+    ("vertices", "holes", "message"),
+    [
+        ([(0, 0), (1, 0)], (), "fewer than 3 distinct vertices"),
+        ([(0, 0), (1, 0), (0, 0), (1, 0)], (), "fewer than 3 distinct vertices"),
+        ([(0, 0), (1, 0), (np.nan, 1)], (), "vertex 2 has a non-finite coordinate"),
+        ([(0, 0), (1, 0), (np.inf, 1)], (), "vertex 2 has a non-finite coordinate"),
+        ([(0, 0), (1, 1), (2, 2)], (), "zero area"),
+        ([(0, 0), (2, 2), (2, 0), (0, 2)], (), "self-intersection at (1, 1) between edge 0 and edge 2"),
+        ([(0, 0), (4, 0), (4, 4), (2, 0), (0, 4)], (), "self-intersection at (2, 0)"),
+        ([(0, 0), (2, 0), (1, 0), (1, 1)], (), "fold back"),
+        (SQUARE, [[(5, 5), (6, 5), (6, 6)]], "hole 0 lies outside the outer loop"),
+        (SQUARE, [[(1, 1), (5, 1), (5, 2)]], "hole 0 crosses the outer loop"),
+        (SQUARE, [HOLE, [(2, 2), (3.5, 2), (3.5, 3.5)]], "hole 1 crosses hole 0"),
+        (SQUARE, [HOLE, [(1.5, 1.5), (2.5, 1.5), (2.5, 2.5)]], "hole 0 and hole 1 overlap"),
+        (SQUARE, [[(0, 0), (1, 0), (1, 1)]], "crosses the outer loop"),
+        ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], (), "expected an array of shape (N, 2)"),
+        ([("a", 0), (1, 0), (0, 1)], (), "not numbers"),
+    ],
+)
+def test_bad_input_is_refused_with_what_and_where(vertices, holes, message):
+    with pytest.raises(InvalidShapeError) as info:
+        Shape(vertices, holes)
+    assert message in str(info.value)
+    assert isinstance(info.value, ValueError)
+
+
+def test_hole_touching_outer_loop_at_a_point_is_valid():
+    s = Shape(SQUARE, [[(0, 2), (2, 3), (2, 1)]])
+    assert shapely.is_valid(s.to_shapely())
+
+
+def test_repair_refuses_when_the_result_is_not_one_polygon():
+    with pytest.raises(InvalidShapeError, match="gives 2 polygons, not one"):
+        Shape([(0, 0), (2, 2), (2, 0), (0, 2)], repair=True)
+
+
+def test_paper_case_2_red_needs_repair():
+    cases = json.load(open(__file__.rsplit("/", 2)[0] + "/../shared/paper/cases.json"))
+    red = cases["case2"]["bodies"][0]["vertices"]
+    with pytest.raises(InvalidShapeError, match=r"self-intersection at \(10\.207"):
+        Shape(red)
+    fixed = Shape(red, repair=True)
+    assert fixed.repairs
+    assert fixed.area == pytest.approx(shapely.make_valid(shapely.Polygon(red)).area, rel=1e-5)
+
+
+def test_interchange_round_trips():
+    s = Shape(SQUARE, [HOLE])
+    for t in (
+        Shape.from_shapely(s.to_shapely()),
+        Shape.from_wkt(s.to_wkt()),
+        Shape.from_geojson(s.to_geojson()),
+        Shape.from_geojson(json.dumps({"type": "Feature", "geometry": s.__geo_interface__})),
+    ):
+        assert np.array_equal(t.exterior, s.exterior)
+        assert np.array_equal(t.holes[0], s.holes[0])
+    assert shapely.geometry.shape(s).equals(s.to_shapely())
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: Shape.from_wkt("POLYGON ((0 0, 1 0"), "not valid WKT"),
+        (lambda: Shape.from_wkt("LINESTRING (0 0, 1 0)"), "expected one Polygon"),
+        (lambda: Shape.from_geojson({"type": "Point", "coordinates": [0, 0]}), "expected a Polygon"),
+        (lambda: Shape.from_geojson("{"), "not valid JSON"),
+        (lambda: Shape.from_shapely(shapely.MultiPolygon([shapely.box(0, 0, 1, 1),
+                                                           shapely.box(2, 0, 3, 1)])),
+         "expected one Polygon"),
+    ],
+)
+def test_interchange_errors(call, message):
+    with pytest.raises(InvalidShapeError, match=message):
+        call()
+
+
+def test_moved_rotates_about_centroid():
+    s = Shape(SQUARE)
+    r = s.moved((1.0, 0.0), np.pi / 2)
+    assert np.allclose(r.centroid, s.centroid + (1, 0))
+    assert r.area == pytest.approx(s.area)
+    expected = shapely.Polygon(np.array(SQUARE) + (1, 0)).normalize()
+    assert shapely.equals_exact(shapely.Polygon(r.exterior).normalize(), expected, 1e-12)
