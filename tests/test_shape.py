@@ -171,3 +171,41 @@ def test_moved_rotates_about_centroid():
     assert r.area == pytest.approx(s.area)
     expected = shapely.Polygon(np.array(SQUARE) + (1, 0)).normalize()
     assert shapely.equals_exact(shapely.Polygon(r.exterior).normalize(), expected, 1e-12)
+
+
+@given(
+    st.lists(st.tuples(st.integers(0, 6), st.integers(0, 6)), min_size=3, max_size=9),
+)
+def test_accepts_exactly_the_rings_shapely_calls_valid(points):
+    """On an integer grid degeneracies are exact: touching, collinear, repeated points."""
+    ring = np.array(points, dtype=float)
+    keep = np.r_[True, np.any(ring[1:] != ring[:-1], axis=1)]
+    cleaned = ring[keep]
+    while len(cleaned) > 1 and np.all(cleaned[-1] == cleaned[0]):
+        cleaned = cleaned[:-1]
+    valid = len(np.unique(cleaned, axis=0)) >= 3 and shapely.is_valid(shapely.Polygon(cleaned))
+    try:
+        Shape(ring)
+        accepted = True
+    except InvalidShapeError:
+        accepted = False
+    assert accepted == valid, shapely.is_valid_reason(shapely.Polygon(cleaned))
+
+
+@given(
+    st.lists(st.tuples(st.integers(0, 8), st.integers(0, 8)), min_size=3, max_size=6),
+    st.lists(st.tuples(st.integers(0, 8), st.integers(0, 8)), min_size=3, max_size=6),
+)
+def test_accepts_exactly_the_holes_shapely_calls_valid(hole_a, hole_b):
+    outer = [(0, 0), (8, 0), (8, 8), (0, 8)]
+    holes = [np.array(hole_a, float), np.array(hole_b, float)]
+    for h in holes:
+        if len(np.unique(h, axis=0)) < 3 or not shapely.is_valid(shapely.Polygon(h)):
+            return  # rings that are invalid on their own are covered above
+    valid = shapely.is_valid(shapely.Polygon(outer, holes))
+    try:
+        Shape(outer, holes)
+        accepted = True
+    except InvalidShapeError:
+        accepted = False
+    assert accepted == valid, shapely.is_valid_reason(shapely.Polygon(outer, holes))

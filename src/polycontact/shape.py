@@ -414,3 +414,13 @@ def _check_hole_placement(loops: list[np.ndarray]) -> None:
         for i, j in zip(left.tolist(), right.tolist()):
             if i < j and shapely.relate_pattern(holes[i], holes[j], "2********"):
                 raise InvalidShapeError(f"hole {i} and hole {j} overlap")
+    # What is left for GEOS to find: touches that cut the solid into pieces.
+    reason = shapely.is_valid_reason(shapely.Polygon(loops[0], loops[1:]))
+    if reason.startswith("Interior is disconnected"):
+        where = reason[reason.find("[") + 1 : reason.find("]")].split()
+        raise InvalidShapeError(
+            f"the holes cut the shape in pieces: its interior is disconnected at "
+            f"({', '.join(where)})"
+        )
+    if reason != "Valid Geometry":
+        raise InvalidShapeError(f"invalid holes: {reason}")
