@@ -1,0 +1,585 @@
+"""Kernels: the relation of two polygonal regions (separate, contact, penetrating).
+
+Both bodies come in the packed form of :attr:`polycontact.Shape.packed`: ``xy`` (V, 2)
+float64 with every loop stacked, ``starts`` (L+1,) int64. Loops are oriented so that the
+interior is on the left of every edge (outer counter-clockwise, holes clockwise). The
+private ``_state`` also takes an orientation sign per body (``-1.0``: the interior is on
+the right of every edge), so a raw clockwise ring can be classified without a copy.
+
+The state decision (the reference point of A against the entrance block E(A, B)):
+the interiors overlap iff (1) an edge of A properly crosses an edge of B, or (2) a loop
+vertex lies strictly inside the other body (distance to its boundary above eps), or
+(3) at a point where the boundaries touch (a vertex within eps of the other boundary)
+the open interior cones of A and B overlap with positive angle. For (2) one vertex per
+loop that touches nothing is enough: an arc of a loop between touches lies wholly inside
+or wholly outside the other body, and an arc inside it makes the cones overlap at its
+end, which (3) sees. Pairs of edges are found with a sweep over x restricted to the
+common bounding box, so the cost is O((m + n) log(m + n) + pairs whose boxes meet).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .validate import _orient, _point_segment_distance, first_defect
+
+SEPARATE = 0
+CONTACT = 1
+PENETRATING = 2
+
+
+@njit(cache=True, nogil=True)
+def _bbox(xy, n):
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
+    for i in range(n):
+        x = xy[i, 0]
+        y = xy[i, 1]
+        x0 = min(x0, x)
+        x1 = max(x1, x)
+        y0 = min(y0, y)
+        y1 = max(y1, y)
+    return x0, x1, y0, y1
+
+
+@njit(cache=True, nogil=True)
+def _next_vertex(i, starts, loop_of):
+    k = loop_of[i]
+    return i + 1 if i + 1 < starts[k + 1] else starts[k]
+
+
+@njit(cache=True, nogil=True)
+def _loop_index(starts, n):
+    loop_of = np.empty(n, np.int64)
+    for k in range(starts.shape[0] - 1):
+        for i in range(starts[k], starts[k + 1]):
+            loop_of[i] = k
+    return loop_of
+
+
+@njit(cache=True, nogil=True)
+def _inside(px, py, xy, starts):
+    """Crossing-number test of a point against every loop (holes count); the point is
+    assumed farther than the tolerance from the boundary."""
+    inside = False
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        j = e - 1
+        for i in range(s, e):
+            yi = xy[i, 1]
+            yj = xy[j, 1]
+            if (yi > py) != (yj > py):
+                xi = xy[i, 0]
+                xj = xy[j, 0]
+                if px < xi + (py - yi) * (xj - xi) / (yj - yi):
+                    inside = not inside
+            j = i
+    return inside
+
+
+@njit(cache=True, nogil=True)
+def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, cnt):
+    """Append the edges of one body whose bounding box meets the window."""
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            x0 = min(xy[i, 0], xy[j, 0])
+            x1 = max(xy[i, 0], xy[j, 0])
+            y0 = min(xy[i, 1], xy[j, 1])
+            y1 = max(xy[i, 1], xy[j, 1])
+            if x1 < wx0 or x0 > wx1 or y1 < wy0 or y0 > wy1:
+                continue
+            ex0[cnt] = x0
+            ex1[cnt] = x1
+            ey0[cnt] = y0
+            ey1[cnt] = y1
+            eid[cnt] = offset + i
+            cnt += 1
+    return cnt
+
+
+@njit(cache=True, nogil=True)
+def _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid, order, cnt,
+                   maxw, na, eps):
+    """Whether the open interior cones of A and B at the touch point p overlap.
+
+    Every edge of either body within eps of p gives rays leaving p: along the edge from
+    its near end (or both ways when p is inside the edge). A ray whose interior side is
+    counter-clockwise of it is "opening"; sorted by angle, the interior of a body in a
+    direction d is decided by the body's nearest ray clockwise of d.
+    """
+    # binary search: first sorted edge with xmin >= px - eps - maxw
+    lo = 0
+    hi = cnt
+    xlo = px - eps - maxw
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if ex0[order[mid]] < xlo:
+            lo = mid + 1
+        else:
+            hi = mid
+    cap = 0
+    for oi in range(lo, cnt):
+        i = order[oi]
+        if ex0[i] > px + eps:
+            break
+        if ey0[i] <= py + eps and ey1[i] >= py - eps:
+            cap += 2
+    ang = np.empty(cap)
+    length = np.empty(cap)
+    opening = np.empty(cap, np.bool_)
+    is_a = np.empty(cap, np.bool_)
+    r = 0
+    for oi in range(lo, cnt):
+        i = order[oi]
+        if ex0[i] > px + eps:
+            break
+        if ey0[i] > py + eps or ey1[i] < py - eps:
+            continue
+        g = eid[i]
+        if g < na:
+            xy = xa
+            v = g
+            w = _next_vertex(v, sa, la)
+            flip = fa
+            body_a = True
+        else:
+            xy = xb
+            v = g - na
+            w = _next_vertex(v, sb, lb)
+            flip = fb
+            body_a = False
+        ux = xy[v, 0]
+        uy = xy[v, 1]
+        wx = xy[w, 0]
+        wy = xy[w, 1]
+        if _point_segment_distance(px, py, ux, uy, wx, wy) > eps:
+            continue
+        du = np.hypot(px - ux, py - uy)
+        dw = np.hypot(px - wx, py - wy)
+        le = np.hypot(wx - ux, wy - uy)
+        if du > eps or dw <= eps:  # ray from p (or from w) back along the edge
+            if not (du <= eps and dw <= eps):
+                ang[r] = np.arctan2(uy - wy, ux - wx)
+                length[r] = le
+                opening[r] = flip < 0.0
+                is_a[r] = body_a
+                r += 1
+        if dw > eps:  # ray from p (or from u) forward along the edge
+            ang[r] = np.arctan2(wy - uy, wx - ux)
+            length[r] = le
+            opening[r] = flip > 0.0
+            is_a[r] = body_a
+            r += 1
+    if r == 0:
+        return False
+    ordr = np.argsort(ang[:r])
+    for q in range(r):
+        i1 = ordr[q]
+        i2 = ordr[(q + 1) % r]
+        gap = ang[i2] - ang[i1]
+        if q == r - 1:
+            gap += 2.0 * np.pi
+        if gap * min(length[i1], length[i2]) <= eps and gap < 1.0:
+            continue
+        mid = ang[i1] + 0.5 * gap
+        if mid > np.pi:
+            mid -= 2.0 * np.pi
+        in_a = _interior_at(mid, ang, opening, is_a, r, True)
+        in_b = _interior_at(mid, ang, opening, is_a, r, False)
+        if in_a and in_b:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def _interior_at(theta, ang, opening, is_a, r, body_a):
+    """Interior flag of one body in direction theta: its nearest ray clockwise."""
+    best = -1
+    best_gap = np.inf
+    for i in range(r):
+        if is_a[i] != body_a:
+            continue
+        gap = theta - ang[i]
+        if gap < 0.0:
+            gap += 2.0 * np.pi
+        if gap < best_gap:
+            best_gap = gap
+            best = i
+    if best < 0:
+        return False
+    return opening[best]
+
+
+@njit(cache=True, nogil=True)
+def _state(xa, sa, fa, xb, sb, fb, eps):
+    """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right)."""
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    ax0, ax1, ay0, ay1 = _bbox(xa, na)
+    bx0, bx1, by0, by1 = _bbox(xb, nb)
+    if ax0 > bx1 + eps or bx0 > ax1 + eps or ay0 > by1 + eps or by0 > ay1 + eps:
+        return SEPARATE
+    wx0 = max(ax0, bx0) - eps
+    wx1 = min(ax1, bx1) + eps
+    wy0 = max(ay0, by0) - eps
+    wy1 = min(ay1, by1) + eps
+    la = _loop_index(sa, na)
+    lb = _loop_index(sb, nb)
+    tot = na + nb
+    ex0 = np.empty(tot)
+    ex1 = np.empty(tot)
+    ey0 = np.empty(tot)
+    ey1 = np.empty(tot)
+    eid = np.empty(tot, np.int64)
+    cnt = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, 0)
+    cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, cnt)
+    order = np.argsort(ex0[:cnt])
+    touch = np.zeros(tot, np.bool_)
+    any_touch = False
+    maxw = 0.0
+    for oi in range(cnt):
+        i = order[oi]
+        maxw = max(maxw, ex1[i] - ex0[i])
+        gi = eid[i]
+        for oj in range(oi + 1, cnt):
+            j = order[oj]
+            if ex0[j] > ex1[i] + eps:
+                break
+            gj = eid[j]
+            if (gi < na) == (gj < na):
+                continue
+            if ey0[j] > ey1[i] + eps or ey0[i] > ey1[j] + eps:
+                continue
+            ga = gi if gi < na else gj
+            gb = (gj if gi < na else gi) - na
+            a1 = _next_vertex(ga, sa, la)
+            b1 = _next_vertex(gb, sb, lb)
+            px, py = xa[ga, 0], xa[ga, 1]
+            qx, qy = xa[a1, 0], xa[a1, 1]
+            rx, ry = xb[gb, 0], xb[gb, 1]
+            sx, sy = xb[b1, 0], xb[b1, 1]
+            near = False
+            if _point_segment_distance(px, py, rx, ry, sx, sy) <= eps:
+                touch[ga] = True
+                near = True
+            if _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps:
+                touch[a1] = True
+                near = True
+            if _point_segment_distance(rx, ry, px, py, qx, qy) <= eps:
+                touch[na + gb] = True
+                near = True
+            if _point_segment_distance(sx, sy, px, py, qx, qy) <= eps:
+                touch[na + b1] = True
+                near = True
+            if near:
+                any_touch = True
+                continue
+            o1 = _orient(px, py, qx, qy, rx, ry)
+            o2 = _orient(px, py, qx, qy, sx, sy)
+            o3 = _orient(rx, ry, sx, sy, px, py)
+            o4 = _orient(rx, ry, sx, sy, qx, qy)
+            if ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
+                return PENETRATING
+    # (3) cones at the touch points
+    if any_touch:
+        for g in range(tot):
+            if not touch[g]:
+                continue
+            if g < na:
+                px, py = xa[g, 0], xa[g, 1]
+            else:
+                px, py = xb[g - na, 0], xb[g - na, 1]
+            if _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid,
+                              order, cnt, maxw, na, eps):
+                return PENETRATING
+    # (2) one untouched vertex per loop, strictly inside the other body
+    for k in range(sa.shape[0] - 1):
+        for i in range(sa[k], sa[k + 1]):
+            if not touch[i]:
+                x = xa[i, 0]
+                y = xa[i, 1]
+                if bx0 <= x <= bx1 and by0 <= y <= by1 and _inside(x, y, xb, sb):
+                    return PENETRATING
+                break
+    for k in range(sb.shape[0] - 1):
+        for i in range(sb[k], sb[k + 1]):
+            if not touch[na + i]:
+                x = xb[i, 0]
+                y = xb[i, 1]
+                if ax0 <= x <= ax1 and ay0 <= y <= ay1 and _inside(x, y, xa, sa):
+                    return PENETRATING
+                break
+    return CONTACT if any_touch else SEPARATE
+
+
+@njit(cache=True, nogil=True)
+def relate_state(xa, sa, xb, sb, eps):
+    """State of A against B: 0 separate, 1 contact, 2 penetrating (interiors overlap).
+
+    Parameters
+    ----------
+    xa, sa, xb, sb : packed loops of A and B (see :attr:`polycontact.Shape.packed`),
+        oriented with the interior on the left of every edge.
+    eps : float
+        Absolute tolerance: distances up to eps count as touching.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> [relate_state(sq, st, sq + d, st, 1e-12) for d in ([2.0, 0.0], [1.0, 0.0], [0.5, 0.5])]
+    [0, 1, 2]
+    """
+    return _state(xa, sa, 1.0, xb, sb, 1.0, eps)
+
+
+@njit(cache=True, nogil=True)
+def _segment_distance(px, py, qx, qy, rx, ry, sx, sy):
+    o1 = _orient(px, py, qx, qy, rx, ry)
+    o2 = _orient(px, py, qx, qy, sx, sy)
+    o3 = _orient(rx, ry, sx, sy, px, py)
+    o4 = _orient(rx, ry, sx, sy, qx, qy)
+    if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and (
+        (o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)
+    ):
+        return 0.0
+    d = _point_segment_distance(px, py, rx, ry, sx, sy)
+    d = min(d, _point_segment_distance(qx, qy, rx, ry, sx, sy))
+    d = min(d, _point_segment_distance(rx, ry, px, py, qx, qy))
+    return min(d, _point_segment_distance(sx, sy, px, py, qx, qy))
+
+
+@njit(cache=True, nogil=True)
+def boundary_distance(xa, sa, xb, sb):
+    """Minimum Euclidean distance between the boundaries of A and B (all loops).
+
+    0 when the boundaries touch or cross. It is not the distance between the regions:
+    a body deep inside another is at a positive boundary distance.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> float(boundary_distance(sq, st, sq + np.array([3.0, 4.0]), st))
+    3.0
+    """
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    la = _loop_index(sa, na)
+    lb = _loop_index(sb, nb)
+    bx0, bx1, by0, by1 = _bbox(xb, nb)
+    # Upper bound first: the vertex of A nearest B's box centre, to its nearest B vertex.
+    cx = 0.5 * (bx0 + bx1)
+    cy = 0.5 * (by0 + by1)
+    ia = 0
+    dmin = np.inf
+    for i in range(na):
+        d = np.hypot(xa[i, 0] - cx, xa[i, 1] - cy)
+        if d < dmin:
+            dmin = d
+            ia = i
+    best = np.inf
+    for j in range(nb):
+        best = min(best, np.hypot(xa[ia, 0] - xb[j, 0], xa[ia, 1] - xb[j, 1]))
+    # B's edges sorted by their smallest x
+    bxmin = np.empty(nb)
+    maxw = 0.0
+    for j in range(nb):
+        j1 = _next_vertex(j, sb, lb)
+        bxmin[j] = min(xb[j, 0], xb[j1, 0])
+        maxw = max(maxw, abs(xb[j, 0] - xb[j1, 0]))
+    order = np.argsort(bxmin)
+    sorted_x = bxmin[order]
+    for i in range(na):
+        i1 = _next_vertex(i, sa, la)
+        px, py = xa[i, 0], xa[i, 1]
+        qx, qy = xa[i1, 0], xa[i1, 1]
+        x0 = min(px, qx)
+        x1 = max(px, qx)
+        y0 = min(py, qy)
+        y1 = max(py, qy)
+        if x0 > bx1 + best or x1 < bx0 - best or y0 > by1 + best or y1 < by0 - best:
+            continue
+        o = np.searchsorted(sorted_x, x0 - best - maxw)
+        while o < nb:
+            j = order[o]
+            o += 1
+            if sorted_x[o - 1] > x1 + best:
+                break
+            j1 = _next_vertex(j, sb, lb)
+            rx, ry = xb[j, 0], xb[j, 1]
+            sx, sy = xb[j1, 0], xb[j1, 1]
+            if max(rx, sx) < x0 - best:
+                continue
+            if min(ry, sy) > y1 + best or max(ry, sy) < y0 - best:
+                continue
+            d = _segment_distance(px, py, qx, qy, rx, ry, sx, sy)
+            if d < best:
+                best = d
+                if best == 0.0:
+                    return 0.0
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _raw_ring(xy, rel):
+    """Check one raw (N, 2) ring; returns ``(n, sign, scale)``.
+
+    ``n`` is the number of vertices used (a repeated closing point dropped), or -1 when
+    the ring is not a valid simple polygon as given (the caller then lets
+    :class:`polycontact.Shape` explain or repair); ``sign`` is +1.0 counter-clockwise,
+    -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1).
+    """
+    n = xy.shape[0]
+    if n >= 2 and xy[n - 1, 0] == xy[0, 0] and xy[n - 1, 1] == xy[0, 1]:
+        n -= 1
+    if n < 3:
+        return -1, 1.0, 1.0
+    scale = 1.0
+    for i in range(n):
+        x = xy[i, 0]
+        y = xy[i, 1]
+        if not (np.isfinite(x) and np.isfinite(y)):
+            return -1, 1.0, 1.0
+        scale = max(scale, abs(x), abs(y))
+    eps = rel * scale
+    x0, x1, y0, y1 = _bbox(xy, n)
+    a2 = 0.0
+    j = n - 1
+    for i in range(n):
+        a2 += xy[j, 0] * xy[i, 1] - xy[i, 0] * xy[j, 1]
+        j = i
+    if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
+        return -1, 1.0, 1.0
+    starts = np.empty(2, np.int64)
+    starts[0] = 0
+    starts[1] = n
+    if first_defect(xy[:n], starts, eps)[0] != 0:
+        return -1, 1.0, 1.0
+    return n, (1.0 if a2 > 0.0 else -1.0), scale
+
+
+@njit(cache=True, nogil=True)
+def classify_raw(a, b, tol, rel):
+    """Validate two raw outer rings and classify them in one call.
+
+    Returns ``(state, eps, na, sign_a, nb, sign_b)``; ``state`` is -1 when ring A is not
+    valid as given and -2 when ring B is not (the caller re-raises through ``Shape``).
+    ``tol`` < 0 means the default tolerance ``rel`` × the largest coordinate.
+    """
+    na, fa, sca = _raw_ring(a, rel)
+    if na < 0:
+        return -1, 0.0, na, fa, 0, 1.0
+    nb, fb, scb = _raw_ring(b, rel)
+    if nb < 0:
+        return -2, 0.0, na, fa, nb, fb
+    eps = tol if tol >= 0.0 else rel * max(sca, scb)
+    sa = np.empty(2, np.int64)
+    sa[0] = 0
+    sa[1] = na
+    sb = np.empty(2, np.int64)
+    sb[0] = 0
+    sb[1] = nb
+    return _state(a[:na], sa, fa, b[:nb], sb, fb, eps), eps, na, fa, nb, fb
+
+
+@njit(cache=True, nogil=True)
+def _segments_cross(px, py, qx, qy, rx, ry, sx, sy, eps):
+    """Proper crossing: no endpoint within eps of the other segment, and they meet."""
+    if (
+        _point_segment_distance(px, py, rx, ry, sx, sy) <= eps
+        or _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps
+        or _point_segment_distance(rx, ry, px, py, qx, qy) <= eps
+        or _point_segment_distance(sx, sy, px, py, qx, qy) <= eps
+    ):
+        return False
+    o1 = _orient(px, py, qx, qy, rx, ry)
+    o2 = _orient(px, py, qx, qy, sx, sy)
+    o3 = _orient(rx, ry, sx, sy, px, py)
+    o4 = _orient(rx, ry, sx, sy, qx, qy)
+    return ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0))
+
+
+@njit(cache=True, nogil=True)
+def _vertex_features(xv, sv, xo, so, eps, out_on, out_in):
+    """Vertices of one body on (within eps of) or strictly inside the other body.
+
+    Appends ``(vertex, edge, distance)`` rows (global indices) to ``out_on`` for every
+    edge within eps, and ``(vertex, nearest edge, distance)`` to ``out_in`` for a vertex
+    strictly inside.
+    """
+    nv = sv[sv.shape[0] - 1]
+    no = so[so.shape[0] - 1]
+    lo = _loop_index(so, no)
+    ox0, ox1, oy0, oy1 = _bbox(xo, no)
+    for i in range(nv):
+        px = xv[i, 0]
+        py = xv[i, 1]
+        if px < ox0 - eps or px > ox1 + eps or py < oy0 - eps or py > oy1 + eps:
+            continue
+        on = False
+        near = np.inf
+        near_e = -1
+        for f in range(no):
+            f1 = _next_vertex(f, so, lo)
+            d = _point_segment_distance(px, py, xo[f, 0], xo[f, 1], xo[f1, 0], xo[f1, 1])
+            if d <= eps:
+                out_on.append((i, f, d))
+                on = True
+            if d < near:
+                near = d
+                near_e = f
+        if not on and _inside(px, py, xo, so):
+            out_in.append((i, near_e, near))
+
+
+@njit(cache=True, nogil=True)
+def features(xa, sa, xb, sb, eps):
+    """Every contact feature of A and B (global vertex/edge indices of the packed form).
+
+    Returns ``(a_on, b_on, a_in, b_in, cross)``: lists of ``(vertex, edge, distance)``
+    for vertices of A on edges of B and of B on edges of A, vertices strictly inside the
+    other body with the nearest edge of the other body, and ``(edge_a, edge_b, x, y)``
+    for proper crossings. Brute force over all pairs (O(m n)); used lazily.
+    """
+    a_on = [(0, 0, 0.0)]
+    b_on = [(0, 0, 0.0)]
+    a_in = [(0, 0, 0.0)]
+    b_in = [(0, 0, 0.0)]
+    cross = [(0, 0, 0.0, 0.0)]
+    a_on.clear()
+    b_on.clear()
+    a_in.clear()
+    b_in.clear()
+    cross.clear()
+    _vertex_features(xa, sa, xb, sb, eps, a_on, a_in)
+    _vertex_features(xb, sb, xa, sa, eps, b_on, b_in)
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    la = _loop_index(sa, na)
+    lb = _loop_index(sb, nb)
+    for e in range(na):
+        e1 = _next_vertex(e, sa, la)
+        px, py, qx, qy = xa[e, 0], xa[e, 1], xa[e1, 0], xa[e1, 1]
+        for f in range(nb):
+            f1 = _next_vertex(f, sb, lb)
+            rx, ry, sx, sy = xb[f, 0], xb[f, 1], xb[f1, 0], xb[f1, 1]
+            if max(rx, sx) < min(px, qx) or min(rx, sx) > max(px, qx):
+                continue
+            if max(ry, sy) < min(py, qy) or min(ry, sy) > max(py, qy):
+                continue
+            if _segments_cross(px, py, qx, qy, rx, ry, sx, sy, eps):
+                o1 = _orient(px, py, qx, qy, rx, ry)
+                o2 = _orient(px, py, qx, qy, sx, sy)
+                t = o1 / (o1 - o2)
+                cross.append((e, f, rx + t * (sx - rx), ry + t * (sy - ry)))
+    return a_on, b_on, a_in, b_in, cross
