@@ -33,6 +33,7 @@ _LAZY = {
     "Relation": "relation",
     "classify": "relation",
     "classify_many": "relation",
+    "RelationBatch": "relation",
     "warmup": "relation",
     # entrance block
     "EntranceBlock": "entrance_block",

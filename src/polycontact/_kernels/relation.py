@@ -342,7 +342,19 @@ def relate_state(xa, sa, xb, sb, eps):
 
 
 @njit(cache=True, nogil=True)
-def _segment_distance(px, py, qx, qy, rx, ry, sx, sy):
+def _closest_on(px, py, ax, ay, bx, by):
+    dx = bx - ax
+    dy = by - ay
+    den = dx * dx + dy * dy
+    t = 0.0
+    if den > 0.0:
+        t = min(1.0, max(0.0, ((px - ax) * dx + (py - ay) * dy) / den))
+    return ax + t * dx, ay + t * dy
+
+
+@njit(cache=True, nogil=True)
+def _segment_closest(px, py, qx, qy, rx, ry, sx, sy):
+    """Distance between segments pq and rs, with a closest pair ``(x1, y1, x2, y2)``."""
     o1 = _orient(px, py, qx, qy, rx, ry)
     o2 = _orient(px, py, qx, qy, sx, sy)
     o3 = _orient(rx, ry, sx, sy, px, py)
@@ -350,27 +362,39 @@ def _segment_distance(px, py, qx, qy, rx, ry, sx, sy):
     if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and (
         (o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)
     ):
-        return 0.0
-    d = _point_segment_distance(px, py, rx, ry, sx, sy)
-    d = min(d, _point_segment_distance(qx, qy, rx, ry, sx, sy))
-    d = min(d, _point_segment_distance(rx, ry, px, py, qx, qy))
-    return min(d, _point_segment_distance(sx, sy, px, py, qx, qy))
+        t = o1 / (o1 - o2)
+        x = rx + t * (sx - rx)
+        y = ry + t * (sy - ry)
+        return 0.0, x, y, x, y
+    best = np.inf
+    x1 = y1 = x2 = y2 = 0.0
+    for k in range(4):
+        if k == 0:
+            ux, uy, ax, ay, bx, by, on_first = px, py, rx, ry, sx, sy, True
+        elif k == 1:
+            ux, uy, ax, ay, bx, by, on_first = qx, qy, rx, ry, sx, sy, True
+        elif k == 2:
+            ux, uy, ax, ay, bx, by, on_first = rx, ry, px, py, qx, qy, False
+        else:
+            ux, uy, ax, ay, bx, by, on_first = sx, sy, px, py, qx, qy, False
+        cx, cy = _closest_on(ux, uy, ax, ay, bx, by)
+        d = np.hypot(ux - cx, uy - cy)
+        if d < best:
+            best = d
+            if on_first:
+                x1, y1, x2, y2 = ux, uy, cx, cy
+            else:
+                x1, y1, x2, y2 = cx, cy, ux, uy
+    return best, x1, y1, x2, y2
 
 
 @njit(cache=True, nogil=True)
-def boundary_distance(xa, sa, xb, sb):
-    """Minimum Euclidean distance between the boundaries of A and B (all loops).
+def closest_pair(xa, sa, xb, sb):
+    """Closest points of the boundaries of A and B: ``(distance, xa, ya, xb, yb)``.
 
-    0 when the boundaries touch or cross. It is not the distance between the regions:
-    a body deep inside another is at a positive boundary distance.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> st = np.array([0, 4])
-    >>> float(boundary_distance(sq, st, sq + np.array([3.0, 4.0]), st))
-    3.0
+    Edges of B are sorted by their smallest x; each edge of A only visits the edges of
+    B whose boxes come within the best distance found so far (started from a vertex
+    pair near the middle of B), so close pairs prune the rest.
     """
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
@@ -388,9 +412,12 @@ def boundary_distance(xa, sa, xb, sb):
             dmin = d
             ia = i
     best = np.inf
+    r0 = r1 = r2 = r3 = 0.0
     for j in range(nb):
-        best = min(best, np.hypot(xa[ia, 0] - xb[j, 0], xa[ia, 1] - xb[j, 1]))
-    # B's edges sorted by their smallest x
+        d = np.hypot(xa[ia, 0] - xb[j, 0], xa[ia, 1] - xb[j, 1])
+        if d < best:
+            best = d
+            r0, r1, r2, r3 = xa[ia, 0], xa[ia, 1], xb[j, 0], xb[j, 1]
     bxmin = np.empty(nb)
     maxw = 0.0
     for j in range(nb):
@@ -422,12 +449,32 @@ def boundary_distance(xa, sa, xb, sb):
                 continue
             if min(ry, sy) > y1 + best or max(ry, sy) < y0 - best:
                 continue
-            d = _segment_distance(px, py, qx, qy, rx, ry, sx, sy)
+            d, c0, c1, c2, c3 = _segment_closest(px, py, qx, qy, rx, ry, sx, sy)
             if d < best:
                 best = d
+                r0, r1, r2, r3 = c0, c1, c2, c3
                 if best == 0.0:
-                    return 0.0
-    return best
+                    return best, r0, r1, r2, r3
+    return best, r0, r1, r2, r3
+
+
+@njit(cache=True, nogil=True)
+def boundary_distance(xa, sa, xb, sb):
+    """Minimum Euclidean distance between the boundaries of A and B (all loops).
+
+    0 when the boundaries touch or cross. It is not the distance between the regions:
+    a body deep inside another is at a positive boundary distance. See
+    :func:`closest_pair` for the search.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> float(boundary_distance(sq, st, sq + np.array([3.0, 0.0]), st))
+    2.0
+    """
+    return closest_pair(xa, sa, xb, sb)[0]
 
 
 @njit(cache=True, nogil=True)
@@ -583,3 +630,195 @@ def features(xa, sa, xb, sb, eps):
                 t = o1 / (o1 - o2)
                 cross.append((e, f, rx + t * (sx - rx), ry + t * (sy - ry)))
     return a_on, b_on, a_in, b_in, cross
+
+
+@njit(cache=True, nogil=True)
+def _ccw_angle(ux, uy, vx, vy):
+    """Counter-clockwise angle from u to v, in [0, 2 pi)."""
+    t = np.arctan2(ux * vy - uy * vx, ux * vx + uy * vy)
+    return t + 2.0 * np.pi if t < 0.0 else t
+
+
+@njit(cache=True, nogil=True)
+def _cone_meets_left(xy, starts, loop_of, v, ux, uy):
+    """Whether the interior cone of a body at its vertex v clearly meets the open
+    half-plane on the left of direction u (then a touch of v on an edge along u can
+    never be a boundary configuration of the overlap set)."""
+    k = loop_of[v]
+    s = starts[k]
+    e = starts[k + 1]
+    nxt = v + 1 if v + 1 < e else s
+    prv = v - 1 if v > s else e - 1
+    ox = xy[nxt, 0] - xy[v, 0]
+    oy = xy[nxt, 1] - xy[v, 1]
+    ix = xy[prv, 0] - xy[v, 0]
+    iy = xy[prv, 1] - xy[v, 1]
+    tol = 1e-9
+    lu = np.hypot(ux, uy)
+    if (ux * oy - uy * ox) > tol * lu * np.hypot(ox, oy):
+        return True
+    if (ux * iy - uy * ix) > tol * lu * np.hypot(ix, iy):
+        return True
+    # both rays on the right: the cone meets the left iff it contains the left normal
+    return _ccw_angle(ox, oy, -uy, ux) + tol < _ccw_angle(ox, oy, ix, iy)
+
+
+@njit(cache=True, nogil=True)
+def _origin_segment_distance(px, py, qx, qy):
+    return _point_segment_distance(0.0, 0.0, px, py, qx, qy)
+
+
+@njit(cache=True, nogil=True)
+def _touch_segments(xa, sa, xb, sb, bound, keep_count, out):
+    """Displacements of A that put a vertex of one body on an edge of the other.
+
+    Vertex b_i on edge e of A: segment b_i - e; vertex a_j on edge f of B: f - a_j.
+    Segments whose configuration always overlaps (the vertex's cone meets the edge's
+    interior side) or that stay farther than ``bound`` from the origin are dropped.
+    With ``keep_count`` the rows ``(px, py, qx, qy, dist)`` are written to ``out``.
+    """
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    la = _loop_index(sa, na)
+    lb = _loop_index(sb, nb)
+    r = 0
+    for e in range(na):
+        e1 = _next_vertex(e, sa, la)
+        ux = xa[e1, 0] - xa[e, 0]
+        uy = xa[e1, 1] - xa[e, 1]
+        for i in range(nb):
+            px = xb[i, 0] - xa[e, 0]
+            py = xb[i, 1] - xa[e, 1]
+            qx = xb[i, 0] - xa[e1, 0]
+            qy = xb[i, 1] - xa[e1, 1]
+            d = _origin_segment_distance(px, py, qx, qy)
+            if d >= bound or _cone_meets_left(xb, sb, lb, i, ux, uy):
+                continue
+            if keep_count:
+                out[r, 0] = px
+                out[r, 1] = py
+                out[r, 2] = qx
+                out[r, 3] = qy
+                out[r, 4] = d
+            r += 1
+    for f in range(nb):
+        f1 = _next_vertex(f, sb, lb)
+        ux = xb[f1, 0] - xb[f, 0]
+        uy = xb[f1, 1] - xb[f, 1]
+        for j in range(na):
+            px = xb[f, 0] - xa[j, 0]
+            py = xb[f, 1] - xa[j, 1]
+            qx = xb[f1, 0] - xa[j, 0]
+            qy = xb[f1, 1] - xa[j, 1]
+            d = _origin_segment_distance(px, py, qx, qy)
+            if d >= bound or _cone_meets_left(xa, sa, la, j, ux, uy):
+                continue
+            if keep_count:
+                out[r, 0] = px
+                out[r, 1] = py
+                out[r, 2] = qx
+                out[r, 3] = qy
+                out[r, 4] = d
+            r += 1
+    return r
+
+
+@njit(cache=True, nogil=True)
+def _separates(xa, sa, xb, sb, dx, dy, eps):
+    moved = xa.copy()
+    moved[:, 0] += dx
+    moved[:, 1] += dy
+    return _state(moved, sa, 1.0, xb, sb, 1.0, eps) != PENETRATING
+
+
+@njit(cache=True, nogil=True)
+def penetration(xa, sa, xb, sb, eps):
+    """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
+
+    Returns ``(depth, dx, dy)``. The boundary of the overlap set {d : int(A+d) meets
+    int(B)} lies on the segments of :func:`_touch_segments`, so the nearest point of its
+    complement is a foot of the perpendicular from the origin on one of them, a segment
+    end, or a crossing of two segments. Candidates are tried in increasing distance,
+    each checked with the state kernel, and the search stops when no segment can hold a
+    nearer one. Moving A out of B's bounding box gives the first upper bound.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> [float(v) for v in penetration(sq, st, sq + np.array([0.75, 0.5]), st, 1e-12)]
+    [0.25, -0.25, 0.0]
+    """
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    ax0, ax1, ay0, ay1 = _bbox(xa, na)
+    bx0, bx1, by0, by1 = _bbox(xb, nb)
+    best = bx1 - ax0
+    bdx = best
+    bdy = 0.0
+    for m, mx, my in ((ax1 - bx0, -1.0, 0.0), (by1 - ay0, 0.0, 1.0), (ay1 - by0, 0.0, -1.0)):
+        if m < best:
+            best = m
+            bdx = mx * m
+            bdy = my * m
+    cnt = _touch_segments(xa, sa, xb, sb, best, False, np.empty((0, 5)))
+    seg = np.empty((cnt, 5))
+    _touch_segments(xa, sa, xb, sb, best, True, seg)
+    order = np.argsort(seg[:, 4])
+    cand = np.empty((cnt + 3, 3))
+    for oi in range(cnt):
+        s = order[oi]
+        if seg[s, 4] >= best:
+            break
+        px, py, qx, qy = seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]
+        vx = qx - px
+        vy = qy - py
+        den = vx * vx + vy * vy
+        t = min(1.0, max(0.0, -(px * vx + py * vy) / den)) if den > 0.0 else 0.0
+        nc = 0
+        for cx, cy in ((px + t * vx, py + t * vy), (px, py), (qx, qy)):
+            d = np.hypot(cx, cy)
+            if d < best:
+                cand[nc, 0] = d
+                cand[nc, 1] = cx
+                cand[nc, 2] = cy
+                nc += 1
+        for oj in range(cnt):
+            u = order[oj]
+            if seg[u, 4] >= best:
+                break
+            if u == s:
+                continue
+            rx, ry = seg[u, 0], seg[u, 1]
+            wx = seg[u, 2] - rx
+            wy = seg[u, 3] - ry
+            det = vx * wy - vy * wx
+            if det == 0.0:
+                continue
+            ts = ((rx - px) * wy - (ry - py) * wx) / det
+            tu = ((rx - px) * vy - (ry - py) * vx) / det
+            if ts < 0.0 or ts > 1.0 or tu < 0.0 or tu > 1.0:
+                continue
+            cx = px + ts * vx
+            cy = py + ts * vy
+            d = np.hypot(cx, cy)
+            if d < best:
+                if nc == cand.shape[0]:
+                    grown = np.empty((2 * nc, 3))
+                    grown[:nc] = cand[:nc]
+                    cand = grown
+                cand[nc, 0] = d
+                cand[nc, 1] = cx
+                cand[nc, 2] = cy
+                nc += 1
+        by_dist = np.argsort(cand[:nc, 0])
+        for c in by_dist:
+            if cand[c, 0] >= best:
+                break
+            if _separates(xa, sa, xb, sb, cand[c, 1], cand[c, 2], eps):
+                best = cand[c, 0]
+                bdx = cand[c, 1]
+                bdy = cand[c, 2]
+                break
+    return best, bdx, bdy

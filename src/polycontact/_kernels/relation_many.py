@@ -1,0 +1,87 @@
+"""Kernels: classify many pairs at once, in parallel over the pairs.
+
+A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
+after body), ``ls`` int64 and ``bs`` int64 (P+1,): the loop starts of body p are
+``ls[bs[p]:bs[p + 1]]`` (rows of ``xy``, its last entry is the end of the body), and
+``sign`` (P,) float64: +1.0 if the interior is on the left of every edge, -1.0 if on
+the right (a clockwise raw ring, classified without a copy).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from .relation import CONTACT, SEPARATE, _raw_ring, _state, closest_pair, penetration
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def check_rings(xy, lo, n, rel):
+    """Validate raw rings ``xy[lo[p]:lo[p] + n[p]]``; returns (vertices used or -1, sign)."""
+    p_count = lo.shape[0]
+    used = np.empty(p_count, np.int64)
+    sign = np.empty(p_count)
+    for p in prange(p_count):
+        u, s, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel)
+        used[p] = u
+        sign[p] = s
+    return used, sign
+
+
+@njit(cache=True, nogil=True)
+def _body(xy, ls, bs, p):
+    first = ls[bs[p]]
+    starts = ls[bs[p] : bs[p + 1]] - first
+    return xy[first : ls[bs[p + 1] - 1]], starts
+
+
+@njit(cache=True, nogil=True)
+def _scale(xy):
+    s = 1.0
+    for i in range(xy.shape[0]):
+        s = max(s, abs(xy[i, 0]), abs(xy[i, 1]))
+    return s
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
+    """States (int8: 0 separate, 1 contact, 2 penetrating) and tolerances of P pairs.
+
+    ``tol`` < 0 means per pair ``rel`` × the largest absolute coordinate of the pair.
+    """
+    p_count = bsa.shape[0] - 1
+    states = np.empty(p_count, np.int8)
+    eps = np.empty(p_count)
+    for p in prange(p_count):
+        ya, sa = _body(xa, lsa, bsa, p)
+        yb, sb = _body(xb, lsb, bsb, p)
+        e = tol if tol >= 0.0 else rel * max(_scale(ya), _scale(yb))
+        eps[p] = e
+        states[p] = _state(ya, sa, fa[p], yb, sb, fb[p], e)
+    return states, eps
+
+
+@njit(cache=True, nogil=True)
+def _oriented(y, s, f):
+    if f > 0.0:
+        return y
+    return y[::-1].copy()  # raw rings are single loops
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
+    """Signed distances of P classified pairs: the boundary gap, 0, or minus the depth."""
+    p_count = bsa.shape[0] - 1
+    out = np.empty(p_count)
+    for p in prange(p_count):
+        ya, sa = _body(xa, lsa, bsa, p)
+        yb, sb = _body(xb, lsb, bsb, p)
+        if states[p] == SEPARATE:
+            out[p] = closest_pair(ya, sa, yb, sb)[0]
+        elif states[p] == CONTACT:
+            out[p] = 0.0
+        else:
+            out[p] = -penetration(
+                _oriented(ya, sa, fa[p]), sa, _oriented(yb, sb, fb[p]), sb, eps[p]
+            )[0]
+    return out

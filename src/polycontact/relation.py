@@ -1,0 +1,493 @@
+"""Classification of two bodies: separate, in contact, or penetrating.
+
+The relation of A and B is the relation of A's reference point to the entrance block
+E(A, B) (design.md section 2): inside it the interiors overlap (penetrating), on its
+boundary they touch (contact), outside it they are apart (separate). The decision is an
+exact interior-overlap test with an absolute tolerance (see
+:mod:`polycontact._kernels.relation`), so an exact fit, such as a jigsaw piece in its
+socket, is contact, and identical shapes penetrate.
+
+Examples
+--------
+>>> from polycontact import Shape, classify
+>>> a = Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+>>> r = classify(a, a.moved((2, 1)))
+>>> r.state, r.distance, r.normal.tolist()
+(<State.CONTACT: 'contact'>, 0.0, [1.0, 0.0])
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidShapeError
+from .shape import Shape, as_shape
+from .tolerances import RELATIVE_TOLERANCE, default_tolerance
+
+__all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many", "warmup"]
+
+
+class State(str, enum.Enum):
+    """How two bodies lie: apart, touching, or with overlapping interiors."""
+
+    SEPARATE = "separate"
+    CONTACT = "contact"
+    PENETRATING = "penetrating"
+
+
+_STATES = (State.SEPARATE, State.CONTACT, State.PENETRATING)
+
+
+@dataclass(frozen=True)
+class Feature:
+    """One way the two boundaries meet.
+
+    Attributes
+    ----------
+    body : str
+        ``"a"`` or ``"b"``: the body that owns ``vertex`` (and ``own_edge``).
+    loop : int
+        Loop of ``body`` (0 outer, 1.. holes, as in :attr:`Shape.loops`).
+    vertex : int or None
+        Vertex of ``body``; None for ``"edges-cross"``.
+    other_loop : int
+        Loop of the other body that holds ``edge``.
+    edge : int
+        Edge of the OTHER body: the edge the vertex lies on, the nearest edge for
+        ``"vertex-inside"``, the crossed edge for ``"edges-cross"``.
+    kind : str
+        ``"vertex-on-edge"`` (within the tolerance; a vertex sitting on a vertex of
+        the other body is reported against both edges that meet there),
+        ``"vertex-inside"`` (strictly inside the other body), or ``"edges-cross"``
+        (a proper crossing of ``own_edge`` with ``edge``; always reported with
+        ``body="a"``).
+    own_edge : int or None
+        For ``"edges-cross"``, the crossing edge of ``body``; otherwise None.
+    """
+
+    body: str
+    loop: int
+    vertex: int | None
+    other_loop: int
+    edge: int
+    kind: str
+    own_edge: int | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Relation:
+    """The relation of two bodies, as returned by :func:`classify`.
+
+    ``state`` and ``tolerance`` are decided by the classification; ``distance``,
+    ``features``, ``point`` and ``normal`` are computed on first access and cached.
+
+    Attributes
+    ----------
+    state : State
+    tolerance : float
+        The absolute tolerance used: distances up to it count as touching.
+    distance : float
+        Signed: the gap between the boundaries when separate, 0 at contact, minus the
+        penetration depth (length of the smallest translation of A that ends the
+        overlap) when penetrating.
+    features : tuple of Feature
+        Every vertex within the tolerance of the other boundary, every vertex strictly
+        inside the other body, every proper edge crossing (A's vertices first, then
+        B's, then crossings).
+    point : ndarray of shape (2,) or None
+        A witness point. Contact: a touching vertex (the one of the first feature).
+        Penetrating: the crossing point of the first edge crossing if there is one,
+        otherwise the first vertex inside, otherwise a touching vertex. Separate: the
+        midpoint of the closest pair of boundary points.
+    normal : ndarray of shape (2,) or None
+        Unit vector from A towards B. Contact: the normal of the touched edge (when a
+        vertex sits on a vertex, the edge on which it lies most squarely). Penetrating:
+        the direction opposite the smallest separating translation of A. Separate: None.
+    escape : ndarray of shape (2,) or None
+        Penetrating only: the smallest translation of A that ends the overlap.
+    """
+
+    state: State
+    tolerance: float
+    _pair: tuple = field(repr=False)
+
+    def __repr__(self) -> str:
+        return (
+            f"Relation(state={self.state.value!r}, distance={self.distance:.6g}, "
+            f"features={len(self.features)}, tolerance={self.tolerance:g})"
+        )
+
+    @cached_property
+    def shapes(self) -> tuple[Shape, Shape]:
+        """The two bodies as oriented :class:`Shape` objects (indices refer to these)."""
+        return _to_shape(self._pair[0]), _to_shape(self._pair[1])
+
+    @cached_property
+    def _packed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        a, b = self.shapes
+        return (*a.packed, *b.packed)
+
+    @cached_property
+    def _closest(self) -> tuple[float, float, float, float, float]:
+        from ._kernels import relation as kr
+
+        return kr.closest_pair(*self._packed)
+
+    @cached_property
+    def _penetration(self) -> tuple[float, float, float]:
+        from ._kernels import relation as kr
+
+        return kr.penetration(*self._packed, self.tolerance)
+
+    @cached_property
+    def distance(self) -> float:
+        """Signed distance (see the class docstring)."""
+        if self.state is State.CONTACT:
+            return 0.0
+        if self.state is State.SEPARATE:
+            return float(self._closest[0])
+        return -float(self._penetration[0])
+
+    @cached_property
+    def escape(self) -> np.ndarray | None:
+        """Smallest translation of A that ends the overlap (penetrating only)."""
+        if self.state is not State.PENETRATING:
+            return None
+        return np.array(self._penetration[1:])
+
+    @cached_property
+    def _raw_features(self) -> tuple:
+        from ._kernels import relation as kr
+
+        return kr.features(*self._packed, self.tolerance)
+
+    @cached_property
+    def features(self) -> tuple[Feature, ...]:
+        """Every feature of the meeting (see the class docstring)."""
+        a, b = self.shapes
+        sa = a.packed[1]
+        sb = b.packed[1]
+        a_on, b_on, a_in, b_in, cross = self._raw_features
+        out: list[Feature] = []
+        for body, own, other, on, inside in (("a", sa, sb, a_on, a_in), ("b", sb, sa, b_on, b_in)):
+            for kind, rows in (("vertex-on-edge", on), ("vertex-inside", inside)):
+                for v, e, _ in rows:
+                    k, vi = _local(own, v)
+                    ko, ei = _local(other, e)
+                    out.append(Feature(body, k, vi, ko, ei, kind))
+        for e, f, _, _ in cross:
+            k, ei = _local(sa, e)
+            ko, fi = _local(sb, f)
+            out.append(Feature("a", k, None, ko, fi, "edges-cross", ei))
+        return tuple(out)
+
+    @cached_property
+    def point(self) -> np.ndarray | None:
+        """Witness point (see the class docstring)."""
+        a_on, b_on, a_in, b_in, cross = self._raw_features
+        xa, _, xb, _ = self._packed
+        if self.state is State.SEPARATE:
+            _, px, py, qx, qy = self._closest
+            return np.array([0.5 * (px + qx), 0.5 * (py + qy)])
+        if self.state is State.PENETRATING:
+            if cross:
+                return np.array(cross[0][2:])
+            if a_in:
+                return xa[a_in[0][0]].copy()
+            if b_in:
+                return xb[b_in[0][0]].copy()
+        if a_on:
+            return xa[a_on[0][0]].copy()
+        if b_on:
+            return xb[b_on[0][0]].copy()
+        return None
+
+    @cached_property
+    def normal(self) -> np.ndarray | None:
+        """Unit normal from A towards B (see the class docstring)."""
+        if self.state is State.SEPARATE:
+            return None
+        if self.state is State.PENETRATING:
+            d = -np.asarray(self._penetration[1:])
+            return d / np.hypot(*d) + 0.0
+        a, b = self.shapes
+        xa, sa, xb, sb = self._packed
+        a_on, b_on, _, _ = self._raw_features[:4]
+        best = None
+        # A vertex of A on an edge of B: B's inward normal; a vertex of B on an edge of
+        # A: A's outward normal. Prefer the touch farthest from the edge's ends.
+        for own, xo, so, rows, sign in ((xa, xb, sb, a_on, 1.0), (xb, xa, sa, b_on, -1.0)):
+            for v, e, _ in rows:
+                k, ei = _local(so, e)
+                loop = xo[so[k] : so[k + 1]]
+                p, q = loop[ei], loop[(ei + 1) % len(loop)]
+                u = q - p
+                length = float(np.hypot(*u))
+                t = float(np.dot(own[v] - p, u)) / length
+                margin = min(t, length - t)
+                if best is None or margin > best[0]:
+                    best = (margin, sign * np.array([-u[1], u[0]]) / length + 0.0)
+        return None if best is None else best[1]
+
+
+def _local(starts: np.ndarray, g: int) -> tuple[int, int]:
+    k = int(np.searchsorted(starts, g, side="right")) - 1
+    return k, int(g - starts[k])
+
+
+def _to_shape(src: Any) -> Shape:
+    if isinstance(src, Shape):
+        return src
+    arr, n, sign = src
+    ring = arr[:n] if sign > 0 else arr[:n][::-1]
+    return Shape._trusted([np.ascontiguousarray(ring, dtype=np.float64)])
+
+
+def _check_tolerance(tolerance: Any) -> float:
+    try:
+        tol = float(tolerance)
+    except (TypeError, ValueError):
+        raise ValueError(f"tolerance must be a number, got {tolerance!r}") from None
+    if not 0.0 <= tol < np.inf:
+        raise ValueError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
+    return tol
+
+
+def _is_raw(x: Any) -> bool:
+    return (
+        type(x) is np.ndarray
+        and x.dtype == np.float64
+        and x.ndim == 2
+        and x.shape[1] == 2
+        and x.flags.c_contiguous
+    )
+
+
+def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
+    """Classify two bodies: separate, contact or penetrating.
+
+    Parameters
+    ----------
+    a, b : Shape, shapely Polygon, or array_like of shape (N, 2)
+        The bodies. An array is an outer loop (closed or not, either orientation).
+    tolerance : float, optional
+        Absolute tolerance; distances up to it count as touching. Default:
+        :func:`polycontact.default_tolerance` of both bodies' coordinates.
+
+    Returns
+    -------
+    Relation
+
+    Raises
+    ------
+    InvalidShapeError
+        If a body is not a valid polygon (the message says which body and why).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> [classify(sq, sq + d).state.value for d in ([2.0, 0.0], [1.0, 0.5], [0.5, 0.5])]
+    ['separate', 'contact', 'penetrating']
+    >>> round(classify(sq, sq + [0.75, 0.5]).distance, 12)
+    -0.25
+    """
+    from ._kernels import relation as kr
+
+    tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
+    if _is_raw(a) and _is_raw(b):
+        code, eps, na, fa, nb, fb = kr.classify_raw(a, b, tol, RELATIVE_TOLERANCE)
+        if code >= 0:
+            obj = object.__new__(Relation)
+            obj.__dict__.update(
+                state=_STATES[code],
+                tolerance=eps,
+                _pair=((a.copy(), na, fa), (b.copy(), nb, fb)),
+            )
+            return obj
+    sa = as_shape(a, "a")
+    sb = as_shape(b, "b")
+    xa, pa = sa.packed
+    xb, pb = sb.packed
+    eps = default_tolerance(xa, xb) if tol < 0.0 else tol
+    code = kr.relate_state(xa, pa, xb, pb, eps)
+    obj = object.__new__(Relation)
+    obj.__dict__.update(state=_STATES[code], tolerance=eps, _pair=(sa, sb))
+    return obj
+
+
+@dataclass(frozen=True, eq=False)
+class RelationBatch:
+    """The relations of many pairs, as returned by :func:`classify_many`.
+
+    Attributes
+    ----------
+    states : ndarray of shape (P,), int8
+        0 separate, 1 contact, 2 penetrating (the order of :class:`State`).
+    tolerances : ndarray of shape (P,), float64
+        The absolute tolerance used for each pair.
+    distances : ndarray of shape (P,), float64
+        Signed distances as in :attr:`Relation.distance`; computed (in parallel) on
+        first access and cached.
+    """
+
+    states: np.ndarray
+    tolerances: np.ndarray
+    _packed: tuple = field(repr=False)
+
+    def __len__(self) -> int:
+        return int(self.states.shape[0])
+
+    def state(self, i: int) -> State:
+        """The :class:`State` of pair ``i``."""
+        return _STATES[int(self.states[i])]
+
+    @cached_property
+    def distances(self) -> np.ndarray:
+        """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
+        from ._kernels import relation_many as km
+
+        return km.many_distances(*self._packed, self.states, self.tolerances)
+
+
+def _pack_array(arr: np.ndarray, what: str) -> tuple | None:
+    """Pack a (P, N, 2) array of raw rings; None if some ring needs ``Shape``."""
+    from ._kernels import relation_many as km
+
+    p_count, n = arr.shape[0], arr.shape[1]
+    xy = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1, 2)
+    lo = np.arange(p_count, dtype=np.int64) * n
+    used, sign = km.check_rings(xy, lo, np.full(p_count, n, dtype=np.int64), RELATIVE_TOLERANCE)
+    if (used < 0).any():
+        return None
+    ls = np.empty(2 * p_count, dtype=np.int64)
+    ls[0::2] = lo
+    ls[1::2] = lo + used
+    return xy, ls, np.arange(0, 2 * p_count + 1, 2, dtype=np.int64), sign
+
+
+def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
+    """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel."""
+    from ._kernels import relation_many as km
+
+    bodies: list[Any] = []
+    raw: list[int] = []
+    for i, it in enumerate(items):
+        if isinstance(it, Shape):
+            bodies.append(it)
+        elif isinstance(it, np.ndarray) and it.dtype == np.float64 and it.ndim == 2 and (
+            it.shape[1] == 2
+        ):
+            bodies.append(it)
+            raw.append(i)
+        else:
+            bodies.append(as_shape(it, f"{what}[{i}]"))
+    sign = np.ones(len(bodies))
+    if raw:
+        rings = [bodies[i] for i in raw]
+        n = np.array([len(r) for r in rings], dtype=np.int64)
+        lo = np.zeros(len(rings), dtype=np.int64)
+        lo[1:] = np.cumsum(n)[:-1]
+        xy = np.concatenate(rings) if rings else np.empty((0, 2))
+        used, sg = km.check_rings(xy, lo, n, RELATIVE_TOLERANCE)
+        for k, i in enumerate(raw):
+            if used[k] < 0:
+                bodies[i] = as_shape(items[i], f"{what}[{i}]")
+            else:
+                bodies[i] = bodies[i][: used[k]]
+                sign[i] = sg[k]
+    chunks = []
+    ls: list[int] = []
+    bs = [0]
+    row = 0
+    for body in bodies:
+        if isinstance(body, Shape):
+            xy, st = body.packed
+            chunks.append(xy)
+            ls.extend((st + row).tolist())
+        else:
+            chunks.append(body)
+            ls.extend((row, row + len(body)))
+        row += len(chunks[-1])
+        bs.append(len(ls))
+    xy = np.ascontiguousarray(np.concatenate(chunks)) if chunks else np.empty((0, 2))
+    return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
+
+
+def _pack(items: Any, what: str) -> tuple:
+    if isinstance(items, np.ndarray) and items.ndim == 3 and items.shape[2] == 2:
+        packed = _pack_array(items, what)
+        if packed is not None:
+            return packed
+        items = list(items)
+    if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
+        raise InvalidShapeError(
+            f"{what}: expected a sequence of bodies or an array of shape (P, N, 2), "
+            f"got {type(items).__name__}"
+        )
+    return _pack_sequence(items, what)
+
+
+def classify_many(
+    shapes_a: Any, shapes_b: Any, *, tolerance: float | None = None
+) -> RelationBatch:
+    """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one parallel call.
+
+    Parameters
+    ----------
+    shapes_a, shapes_b : sequence of bodies, or ndarray of shape (P, N, 2)
+        Bodies as for :func:`classify` (Shape, shapely Polygon, (N, 2) array), or the
+        packed form: a float64 array of P outer rings of N vertices each (closed or
+        not, either orientation), read in place without a copy.
+    tolerance : float, optional
+        Absolute tolerance for every pair; default per pair as in :func:`classify`.
+
+    Returns
+    -------
+    RelationBatch
+        ``states`` (int8 codes), ``tolerances``, and ``distances`` on demand.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> batch = classify_many(np.stack([sq, sq, sq]), np.stack([sq + 2, sq + 1, sq + 0.5]))
+    >>> batch.states.tolist(), batch.distances.round(6).tolist()
+    ([0, 1, 2], [1.414214, 0.0, -0.5])
+    """
+    from ._kernels import relation_many as km
+
+    pa = _pack(shapes_a, "shapes_a")
+    pb = _pack(shapes_b, "shapes_b")
+    if len(pa[3]) != len(pb[3]):
+        raise ValueError(
+            f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"
+        )
+    tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
+    states, eps = km.many_states(*pa, *pb, tol, RELATIVE_TOLERANCE)
+    return RelationBatch(states, eps, (*pa, *pb))
+
+
+def warmup() -> None:
+    """Compile (or load from the cache) the classification kernels now.
+
+    Numba compiles each kernel on its first call; call this once at start-up to pay
+    that cost up front instead of on the first :func:`classify`.
+
+    Examples
+    --------
+    >>> warmup()
+    """
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    for d in ((2.0, 0.0), (1.0, 0.0), (0.5, 0.5)):
+        r = classify(sq, sq + d)
+        r.distance, r.features, r.point, r.normal
+        rs = classify(Shape(sq), Shape(sq + d))
+        rs.distance, rs.features
+    classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances
