@@ -1,0 +1,105 @@
+"""Rigid motion of a body with constant linear and angular acceleration.
+
+A body moves rigidly about its area centroid ``c`` (paper §5(3)):
+
+    c(t) = c0 + v t + a t² / 2,    θ(t) = ω t + α t² / 2,
+    p(t) = c(t) + R(θ(t)) (p0 − c0)
+
+for every point ``p0`` of the body at t = 0. Angles are radians, counter-clockwise
+positive (the frame convention of :mod:`polycontact.shape`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Motion"]
+
+
+def _pair(value: Any, what: str) -> tuple[float, float]:
+    try:
+        x, y = (float(c) for c in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: expected two numbers, got {value!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ValueError(f"{what}: expected finite numbers, got {[x, y]}")
+    return x, y
+
+
+def _number(value: Any, what: str) -> float:
+    if isinstance(value, bool):
+        raise ValueError(f"{what}: expected a number, got {value!r}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: expected a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{what}: expected a finite number, got {x}")
+    return x
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Constant-acceleration rigid motion about the body's area centroid.
+
+    Parameters
+    ----------
+    velocity : (float, float)
+        Velocity of the centroid at t = 0.
+    acceleration : (float, float)
+        Constant acceleration of the centroid.
+    angular_velocity : float
+        Angular velocity at t = 0, radians per unit time, counter-clockwise positive.
+    angular_acceleration : float
+        Constant angular acceleration, radians per unit time squared.
+
+    Examples
+    --------
+    >>> m = Motion(velocity=(1, 0), angular_velocity=math.pi / 2)
+    >>> translation, angle = m.pose(2.0)
+    >>> translation.tolist(), round(angle, 6)
+    ([2.0, 0.0], 3.141593)
+    """
+
+    velocity: tuple[float, float] = (0.0, 0.0)
+    acceleration: tuple[float, float] = (0.0, 0.0)
+    angular_velocity: float = 0.0
+    angular_acceleration: float = 0.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
+        object.__setattr__(self, "acceleration", _pair(self.acceleration, "acceleration"))
+        object.__setattr__(
+            self, "angular_velocity", _number(self.angular_velocity, "angular_velocity")
+        )
+        object.__setattr__(
+            self,
+            "angular_acceleration",
+            _number(self.angular_acceleration, "angular_acceleration"),
+        )
+
+    def pose(self, t: float) -> tuple[np.ndarray, float]:
+        """``(translation, angle)`` at time ``t``: centroid displacement and rotation.
+
+        The placed body is the body at t = 0 rotated by ``angle`` about its centroid,
+        then translated by ``translation`` (what :meth:`polycontact.Shape.moved` does).
+        """
+        t = float(t)
+        v = np.asarray(self.velocity)
+        a = np.asarray(self.acceleration)
+        translation = v * t + 0.5 * a * t * t
+        angle = self.angular_velocity * t + 0.5 * self.angular_acceleration * t * t
+        return translation, float(angle)
+
+    @property
+    def array(self) -> np.ndarray:
+        """The motion as the kernel vector ``[vx, vy, ax, ay, ω, α]`` (float64)."""
+        return np.array(
+            [*self.velocity, *self.acceleration, self.angular_velocity,
+             self.angular_acceleration],
+            dtype=np.float64,
+        )

@@ -1,0 +1,227 @@
+"""Scenes: two or more moving bodies and a time window, read from JSON.
+
+The format (design.md §4)::
+
+    {"t_max": 20, "time_tolerance": 1e-4, "description": "...",
+     "bodies": [{"name": "red", "vertices": [[x, y], ...], "holes": [[[x, y], ...]],
+                 "velocity": [vx, vy], "acceleration": [ax, ay],
+                 "angular_velocity": w | "angular_velocity_deg": w,
+                 "angular_acceleration": al | "angular_acceleration_deg": al}, ...]}
+
+``t_max`` and each body's ``vertices`` are required; ``time_tolerance``,
+``description`` and every motion key are optional (zero motion by default). Angular
+quantities are radians (per second, per second squared) unless the key ends in
+``_deg``. Unknown keys, wrong types, non-finite numbers, duplicate names and fewer than
+two bodies are refused with an :class:`~polycontact.InvalidSceneError` naming the key.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .errors import InvalidSceneError, InvalidShapeError
+from .impact import Impact, ImpactStatus, time_of_impact
+from .motion import Motion
+from .shape import Shape
+
+__all__ = ["Body", "Scene", "load_scene"]
+
+_TOP_KEYS = {"t_max", "bodies", "time_tolerance", "description"}
+_BODY_KEYS = {
+    "name", "vertices", "holes", "velocity", "acceleration",
+    "angular_velocity", "angular_velocity_deg",
+    "angular_acceleration", "angular_acceleration_deg",
+}
+
+
+@dataclass(frozen=True)
+class Body:
+    """A named shape and its motion."""
+
+    name: str
+    shape: Shape
+    motion: Motion
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Bodies moving over ``[0, t_max]``.
+
+    Examples
+    --------
+    >>> scene = Scene.from_dict({"t_max": 5, "bodies": [
+    ...     {"name": "a", "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]], "velocity": [1, 0]},
+    ...     {"name": "b", "vertices": [[3, 0], [4, 0], [4, 1], [3, 1]]}]})
+    >>> a, b, impact = scene.first_impact()
+    >>> a.name, b.name, round(impact.time, 3)
+    ('a', 'b', 2.0)
+    """
+
+    bodies: tuple[Body, ...]
+    t_max: float
+    time_tolerance: float | None = None
+    description: str | None = None
+
+    @classmethod
+    def from_dict(cls, data: Any, *, repair: bool = False) -> Scene:
+        """Build a scene from parsed JSON; ``repair`` is passed to :class:`Shape`."""
+        if not isinstance(data, dict):
+            raise InvalidSceneError(f"expected a JSON object, got {type(data).__name__}")
+        _no_unknown(data, _TOP_KEYS, "")
+        t_max = _number(_required(data, "t_max", ""), "t_max")
+        if t_max < 0:
+            raise InvalidSceneError(f"t_max: expected a number >= 0, got {t_max}")
+        tol = None
+        if "time_tolerance" in data:
+            tol = _number(data["time_tolerance"], "time_tolerance")
+            if tol <= 0:
+                raise InvalidSceneError(f"time_tolerance: expected a number > 0, got {tol}")
+        desc = data.get("description")
+        if desc is not None and not isinstance(desc, str):
+            raise InvalidSceneError("description: expected a string")
+        bodies = _required(data, "bodies", "")
+        if not isinstance(bodies, list):
+            raise InvalidSceneError(f"bodies: expected a list, got {type(bodies).__name__}")
+        if len(bodies) < 2:
+            raise InvalidSceneError(f"bodies: expected at least two bodies, got {len(bodies)}")
+        parsed = tuple(_body(b, i, repair) for i, b in enumerate(bodies))
+        names = [b.name for b in parsed]
+        for i, name in enumerate(names):
+            if name in names[:i]:
+                raise InvalidSceneError(f"bodies[{i}].name: duplicate name {name!r}")
+        return cls(parsed, t_max, tol, desc)
+
+    def first_impact(
+        self,
+        *,
+        method: str = "exact",
+        time_tolerance: float | None = None,
+        samples: int = 10,
+    ) -> tuple[Body, Body, Impact]:
+        """The earliest event among all pairs: ``(body_a, body_b, impact)``.
+
+        Order of events: a pair already penetrating at t = 0, then the earliest
+        collision; a pair whose search ran out of iterations before that time is
+        reported instead (no verdict). Without collision, the pair that touched first,
+        else the first pair.
+        """
+        tol = time_tolerance if time_tolerance is not None else self.time_tolerance
+        results = []
+        for i, a in enumerate(self.bodies):
+            for b in self.bodies[i + 1:]:
+                imp = time_of_impact(
+                    a.shape, a.motion, b.shape, b.motion, t_max=self.t_max, method=method,
+                    time_tolerance=1e-4 if tol is None else tol, samples=samples,
+                )
+                results.append((a, b, imp))
+        return min(results, key=lambda r: _event_order(r[2]))
+
+
+def _event_order(imp: Impact) -> tuple[float, float]:
+    if imp.status is ImpactStatus.PENETRATING_AT_START:
+        return (0.0, 0.0)
+    if imp.status is ImpactStatus.HIT:
+        return (imp.time, 0.0)
+    if imp.status is ImpactStatus.OUT_OF_ITERATIONS:
+        return (imp.searched_to, 0.0)
+    contact = imp.first_contact if imp.first_contact is not None else math.inf
+    return (math.inf, contact)
+
+
+def load_scene(path: str | Path, *, repair: bool = False) -> Scene:
+    """Read a scene JSON file (format in the module docstring).
+
+    Raises
+    ------
+    InvalidSceneError
+        Unreadable file, invalid JSON, or a bad key; the message starts with the file
+        name and names the key (``bodies[1].velocity: ...``).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InvalidSceneError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InvalidSceneError(f"{path}: not valid JSON ({exc})") from None
+    try:
+        return Scene.from_dict(data, repair=repair)
+    except InvalidSceneError as exc:
+        raise InvalidSceneError(f"{path}: {exc}") from None
+
+
+def _required(data: dict, key: str, where: str) -> Any:
+    if key not in data:
+        raise InvalidSceneError(f"{where}{key}: missing")
+    return data[key]
+
+
+def _no_unknown(data: dict, allowed: set[str], where: str) -> None:
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise InvalidSceneError(f"{where}{unknown[0]}: unknown key")
+
+
+def _number(value: Any, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InvalidSceneError(f"{what}: expected a number, got {json.dumps(value)}")
+    if not math.isfinite(value):
+        raise InvalidSceneError(f"{what}: expected a finite number, got {value}")
+    return float(value)
+
+
+def _vector(value: Any, what: str) -> tuple[float, float]:
+    if not isinstance(value, list) or len(value) != 2:
+        raise InvalidSceneError(f"{what}: expected [x, y], got {json.dumps(value)}")
+    return _number(value[0], f"{what}[0]"), _number(value[1], f"{what}[1]")
+
+
+def _ring(value: Any, what: str) -> list[tuple[float, float]]:
+    if not isinstance(value, list):
+        raise InvalidSceneError(f"{what}: expected a list of [x, y] points")
+    return [_vector(p, f"{what}[{i}]") for i, p in enumerate(value)]
+
+
+def _angle(data: dict, key: str, where: str) -> float:
+    deg = f"{key}_deg"
+    if key in data and deg in data:
+        raise InvalidSceneError(f"{where}{deg}: give {key} or {deg}, not both")
+    if deg in data:
+        return math.radians(_number(data[deg], f"{where}{deg}"))
+    if key in data:
+        return _number(data[key], f"{where}{key}")
+    return 0.0
+
+
+def _body(data: Any, i: int, repair: bool) -> Body:
+    where = f"bodies[{i}]"
+    if not isinstance(data, dict):
+        raise InvalidSceneError(f"{where}: expected an object, got {type(data).__name__}")
+    name = data.get("name", f"body{i}")
+    if not isinstance(name, str) or not name:
+        raise InvalidSceneError(f"{where}.name: expected a non-empty string")
+    where += "."
+    _no_unknown(data, _BODY_KEYS, where)
+    vertices = _ring(_required(data, "vertices", where), f"{where}vertices")
+    holes_raw = data.get("holes", [])
+    if not isinstance(holes_raw, list):
+        raise InvalidSceneError(f"{where}holes: expected a list of rings")
+    holes = [_ring(h, f"{where}holes[{k}]") for k, h in enumerate(holes_raw)]
+    try:
+        shape = Shape(vertices, holes, repair=repair)
+    except InvalidShapeError as exc:
+        hint = "" if repair else " (--repair / repair=True may fix it)"
+        raise InvalidSceneError(f"{where}vertices ({name!r}): {exc}{hint}") from None
+    motion = Motion(
+        velocity=_vector(data.get("velocity", [0, 0]), f"{where}velocity"),
+        acceleration=_vector(data.get("acceleration", [0, 0]), f"{where}acceleration"),
+        angular_velocity=_angle(data, "angular_velocity", where),
+        angular_acceleration=_angle(data, "angular_acceleration", where),
+    )
+    return Body(name, shape, motion)
