@@ -1,0 +1,246 @@
+"""Entrance block: the components of the finite cover, their union, the two methods."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import polycontact as pc
+from polycontact.entrance_block import Element
+
+SQUARE = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+ELL = [(0.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)]
+FRAME = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
+NOTCHED_HOLE = [(1.0, 1.0), (3.0, 1.0), (3.0, 2.0), (2.0, 2.0), (2.0, 3.0), (1.0, 3.0)]
+
+
+def _star(draw, n, r_lo, r_hi, centre):
+    """A star-shaped ring about ``centre`` with angular gaps well under pi."""
+    jitter = np.array(draw(st.lists(st.floats(-0.3, 0.3), min_size=n, max_size=n)))
+    angles = (np.arange(n) + jitter) * 2 * np.pi / n + draw(st.floats(0, 2 * np.pi))
+    radii = np.array(draw(st.lists(st.floats(r_lo, r_hi), min_size=n, max_size=n)))
+    return centre + np.c_[radii * np.cos(angles), radii * np.sin(angles)]
+
+
+@st.composite
+def bodies(draw, max_vertices=10, holes=True):
+    """Random star-shaped (mostly concave) bodies, some with a star-shaped hole."""
+    centre = np.array([draw(st.floats(-5, 5)), draw(st.floats(-5, 5))])
+    outer = _star(draw, draw(st.integers(3, max_vertices)), 0.4, 2.0, centre)
+    loops = []
+    room = shapely.Polygon(outer).exterior.distance(shapely.Point(centre))
+    if holes and room > 0.05 and shapely.Polygon(outer).contains(shapely.Point(centre)) \
+            and draw(st.booleans()):
+        loops.append(_star(draw, draw(st.integers(3, 6)), 0.2 * room, 0.8 * room, centre))
+    return pc.Shape(outer, loops)
+
+
+def _minkowski_reference(a: pc.Shape, b: pc.Shape, a0) -> shapely.Geometry:
+    """B ⊕ (a0 − A) by triangles: the convex hulls of the sums of triangle pairs."""
+    reflected = shapely.Polygon(a0 - a.exterior, [a0 - h for h in a.holes])
+    ta = shapely.get_parts(shapely.constrained_delaunay_triangles(reflected))
+    tb = shapely.get_parts(shapely.constrained_delaunay_triangles(b.to_shapely()))
+    pa = shapely.get_coordinates(ta).reshape(len(ta), 4, 2)[:, :3]
+    pb = shapely.get_coordinates(tb).reshape(len(tb), 4, 2)[:, :3]
+    sums = (pa[:, None, :, None] + pb[None, :, None, :]).reshape(-1, 9, 2)
+    return shapely.union_all(shapely.convex_hull(shapely.multipoints(sums)))
+
+
+def _same_region(g1, g2, rel=1e-9):
+    scale = max(g1.area, g2.area, 1e-300)
+    assert g1.symmetric_difference(g2).area <= rel * scale
+
+
+# -- hand cases ------------------------------------------------------------------------
+def test_two_squares_side_by_side():
+    a = pc.Shape(SQUARE)
+    eb = pc.entrance_block(a, a.moved((3.0, 0.0)), method="pairs")
+    assert [len(eb.of_family(f)) for f in ("A2-B0", "A0-B2", "A1-B1")] == [4, 4, 16]
+    assert np.array_equal(eb.reference, [0.5, 0.5])
+    assert eb.to_shapely().equals(shapely.box(2.5, -0.5, 4.5, 1.5))
+    # B's vertex 0 at (3, 0) is in A when a0 is in (3, 0) + a0 − A
+    first = eb.components[0]
+    assert first.kind == "A2-B0" and first.features == (Element("b", "vertex", 0, 0),)
+    assert first.geometry.equals(shapely.box(2.5, -0.5, 3.5, 0.5))
+    assert first.label == "E(A(2), B(0))[B vertex 0]"
+    # A's vertex 2 at (1, 1) is in B when a0 is in B + a0 − (1, 1)
+    third_of_a = eb.of_family("A0-B2")[2]
+    assert third_of_a.features == (Element("a", "vertex", 0, 2),)
+    assert third_of_a.geometry.equals(shapely.box(2.5, -0.5, 3.5, 0.5))
+
+
+def test_edge_pair_parallelogram_and_parallel_pairs_are_segments():
+    a = pc.Shape(SQUARE)
+    eb = pc.entrance_block(a, a.moved((3.0, 0.0)), method="pairs")
+    pairs = {(c.features[0].index, c.features[1].index): c for c in eb.of_family("A1-B1")}
+    # edge 0 of A: (0,0)->(1,0); edge 1 of B: (4,0)->(4,1): f ⊕ (a0 − e)
+    expected = shapely.Polygon([(4.5, 0.5), (4.5, 1.5), (3.5, 1.5), (3.5, 0.5)])
+    assert pairs[0, 1].geometry.equals(expected)
+    assert pairs[0, 1].label == "E(A(1), B(1))[A edge 0, B edge 1]"
+    # edges 0 of A and 2 of B are parallel: a segment, kept, inside the union
+    flat = pairs[0, 2]
+    assert flat.is_degenerate and flat.geometry.geom_type == "LineString"
+    assert flat.geometry.equals(shapely.LineString([(2.5, 1.5), (4.5, 1.5)]))
+    degenerate = [c for c in eb.components if c.is_degenerate]
+    assert len(degenerate) == 8  # 2 horizontal × 2 horizontal + 2 vertical × 2 vertical
+    union = eb.to_shapely()
+    assert all(union.covers(c.geometry) for c in degenerate)
+
+
+def test_holes_contribute_vertices_and_edges():
+    a = pc.Shape(ELL)
+    b = pc.Shape(FRAME, [NOTCHED_HOLE])
+    for method, n_edge in (("pairs", 6 * 10), ("swept", 10)):
+        eb = pc.entrance_block(a, b, method=method)
+        kinds = [c.kind for c in eb.components]
+        assert kinds.count("A2-B0") == 10 and kinds.count("A0-B2") == 6
+        assert len(eb.of_family("A1-B1")) == n_edge
+        hole_vertex = eb.components[4 + 2]  # B loop 1 (the hole), vertex 2
+        assert hole_vertex.features == (Element("b", "vertex", 1, 2),)
+        assert str(hole_vertex.features[0]) == "B vertex 2 of hole 0"
+    # A with a hole: E(A(2), B(0)_i) is A reflected, hole included
+    eb = pc.entrance_block(b, a, reference=(0.0, 0.0))
+    first = eb.components[0].geometry
+    assert len(first.interiors) == 1
+    assert first.area == pytest.approx(b.area)
+    assert first.equals(shapely.Polygon(-b.exterior, [-b.holes[0]]))
+
+
+def test_l_fits_in_notched_hole_the_block_has_a_hole():
+    a = pc.Shape([(0.0, 0.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5)])
+    b = pc.Shape(FRAME, [NOTCHED_HOLE])
+    for method in ("pairs", "swept"):
+        union = pc.entrance_block(a, b, method=method).to_shapely()
+        assert union.geom_type == "Polygon" and len(union.interiors) == 1
+        _same_region(union, _minkowski_reference(a, b, a.centroid))
+
+
+def test_reference_point_moves_the_block():
+    a, b = pc.Shape(ELL), pc.Shape(FRAME, [NOTCHED_HOLE]).moved((6.0, 1.0))
+    at_centroid = pc.entrance_block(a, b).to_shapely()
+    shifted = pc.entrance_block(a, b, reference=(-2.0, 7.5)).to_shapely()
+    d = np.array([-2.0, 7.5]) - a.centroid
+    _same_region(shifted, shapely.affinity.translate(at_centroid, *d))
+
+
+def test_swept_uses_the_splice_and_the_edge_union_alike():
+    # a convex loop (spliced) and a concave one (edge by edge) along the same edge
+    from polycontact.entrance_block import _splice, _swept_loop
+
+    v = np.array([0.7, 0.2])
+    square = np.array(SQUARE)
+    ell = np.array(ELL)
+    assert _splice(square, v) is not None
+    assert _splice(ell, np.array([1.0, 1.0])) is not None  # monotone across (1, 1)
+    assert _splice(ell, np.array([1.0, -1.0])) is None  # a line along (1, -1) meets it twice
+    for loop, step in ((square, v), (ell, v), (ell, np.array([3.0, 0.0])), (ell, np.array([1.0, -1.0]))):
+        edges = [shapely.Polygon([p, q, q + step, p + step])
+                 for p, q in zip(loop, np.roll(loop, -1, axis=0))]
+        area, lines = _swept_loop(loop, step, 1e-12)
+        _same_region(area, shapely.union_all(edges))
+        assert len(lines) == (3 if step[1] == 0.0 and loop is ell else 0)  # 3 edges along x
+
+
+def test_curve_sweep_is_not_the_filled_sweep():
+    # a long square sliding a little: the boundary sweeps two thin strips, not the square
+    big = np.array([(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)])
+    from polycontact.entrance_block import _swept_loop
+
+    area, lines = _swept_loop(big, np.array([1.0, 0.0]), 1e-12)
+    _same_region(area, shapely.box(0, 0, 1, 10).union(shapely.box(10, 0, 11, 10)))
+    # the edges along the motion sweep segments, kept apart
+    assert shapely.union_all(lines).equals(
+        shapely.MultiLineString([[(0, 0), (11, 0)], [(11, 10), (0, 10)]]))
+
+
+def test_bad_input_is_refused():
+    a = pc.Shape(SQUARE)
+    with pytest.raises(ValueError, match="method must be one of 'swept', 'pairs', got 'fast'"):
+        pc.entrance_block(a, a, method="fast")
+    with pytest.raises(ValueError, match="reference: expected two finite numbers"):
+        pc.entrance_block(a, a, reference=(1.0, np.nan))
+    with pytest.raises(ValueError, match="reference: expected two"):
+        pc.entrance_block(a, a, reference=(1.0, 2.0, 3.0))
+    with pytest.raises(pc.InvalidShapeError, match="b: outer loop: fewer than 3"):
+        pc.entrance_block(a, [(0, 0), (1, 1)])
+    with pytest.raises(ValueError, match="family must be one of"):
+        pc.entrance_block(a, a).of_family("A1e-B1f")
+
+
+def test_inputs_untouched_and_result_read_only():
+    ref = np.array([0.25, 0.25])
+    ring = np.array(ELL)
+    eb = pc.entrance_block(ring, pc.Shape(FRAME), reference=ref)
+    assert np.array_equal(ring, ELL) and np.array_equal(ref, [0.25, 0.25])
+    ref[0] = 9.0
+    assert eb.reference[0] == 0.25
+    with pytest.raises(ValueError):
+        eb.reference[0] = 1.0
+
+
+# -- random bodies -----------------------------------------------------------------------
+@given(bodies(), bodies())
+def test_the_two_methods_give_the_same_region(a, b):
+    pairs = pc.entrance_block(a, b, method="pairs")
+    swept = pc.entrance_block(a, b, method="swept")
+    _same_region(pairs.to_shapely(), swept.to_shapely())
+    assert pairs.area == pytest.approx(swept.area, rel=1e-9)
+
+
+@settings(max_examples=60)
+@given(bodies(max_vertices=8), bodies(max_vertices=8))
+def test_union_is_the_minkowski_sum(a, b):
+    _same_region(pc.entrance_block(a, b).to_shapely(), _minkowski_reference(a, b, a.centroid))
+
+
+@settings(max_examples=60)
+@given(bodies(max_vertices=8), bodies(max_vertices=8))
+def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
+    pairs = pc.entrance_block(a, b, method="pairs")
+    swept = pc.entrance_block(a, b, method="swept")
+    n_b = b.n_vertices
+    scale = max(1.0, float(np.abs(swept.to_shapely().bounds).max()))
+    for f, comp in enumerate(swept.of_family("A1-B1")):
+        mine = pairs.of_family("A1-B1")[f::n_b]
+        assert {c.features[1] for c in mine} == set(comp.features)
+        union = shapely.union_all([c.geometry for c in mine])
+        _same_region(union.buffer(0), comp.geometry.buffer(0))
+        # equal as closed sets, segments included: each within 1e-9 of the other
+        assert union.buffer(1e-9 * scale).covers(comp.geometry)
+        assert comp.geometry.buffer(1e-9 * scale).covers(union)
+
+
+@settings(max_examples=60)
+@given(bodies(max_vertices=7), bodies(max_vertices=7), st.data())
+def test_components_mean_what_their_features_say(a, b, data):
+    """a0 in a component iff its features meet when A is moved there (closed sets)."""
+    for method in ("pairs", "swept"):
+        eb = pc.entrance_block(a, b, method=method)
+        lo, hi = np.array(eb.to_shapely().bounds).reshape(2, 2)
+        for _ in range(5):
+            p = lo + (hi - lo) * np.array([data.draw(st.floats(-0.1, 1.1)) for _ in range(2)])
+            moved = a.moved(p - eb.reference)
+            point = shapely.Point(p)
+            for c in eb.components:
+                if shapely.distance(c.geometry.boundary if c.geometry.area else c.geometry,
+                                    point) < 1e-9:
+                    continue  # too close to call in floating point
+                feat = c.features
+                if c.kind == "A2-B0":
+                    meets = moved.to_shapely().intersects(shapely.Point(b.loops[feat[0].loop][feat[0].index]))
+                elif c.kind == "A0-B2":
+                    meets = b.to_shapely().intersects(
+                        shapely.Point(moved.loops[feat[0].loop][feat[0].index]))
+                elif c.kind == "A1e-B1f":
+                    meets = _edge(moved, feat[0]).intersects(_edge(b, feat[1]))
+                else:
+                    meets = moved.to_shapely().boundary.intersects(_edge(b, feat[0]))
+                assert bool(c.geometry.intersects(point)) == bool(meets), (c.label, p)
+
+
+def _edge(s: pc.Shape, el: Element) -> shapely.LineString:
+    loop = s.loops[el.loop]
+    return shapely.LineString([loop[el.index], loop[(el.index + 1) % len(loop)]])
