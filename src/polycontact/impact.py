@@ -288,12 +288,16 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
     time = bracket = None
     if status is ImpactStatus.HIT:
         time, bracket = t_hi, (t_lo, t_hi)
-        state = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps).state
-        where = t_hi if method == "sampled" else t_lo
-        rel = _relation_at(a, ma, b, mb, where, eps)
-        if method == "exact" and rel.state is State.PENETRATING:
-            rel = _relation_at(a, ma, b, mb, t_hi, eps)
-        features, point, normal = rel.features, rel.point, rel.normal
+        rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
+        state = rel_hi.state
+        rel = rel_hi
+        if method == "exact":
+            rel_lo = _relation_at(a, ma, b, mb, t_lo, eps)
+            rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
+        features, point = rel.features, rel.point
+        # the normal opposes the smallest translation that ends the (tiny) overlap at
+        # `time`: at a corner-on-corner or flush touch it is the direction of the push
+        normal = rel_hi.normal if rel_hi.state is State.PENETRATING else rel.normal
     elif status is ImpactStatus.PENETRATING_AT_START:
         first_contact = 0.0
         rel = classify(a.at(ma, 0.0), b.at(mb, 0.0), tolerance=eps)
