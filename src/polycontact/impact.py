@@ -144,15 +144,20 @@ def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
     return max(1.0, reach)
 
 
-def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: float):
-    """classify at time t, with the tolerance widened to the gap so a near touch counts."""
+def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: float,
+                 reach: float = 0.0):
+    """classify at time t, the tolerance widened to the gap and to ``reach``.
+
+    ``reach`` is how far the bodies can still move relative to each other before the
+    penetration (speed bound × bracket length): every vertex that can meet an edge by
+    then counts as touching.
+    """
     from ._kernels.relation import boundary_distance
 
     pa = a.at(ma, t)
     pb = b.at(mb, t)
     gap = float(boundary_distance(*pa.packed, *pb.packed))
-    rel = classify(pa, pb, tolerance=max(eps, 1.01 * gap))
-    return rel
+    return classify(pa, pb, tolerance=max(eps, 1.01 * gap, 1.01 * reach))
 
 
 def time_of_impact(
@@ -292,7 +297,11 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         state = rel_hi.state
         rel = rel_hi
         if method == "exact":
-            rel_lo = _relation_at(a, ma, b, mb, t_lo, eps)
+            from ._kernels.impact import speed_bound
+
+            reach = (t_hi - t_lo) * speed_bound(ma.array, a.bounding_radius, mb.array,
+                                                b.bounding_radius, t_lo, t_hi)
+            rel_lo = _relation_at(a, ma, b, mb, t_lo, eps, reach)
             rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
         features, point = rel.features, rel.point
         # the normal opposes the smallest translation that ends the (tiny) overlap at

@@ -1,0 +1,286 @@
+"""time_of_impact against an independent Shapely oracle and hand-solvable scenes.
+
+The oracle places the bodies with its own rotation formula, asks Shapely whether the
+interiors overlap (``relate_pattern(a, b, "2********")``) on a dense time grid, and
+bisects the first penetrating sample against the one before it. It shares no code with
+the library's kernels.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import polycontact as pc
+from polycontact import ImpactStatus, Motion, Shape, State, time_of_impact
+
+TOL = 1e-4
+
+
+# -- the oracle ---------------------------------------------------------------------
+def _place(shape: Shape, motion: Motion, t: float) -> shapely.Polygon:
+    c = shape.centroid
+    vx, vy = motion.velocity
+    ax, ay = motion.acceleration
+    th = motion.angular_velocity * t + 0.5 * motion.angular_acceleration * t * t
+    rot = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+    shift = np.array([vx * t + 0.5 * ax * t * t, vy * t + 0.5 * ay * t * t])
+    loops = [(loop - c) @ rot.T + c + shift for loop in shape.loops]
+    return shapely.Polygon(loops[0], loops[1:])
+
+
+def oracle_penetrates(a, ma, b, mb, t) -> bool:
+    return bool(shapely.relate_pattern(_place(a, ma, t), _place(b, mb, t), "2********"))
+
+
+def oracle_first_penetration(a, ma, b, mb, t0, t1, n, tol=1e-7):
+    """(t_prev, t_first) of the first penetrating sample of n in [t0, t1], bisected."""
+    ts = np.linspace(t0, t1, n)
+    prev = ts[0]
+    for t in ts:
+        if oracle_penetrates(a, ma, b, mb, t):
+            lo, hi = prev, t
+            while hi - lo > tol:
+                mid = 0.5 * (lo + hi)
+                if oracle_penetrates(a, ma, b, mb, mid):
+                    hi = mid
+                else:
+                    lo = mid
+            return hi
+        prev = t
+    return None
+
+
+def check_against_oracle(a, ma, b, mb, t_max, n=1500):
+    hit = time_of_impact(a, ma, b, mb, t_max=t_max, time_tolerance=TOL)
+    assert hit.status in (ImpactStatus.HIT, ImpactStatus.NO_HIT)
+    first = oracle_first_penetration(a, ma, b, mb, 0.0, t_max, n)
+    if first is not None:
+        # never later than a penetration the oracle sees
+        assert hit.collides, f"missed the penetration at {first}"
+        assert hit.time <= first + TOL
+    if hit.collides:
+        lo, hi = hit.time_bracket
+        assert hi == hit.time and 0 <= hi - lo <= TOL
+        assert oracle_penetrates(a, ma, b, mb, hit.time)
+        assert not oracle_penetrates(a, ma, b, mb, lo)
+        # no oracle sample before the bracket penetrates
+        before = oracle_first_penetration(a, ma, b, mb, 0.0, lo, max(3, int(n * lo / t_max)))
+        assert before is None
+        assert hit.state is State.PENETRATING
+        assert hit.first_contact is not None and hit.first_contact <= hit.time
+    return hit, first
+
+
+# -- random concave bodies (the paper's generator: random radii at sorted angles) ---
+def star_polygon(rng: np.random.Generator, n: int, scale: float) -> np.ndarray:
+    angles = np.sort(rng.choice(360, size=n, replace=False)) * math.pi / 180
+    radii = rng.uniform(0.25, 1.0, size=n) * scale
+    return np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
+
+
+def random_motion(rng: np.random.Generator, toward: np.ndarray) -> Motion:
+    return Motion(
+        velocity=tuple(toward * rng.uniform(0.5, 1.5) + rng.normal(0, 0.3, 2)),
+        acceleration=tuple(rng.normal(0, 0.3, 2)),
+        angular_velocity=float(rng.normal(0, 2.0)),
+        angular_acceleration=float(rng.normal(0, 1.0)),
+    )
+
+
+@settings(max_examples=25)
+@given(st.integers(0, 2**32 - 1))
+def test_random_concave_pairs_match_oracle(seed):
+    rng = np.random.default_rng(seed)
+    a = Shape(star_polygon(rng, int(rng.integers(5, 14)), 1.0))
+    b = Shape(star_polygon(rng, int(rng.integers(5, 14)), 1.0)).moved((4.0, rng.normal(0, 0.8)))
+    direction = np.array([1.0, 0.0])
+    ma = random_motion(rng, direction)
+    mb = random_motion(rng, -direction)
+    check_against_oracle(a, ma, b, mb, t_max=3.0)
+
+
+# -- hand-made scenes -------------------------------------------------------------------
+SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+
+
+def test_flush_approach_is_a_collision_when_edges_meet():
+    # paper Fig. 17: two squares head-on, edges parallel
+    b = SQ.moved((3, 0))
+    for method in ("exact", "sampled"):
+        hit = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(velocity=(-0.5, 0)),
+                             t_max=5, method=method)
+        assert hit.collides and hit.status is ImpactStatus.HIT
+        assert abs(hit.time - 2 / 1.5) <= TOL
+    assert np.allclose(hit.normal, [1, 0])
+
+
+def test_exact_flush_features_are_the_touching_vertices():
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), SQ.moved((3, 0)), Motion(), t_max=5)
+    touching = {(f.body, f.vertex) for f in hit.features}
+    assert {("a", 1), ("a", 2), ("b", 0), ("b", 3)} <= touching
+    assert np.allclose(hit.normal, [1, 0])
+    assert hit.point[0] == pytest.approx(3.0)
+
+
+def test_sliding_along_is_contact_not_collision():
+    # paper Fig. 16: A's top edge slides along B's bottom edge
+    b = SQ.moved((3, 1))
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=2.1)
+    assert not hit.collides and hit.time is None
+    assert hit.status is ImpactStatus.NO_HIT
+    assert hit.first_contact == pytest.approx(2.0, abs=TOL)
+    assert hit.state is State.CONTACT
+    assert hit.features and hit.normal is not None
+
+
+def test_slide_then_hit_a_step():
+    # A slides under B's overhang, then hits B's leg at x = 3.3
+    b = Shape([(3.0, 1.0), (3.3, 1.0), (3.3, 0.0), (3.6, 0.0), (3.6, 2.0), (3.0, 2.0)])
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=3)
+    assert hit.first_contact == pytest.approx(2.0, abs=TOL)
+    assert hit.collides and hit.time == pytest.approx(2.3, abs=TOL)
+    assert ("a", 1) in {(f.body, f.vertex) for f in hit.features}
+
+
+def test_slide_runs_out_of_iterations_with_a_status_not_a_hang():
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), SQ.moved((3, 1)), Motion(), t_max=5,
+                         max_iterations=1000)
+    assert hit.status is ImpactStatus.OUT_OF_ITERATIONS
+    assert not hit.collides and 2.0 <= hit.searched_to < 5
+
+
+def test_corner_graze_is_contact():
+    # B's corner touches A's top edge while A passes underneath, rising then falling
+    b = Shape([(2.5, 1.5), (3.0, 1.0), (3.5, 1.5)])
+    ma = Motion(velocity=(1, 0.5), acceleration=(0, -1))   # y(t) = 0.5 t - t²/2, max at t=0.5
+    # A's top edge starts at y = 0.875 and reaches y = 1 exactly at t = 0.5
+    hit = time_of_impact(SQ.moved((2, -0.125)), ma, b, Motion(), t_max=1)
+    assert not hit.collides and hit.status is ImpactStatus.NO_HIT
+    # "touching" is within the contact resolution lam = 1e-6 (L_A + L_B): the gap
+    # (t - 0.5)²/2 is below lam from t = 0.5 - sqrt(2 lam) on
+    lam = pc.impact.CONTACT_RESOLUTION * (SQ.bounding_radius + b.bounding_radius)
+    assert hit.first_contact == pytest.approx(0.5 - math.sqrt(2 * lam), abs=1e-4)
+
+
+def test_start_inside_a_hole_collides_only_at_the_hole_boundary():
+    ring = Shape([(-5, -5), (5, -5), (5, 5), (-5, 5)], [[(-3, -3), (3, -3), (3, 3), (-3, 3)]])
+    small = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])
+    hit = time_of_impact(small, Motion(velocity=(2, 0)), ring, Motion(), t_max=5)
+    assert hit.collides and hit.time == pytest.approx(1.25, abs=TOL)
+    assert {(f.body, f.other_loop) for f in hit.features} == {("a", 1)}
+    check_against_oracle(small, Motion(velocity=(2, 0.3), angular_velocity=3.0), ring,
+                         Motion(angular_velocity=-0.5), t_max=5)
+
+
+def test_entering_a_concavity_is_not_a_hit_at_the_hull():
+    c_shape = Shape([(0, 0), (4, 0), (4, 1), (1, 1), (1, 3), (4, 3), (4, 4), (0, 4)])
+    peg = Shape([(6, 1.5), (7, 1.5), (7, 2.5), (6, 2.5)])
+    hit = time_of_impact(peg, Motion(velocity=(-1, 0)), c_shape, Motion(), t_max=10)
+    hull = time_of_impact(peg, Motion(velocity=(-1, 0)), c_shape.to_shapely().convex_hull,
+                          Motion(), t_max=10)
+    assert hull.time == pytest.approx(2.0, abs=TOL)
+    assert hit.time == pytest.approx(5.0, abs=TOL)      # reaches the inner wall x = 1
+
+
+def test_already_penetrating_is_reported_not_an_impact_at_zero():
+    for method in ("exact", "sampled"):
+        hit = time_of_impact(SQ, Motion(velocity=(1, 0)), SQ.moved((0.5, 0)), Motion(),
+                             t_max=1, method=method)
+        assert hit.status is ImpactStatus.PENETRATING_AT_START
+        assert not hit.collides and hit.time is None and hit.state is State.PENETRATING
+
+
+def test_touching_at_start_then_separating():
+    hit = time_of_impact(SQ, Motion(velocity=(-1, 0)), SQ.moved((1, 0)), Motion(), t_max=1)
+    assert not hit.collides and hit.first_contact == 0.0
+
+
+def test_no_broad_phase_overlap_means_no_search():
+    hit = time_of_impact(SQ, Motion(velocity=(0, 1)), SQ.moved((10, 0)), Motion(), t_max=1)
+    assert hit.broad_phase == () and hit.status is ImpactStatus.NO_HIT
+    assert hit.iterations == 0 and hit.first_contact is None and hit.state is None
+
+
+# -- tunnelling: a thin bar spinning fast clips a small body for 3.7 ms -------------------
+BAR = Shape([(-1, -0.01), (1, -0.01), (1, 0.01), (-1, 0.01)])
+DOT = Shape([(-0.025, 0.945), (0.025, 0.945), (0.025, 0.995), (-0.025, 0.995)])
+
+
+def test_spinning_bar_sampled_tunnels_exact_does_not():
+    spin = Motion(angular_velocity=20.0)
+    first = oracle_first_penetration(BAR, spin, DOT, Motion(), 0.0, 0.2, 4001)
+    assert first is not None and 0.07 < first < 0.08
+    # it is a clip: free again 5 ms later
+    assert not oracle_penetrates(BAR, spin, DOT, Motion(), first + 0.005)
+    sampled = time_of_impact(BAR, spin, DOT, Motion(), t_max=0.2, method="sampled")
+    assert not sampled.collides
+    exact = time_of_impact(BAR, spin, DOT, Motion(), t_max=0.2)
+    assert exact.collides and abs(exact.time - first) <= TOL
+
+
+def test_spinning_bar_many_turns_inside_the_interval():
+    spin = Motion(angular_velocity=200.0)             # 32 turns per second
+    dot = DOT.moved((0, 0.25))
+    come = Motion(velocity=(0, -0.02))
+    # the dot's nearest point is beyond the bar's reach (1.00005) until t = 9.75
+    first = oracle_first_penetration(BAR, spin, dot, come, 9.7, 9.9, 20001)
+    assert first is not None
+    exact = time_of_impact(BAR, spin, dot, come, t_max=10)
+    (start, end), = exact.broad_phase
+    assert 200.0 * (first - start) / (2 * math.pi) > 10     # turns inside the interval
+    assert exact.collides and 9.7 < exact.time <= first + TOL
+    assert oracle_penetrates(BAR, spin, dot, come, exact.time)
+    assert not oracle_penetrates(BAR, spin, dot, come, exact.time_bracket[0])
+
+
+# -- the paper's cases ---------------------------------------------------------------------
+@pytest.mark.parametrize("case", [1, 2])
+def test_paper_cases_match_oracle(case):
+    scene = pc.load_scene(f"examples/paper-case-{case}.json", repair=True)
+    a, b = scene.bodies
+    hit, first = check_against_oracle(a.shape, a.motion, b.shape, b.motion, scene.t_max,
+                                      n=4000)
+    assert first is not None
+
+
+def test_paper_case_1_sampled_misses_the_first_penetration():
+    scene = pc.load_scene("examples/paper-case-1.json")
+    a, b = scene.bodies
+    exact = time_of_impact(a.shape, a.motion, b.shape, b.motion, t_max=scene.t_max)
+    sampled = time_of_impact(a.shape, a.motion, b.shape, b.motion, t_max=scene.t_max,
+                             method="sampled")
+    assert exact.time == pytest.approx(7.98475, abs=TOL)
+    # the paper's answer, 9.6965 s, is the start of a second penetration
+    assert sampled.time == pytest.approx(9.6965, abs=TOL)
+    assert oracle_penetrates(a.shape, a.motion, b.shape, b.motion, 8.05)
+    assert not oracle_penetrates(a.shape, a.motion, b.shape, b.motion, 9.0)
+    assert ("a", 2) in {(f.body, f.vertex) for f in sampled.features}   # red vertex 3
+
+
+# -- arguments ---------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"method": "fast"}, "method: expected one of exact, sampled"),
+        ({"samples": 1}, "samples"),
+        ({"time_tolerance": 0}, "time_tolerance"),
+        ({"time_tolerance": float("nan")}, "time_tolerance"),
+        ({"t_max": -1}, "t_max"),
+        ({"max_iterations": 0}, "max_iterations"),
+    ],
+)
+def test_bad_arguments(kwargs, message):
+    args = {"t_max": 1.0, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        time_of_impact(SQ, Motion(), SQ.moved((3, 0)), Motion(), **args)
+
+
+def test_motion_must_be_a_motion():
+    with pytest.raises(TypeError, match="motion_b"):
+        time_of_impact(SQ, Motion(), SQ, (1, 0), t_max=1)
