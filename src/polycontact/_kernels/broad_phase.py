@@ -104,9 +104,9 @@ def nonpositive_intervals(coeffs, lo, hi):
         if fa <= 0.0 and fb <= 0.0:
             x0, x1 = a, b
         elif fa <= 0.0:
-            x0, x1 = a, _bisect(coeffs, deg, a, b, fa)
+            x0, x1 = a, (a if fa == 0.0 else _bisect(coeffs, deg, a, b, fa))
         elif fb <= 0.0:
-            x0, x1 = _bisect(coeffs, deg, a, b, fa), b
+            x0, x1 = (b if fb == 0.0 else _bisect(coeffs, deg, a, b, fa)), b
         else:
             continue
         if n > 0 and x0 <= out[n - 1, 1]:

@@ -1,0 +1,148 @@
+"""Impact and broad-phase kernels against plain NumPy / Shapely references.
+
+Small inputs: this file also runs with NUMBA_DISABLE_JIT=1 (see .ci/run).
+"""
+
+import math
+
+import numpy as np
+import shapely
+from hypothesis import given
+from hypothesis import strategies as st
+
+from polycontact import Motion, Shape
+from polycontact._kernels import broad_phase as kb
+from polycontact._kernels import impact as ki
+
+coef = st.floats(-10, 10, allow_nan=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
+
+
+def _reference_nonpositive(c, lo, hi):
+    """Where the polynomial is <= 0, from numpy.roots and the sign between roots."""
+    roots = np.roots(c[::-1]) if np.any(c[1:]) else np.array([])
+    real = sorted(r.real for r in roots if abs(r.imag) < 1e-9 and lo < r.real < hi)
+    pts = [lo, *real, hi]
+    val = lambda t: np.polyval(c[::-1], t)
+    return [(s, e) for s, e in zip(pts, pts[1:]) if val(0.5 * (s + e)) <= 0]
+
+
+@given(st.lists(coef, min_size=5, max_size=5))
+def test_nonpositive_intervals_match_numpy_roots(c):
+    c = np.array(c)
+    out = kb.nonpositive_intervals(c, 0.0, 3.0)
+    val = lambda t: np.polyval(c[::-1], t)
+    for s, e in out:
+        assert 0.0 <= s <= e <= 3.0
+        m = 0.5 * (s + e)
+        assert val(m) <= 1e-9 * max(1.0, np.abs(c).sum() * 81)
+    for s, e in _reference_nonpositive(c, 0.0, 3.0):
+        m = 0.5 * (s + e)
+        if val(m) < -1e-6:
+            assert any(a - 1e-9 <= m <= b + 1e-9 for a, b in out)
+
+
+@given(st.lists(coef, min_size=5, max_size=5))
+def test_polynomial_is_monotone_between_breakpoints(c):
+    c = np.array(c)
+    pts = kb.monotone_breakpoints(c, -2.0, 2.0)
+    assert pts[0] == -2.0 and pts[-1] == 2.0 and np.all(np.diff(pts) >= 0)
+    der = np.polyder(c[::-1])
+    for s, e in zip(pts, pts[1:]):
+        d = np.polyval(der, np.linspace(s, e, 9)[1:-1])
+        scale = 1e-7 * max(1.0, np.abs(c).sum() * 32)
+        assert np.all(d >= -scale) or np.all(d <= scale)
+
+
+def test_double_root_is_a_point_interval():
+    c = np.array([1.0, -2.0, 1.0, 0.0, 0.0])        # (t - 1)²
+    out = kb.nonpositive_intervals(c, 0.0, 3.0)
+    assert out.shape == (1, 2) and abs(out[0, 0] - 1) < 1e-7 and abs(out[0, 1] - 1) < 1e-7
+
+
+def test_constant_polynomials():
+    assert kb.nonpositive_intervals(np.array([-1.0, 0, 0, 0, 0]), 0.0, 2.0).tolist() == [
+        [0.0, 2.0]]
+    assert kb.nonpositive_intervals(np.array([1.0, 0, 0, 0, 0]), 0.0, 2.0).shape == (0, 2)
+
+
+vec = st.tuples(st.floats(-3, 3), st.floats(-3, 3))
+
+
+@given(vec, vec, st.floats(-4, 4), st.floats(-4, 4), st.floats(0, 3))
+def test_place_matches_shape_moved(v, a, w, al, t):
+    tri = Shape([(0, 0), (2, 0.5), (0.5, 1.5)])
+    m = Motion(v, a, w, al)
+    out = np.empty_like(tri.packed[0])
+    ki.place(tri.packed[0] - tri.centroid, np.array(tri.centroid), m.array, t, out)
+    assert np.allclose(out, tri.at(m, t).exterior, atol=1e-12)
+
+
+@given(vec, vec, st.floats(-4, 4), st.floats(-4, 4), vec, vec, st.floats(-4, 4),
+       st.floats(-4, 4), st.floats(0, 2), st.floats(0.0, 0.5))
+def test_speed_bound_bounds_every_vertex_speed(va, aa, wa, ala, vb, ab, wb, alb, t0, dt):
+    a = Shape([(0, 0), (2, 0.5), (0.5, 1.5)])
+    b = Shape([(0, 0), (1, 0), (1, 3), (0, 3)])
+    ma, mb = Motion(va, aa, wa, ala), Motion(vb, ab, wb, alb)
+    bound = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
+                           t0, t0 + dt)
+    h = 1e-6
+    for t in np.linspace(t0, t0 + dt, 5):
+        pa = (a.at(ma, t + h).exterior - a.at(ma, t - h).exterior) / (2 * h)
+        pb = (b.at(mb, t + h).exterior - b.at(mb, t - h).exterior) / (2 * h)
+        rel = pa[:, None, :] - pb[None, :, :]
+        assert np.max(np.hypot(rel[..., 0], rel[..., 1])) <= bound * (1 + 1e-6) + 1e-6
+
+
+def _kernel_args(a, ma, b, mb):
+    return (a.packed[0] - a.centroid, a.packed[1], np.array(a.centroid), ma.array,
+            b.packed[0] - b.centroid, b.packed[1], np.array(b.centroid), mb.array)
+
+
+def test_exact_search_on_flush_squares():
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    b = sq.moved((3, 0))
+    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
+    iv = np.array([[0.0, 5.0]])
+    code, hi, lo, contact, its, reached = ki.exact_search(
+        ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb, b.bounding_radius, iv,
+        1e-4, 1e-12, 1e-6, 10000)
+    assert code == ki.HIT and lo < hi and hi - lo <= 1e-4 and abs(hi - 2.0) <= 1e-4
+    assert lo <= 2.0 <= hi and contact <= hi
+
+
+def test_exact_search_reports_the_budget():
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    b = sq.moved((0.5, 1))                         # sliding contact from t = 0
+    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
+    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
+                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
+    assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0
+
+
+def _paper_sampled(a, ma, b, mb, t1, t2, n, threshold):
+    """The paper's §3 steps 3–6 with Shapely deciding penetration."""
+    def pen(t):
+        return shapely.relate_pattern(a.at(ma, t).to_shapely(), b.at(mb, t).to_shapely(),
+                                      "2********")
+    found = False
+    while True:
+        ts = [t1 + i * (t2 - t1) / (n - 1) for i in range(n - 1)] + [t2]
+        t0 = next((t for t in ts if pen(t)), None)
+        if t0 is None:
+            return t2 if found else None
+        found = True
+        t1, t2 = max(t0 - (t2 - t1) / n, 0.0), t0
+        if t2 - t1 < threshold:
+            return t2
+
+
+def test_sampled_search_follows_the_paper_steps():
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    b = Shape([(3, 0.5), (4, 0), (4, 1)])
+    for n in (2, 3, 10):
+        m_a = Motion(velocity=(1, 0.1), angular_velocity=0.3)
+        args = _kernel_args(sq, m_a, b, Motion())
+        code, hi, lo, contact, evals = ki.sampled_search(*args, np.array([[0.5, 4.0]]), 1e-3,
+                                                         n, 1e-12)
+        expected = _paper_sampled(sq, m_a, b, Motion(), 0.5, 4.0, n, 1e-3)
+        assert code == ki.HIT and math.isclose(hi, expected, abs_tol=1e-12)
