@@ -259,14 +259,17 @@ def _check_tolerance(tolerance: Any) -> float:
     return tol
 
 
-def _is_raw(x: Any) -> bool:
-    return (
-        type(x) is np.ndarray
-        and x.dtype == np.float64
-        and x.ndim == 2
-        and x.shape[1] == 2
-        and x.flags.c_contiguous
-    )
+_F64 = np.dtype(np.float64)
+_KERNELS: list[Any] = []
+
+
+def _kr() -> Any:
+    """The relation kernels module (imported on first use: numba loads lazily)."""
+    if not _KERNELS:
+        from ._kernels import relation
+
+        _KERNELS.append(relation)
+    return _KERNELS[0]
 
 
 def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
@@ -276,6 +279,9 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     ----------
     a, b : Shape, shapely Polygon, or array_like of shape (N, 2)
         The bodies. An array is an outer loop (closed or not, either orientation).
+        C-contiguous float64 arrays take a lean path: one compiled call validates both
+        rings and classifies them; only an invalid ring goes through :class:`Shape`
+        (which explains the defect, or cleans repeated vertices).
     tolerance : float, optional
         Absolute tolerance; distances up to it count as touching. Default:
         :func:`polycontact.default_tolerance` of both bodies' coordinates.
@@ -283,6 +289,8 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     Returns
     -------
     Relation
+        ``state`` and ``tolerance`` at once; ``distance``, ``features``, ``point`` and
+        ``normal`` computed on first access (from copies of array inputs).
 
     Raises
     ------
@@ -298,17 +306,22 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     >>> round(classify(sq, sq + [0.75, 0.5]).distance, 12)
     -0.25
     """
-    from ._kernels import relation as kr
-
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
-    if _is_raw(a) and _is_raw(b):
-        code, eps, na, fa, nb, fb = kr.classify_raw(a, b, tol, RELATIVE_TOLERANCE)
+    if (
+        type(a) is np.ndarray
+        and type(b) is np.ndarray
+        and a.dtype is _F64
+        and b.dtype is _F64
+        and a.ndim == 2
+        and b.ndim == 2
+        and a.flags.c_contiguous
+        and b.flags.c_contiguous
+    ):
+        code, eps, na, fa, nb, fb = _kr().classify_raw(a, b, tol, RELATIVE_TOLERANCE)
         if code >= 0:
             obj = object.__new__(Relation)
             obj.__dict__.update(
-                state=_STATES[code],
-                tolerance=eps,
-                _pair=((a.copy(), na, fa), (b.copy(), nb, fb)),
+                state=_STATES[code], tolerance=eps, _pair=((a.copy(), na, fa), (b.copy(), nb, fb))
             )
             return obj
     sa = as_shape(a, "a")
@@ -316,9 +329,10 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     xa, pa = sa.packed
     xb, pb = sb.packed
     eps = default_tolerance(xa, xb) if tol < 0.0 else tol
-    code = kr.relate_state(xa, pa, xb, pb, eps)
     obj = object.__new__(Relation)
-    obj.__dict__.update(state=_STATES[code], tolerance=eps, _pair=(sa, sb))
+    obj.__dict__.update(
+        state=_STATES[_kr().relate_state(xa, pa, xb, pb, eps)], tolerance=eps, _pair=(sa, sb)
+    )
     return obj
 
 

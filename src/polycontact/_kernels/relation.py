@@ -22,11 +22,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .validate import _orient, _point_segment_distance, first_defect
+from .validate import _orient, _point_segment_distance, segment_meet
 
 SEPARATE = 0
 CONTACT = 1
 PENETRATING = 2
+
+
+@njit(cache=True, nogil=True)
+def _norm(x, y):
+    return np.sqrt(x * x + y * y)
 
 
 @njit(cache=True, nogil=True)
@@ -82,8 +87,12 @@ def _inside(px, py, xy, starts):
 
 
 @njit(cache=True, nogil=True)
-def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, cnt):
-    """Append the edges of one body whose bounding box meets the window."""
+def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, box, ids, cnt):
+    """Append the edges of one body whose bounding box meets the window.
+
+    ``box[r] = (xmin, xmax, ymin, ymax)``, ``ids[r] = (vertex, next vertex)`` in the
+    global numbering of the pair (vertices of B after those of A: ``offset``).
+    """
     for k in range(starts.shape[0] - 1):
         s = starts[k]
         e = starts[k + 1]
@@ -95,41 +104,93 @@ def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid,
             y1 = max(xy[i, 1], xy[j, 1])
             if x1 < wx0 or x0 > wx1 or y1 < wy0 or y0 > wy1:
                 continue
-            ex0[cnt] = x0
-            ex1[cnt] = x1
-            ey0[cnt] = y0
-            ey1[cnt] = y1
-            eid[cnt] = offset + i
+            box[cnt, 0] = x0
+            box[cnt, 1] = x1
+            box[cnt, 2] = y0
+            box[cnt, 3] = y1
+            ids[cnt, 0] = offset + i
+            ids[cnt, 1] = offset + j
             cnt += 1
     return cnt
 
 
 @njit(cache=True, nogil=True)
-def _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid, order, cnt,
-                   maxw, na, eps):
+def _sort_by_xmin(box, cnt):
+    """Order of the first cnt rows of box by xmin.
+
+    A bucket pass (one bucket per row over the range of xmin) followed by an insertion
+    pass: O(cnt) for spread-out keys. If the insertion pass does too much work (keys
+    bunched in a few buckets) it falls back to ``np.argsort``.
+    """
+    order = np.empty(cnt, np.int64)
+    if cnt == 0:
+        return order
+    lo = np.inf
+    hi = -np.inf
+    for i in range(cnt):
+        lo = min(lo, box[i, 0])
+        hi = max(hi, box[i, 0])
+    if cnt > 16 and hi > lo:
+        scale = (cnt - 1) / (hi - lo)
+        start = np.zeros(cnt + 1, np.int64)
+        for i in range(cnt):
+            start[int((box[i, 0] - lo) * scale) + 1] += 1
+        for k in range(cnt):
+            start[k + 1] += start[k]
+        for i in range(cnt):
+            k = int((box[i, 0] - lo) * scale)
+            order[start[k]] = i
+            start[k] += 1
+    else:
+        for i in range(cnt):
+            order[i] = i
+    budget = 8 * cnt + 64
+    for i in range(1, cnt):
+        cur = order[i]
+        key = box[cur, 0]
+        j = i
+        while j > 0 and box[order[j - 1], 0] > key:
+            order[j] = order[j - 1]
+            j -= 1
+            budget -= 1
+        order[j] = cur
+        if budget < 0:
+            return np.argsort(box[:cnt, 0])
+    return order
+
+
+@njit(cache=True, nogil=True)
+def _pt(g, xa, xb, na):
+    if g < na:
+        return xa[g, 0], xa[g, 1]
+    return xb[g - na, 0], xb[g - na, 1]
+
+
+@njit(cache=True, nogil=True)
+def _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
     """Whether the open interior cones of A and B at the touch point p overlap.
 
     Every edge of either body within eps of p gives rays leaving p: along the edge from
     its near end (or both ways when p is inside the edge). A ray whose interior side is
     counter-clockwise of it is "opening"; sorted by angle, the interior of a body in a
-    direction d is decided by the body's nearest ray clockwise of d.
+    direction d is decided by the body's nearest ray clockwise of d (rays of one body
+    alternate opening/closing around p, so holes touching the outer loop work too).
     """
-    # binary search: first sorted edge with xmin >= px - eps - maxw
     lo = 0
     hi = cnt
     xlo = px - eps - maxw
     while lo < hi:
         mid = (lo + hi) // 2
-        if ex0[order[mid]] < xlo:
+        if box[order[mid], 0] < xlo:
             lo = mid + 1
         else:
             hi = mid
     cap = 0
     for oi in range(lo, cnt):
         i = order[oi]
-        if ex0[i] > px + eps:
+        if box[i, 0] > px + eps:
             break
-        if ey0[i] <= py + eps and ey1[i] >= py - eps:
+        if box[i, 2] <= py + eps and box[i, 3] >= py - eps:
             cap += 2
     ang = np.empty(cap)
     length = np.empty(cap)
@@ -138,32 +199,19 @@ def _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid, o
     r = 0
     for oi in range(lo, cnt):
         i = order[oi]
-        if ex0[i] > px + eps:
+        if box[i, 0] > px + eps:
             break
-        if ey0[i] > py + eps or ey1[i] < py - eps:
+        if box[i, 2] > py + eps or box[i, 3] < py - eps:
             continue
-        g = eid[i]
-        if g < na:
-            xy = xa
-            v = g
-            w = _next_vertex(v, sa, la)
-            flip = fa
-            body_a = True
-        else:
-            xy = xb
-            v = g - na
-            w = _next_vertex(v, sb, lb)
-            flip = fb
-            body_a = False
-        ux = xy[v, 0]
-        uy = xy[v, 1]
-        wx = xy[w, 0]
-        wy = xy[w, 1]
+        body_a = ids[i, 0] < na
+        flip = fa if body_a else fb
+        ux, uy = _pt(ids[i, 0], xa, xb, na)
+        wx, wy = _pt(ids[i, 1], xa, xb, na)
         if _point_segment_distance(px, py, ux, uy, wx, wy) > eps:
             continue
-        du = np.hypot(px - ux, py - uy)
-        dw = np.hypot(px - wx, py - wy)
-        le = np.hypot(wx - ux, wy - uy)
+        du = _norm(px - ux, py - uy)
+        dw = _norm(px - wx, py - wy)
+        le = _norm(wx - ux, wy - uy)
         if du > eps or dw <= eps:  # ray from p (or from w) back along the edge
             if not (du <= eps and dw <= eps):
                 ang[r] = np.arctan2(uy - wy, ux - wx)
@@ -191,9 +239,9 @@ def _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid, o
         mid = ang[i1] + 0.5 * gap
         if mid > np.pi:
             mid -= 2.0 * np.pi
-        in_a = _interior_at(mid, ang, opening, is_a, r, True)
-        in_b = _interior_at(mid, ang, opening, is_a, r, False)
-        if in_a and in_b:
+        if _interior_at(mid, ang, opening, is_a, r, True) and _interior_at(
+            mid, ang, opening, is_a, r, False
+        ):
             return True
     return False
 
@@ -218,6 +266,20 @@ def _interior_at(theta, ang, opening, is_a, r, body_a):
 
 
 @njit(cache=True, nogil=True)
+def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
+    """Is the first untouched vertex of some loop of one body strictly inside the other?"""
+    for k in range(sv.shape[0] - 1):
+        for i in range(sv[k], sv[k + 1]):
+            if not touch[offset + i]:
+                x = xv[i, 0]
+                y = xv[i, 1]
+                if x0 <= x <= x1 and y0 <= y <= y1 and _inside(x, y, xo, so):
+                    return True
+                break
+    return False
+
+
+@njit(cache=True, nogil=True)
 def _state(xa, sa, fa, xb, sb, fb, eps):
     """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right)."""
     na = sa[sa.shape[0] - 1]
@@ -230,41 +292,48 @@ def _state(xa, sa, fa, xb, sb, fb, eps):
     wx1 = min(ax1, bx1) + eps
     wy0 = max(ay0, by0) - eps
     wy1 = min(ay1, by1) + eps
-    la = _loop_index(sa, na)
-    lb = _loop_index(sb, nb)
     tot = na + nb
-    ex0 = np.empty(tot)
-    ex1 = np.empty(tot)
-    ey0 = np.empty(tot)
-    ey1 = np.empty(tot)
-    eid = np.empty(tot, np.int64)
-    cnt = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, 0)
-    cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, ex0, ex1, ey0, ey1, eid, cnt)
-    order = np.argsort(ex0[:cnt])
+    box = np.empty((tot, 4))
+    ids = np.empty((tot, 2), np.int64)
+    cnt = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, box, ids, 0)
+    cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, box, ids, cnt)
+    order = _sort_by_xmin(box, cnt)
     touch = np.zeros(tot, np.bool_)
     any_touch = False
     maxw = 0.0
     for oi in range(cnt):
         i = order[oi]
-        maxw = max(maxw, ex1[i] - ex0[i])
-        gi = eid[i]
+        xi1 = box[i, 1] + eps
+        yi0 = box[i, 2] - eps
+        yi1 = box[i, 3] + eps
+        maxw = max(maxw, box[i, 1] - box[i, 0])
+        i_in_a = ids[i, 0] < na
         for oj in range(oi + 1, cnt):
             j = order[oj]
-            if ex0[j] > ex1[i] + eps:
+            if box[j, 0] > xi1:
                 break
-            gj = eid[j]
-            if (gi < na) == (gj < na):
+            if (ids[j, 0] < na) == i_in_a or box[j, 2] > yi1 or box[j, 3] < yi0:
                 continue
-            if ey0[j] > ey1[i] + eps or ey0[i] > ey1[j] + eps:
-                continue
-            ga = gi if gi < na else gj
-            gb = (gj if gi < na else gi) - na
-            a1 = _next_vertex(ga, sa, la)
-            b1 = _next_vertex(gb, sb, lb)
+            ea = i if i_in_a else j
+            eb = j if i_in_a else i
+            ga = ids[ea, 0]
+            a1 = ids[ea, 1]
+            gb = ids[eb, 0]
+            b1 = ids[eb, 1]
             px, py = xa[ga, 0], xa[ga, 1]
             qx, qy = xa[a1, 0], xa[a1, 1]
-            rx, ry = xb[gb, 0], xb[gb, 1]
-            sx, sy = xb[b1, 0], xb[b1, 1]
+            rx, ry = xb[gb - na, 0], xb[gb - na, 1]
+            sx, sy = xb[b1 - na, 0], xb[b1 - na, 1]
+            o1 = _orient(px, py, qx, qy, rx, ry)
+            o2 = _orient(px, py, qx, qy, sx, sy)
+            ta = eps * _norm(qx - px, qy - py)
+            if (o1 > ta and o2 > ta) or (o1 < -ta and o2 < -ta):
+                continue  # B's edge strictly on one side of A's edge line
+            o3 = _orient(rx, ry, sx, sy, px, py)
+            o4 = _orient(rx, ry, sx, sy, qx, qy)
+            tb = eps * _norm(sx - rx, sy - ry)
+            if (o3 > tb and o4 > tb) or (o3 < -tb and o4 < -tb):
+                continue
             near = False
             if _point_segment_distance(px, py, rx, ry, sx, sy) <= eps:
                 touch[ga] = True
@@ -273,49 +342,27 @@ def _state(xa, sa, fa, xb, sb, fb, eps):
                 touch[a1] = True
                 near = True
             if _point_segment_distance(rx, ry, px, py, qx, qy) <= eps:
-                touch[na + gb] = True
+                touch[gb] = True
                 near = True
             if _point_segment_distance(sx, sy, px, py, qx, qy) <= eps:
-                touch[na + b1] = True
+                touch[b1] = True
                 near = True
             if near:
                 any_touch = True
-                continue
-            o1 = _orient(px, py, qx, qy, rx, ry)
-            o2 = _orient(px, py, qx, qy, sx, sy)
-            o3 = _orient(rx, ry, sx, sy, px, py)
-            o4 = _orient(rx, ry, sx, sy, qx, qy)
-            if ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
+            elif ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
                 return PENETRATING
     # (3) cones at the touch points
     if any_touch:
         for g in range(tot):
-            if not touch[g]:
-                continue
-            if g < na:
-                px, py = xa[g, 0], xa[g, 1]
-            else:
-                px, py = xb[g - na, 0], xb[g - na, 1]
-            if _cones_overlap(px, py, xa, sa, la, fa, xb, sb, lb, fb, ex0, ey0, ey1, eid,
-                              order, cnt, maxw, na, eps):
-                return PENETRATING
+            if touch[g]:
+                px, py = _pt(g, xa, xb, na)
+                if _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
+                    return PENETRATING
     # (2) one untouched vertex per loop, strictly inside the other body
-    for k in range(sa.shape[0] - 1):
-        for i in range(sa[k], sa[k + 1]):
-            if not touch[i]:
-                x = xa[i, 0]
-                y = xa[i, 1]
-                if bx0 <= x <= bx1 and by0 <= y <= by1 and _inside(x, y, xb, sb):
-                    return PENETRATING
-                break
-    for k in range(sb.shape[0] - 1):
-        for i in range(sb[k], sb[k + 1]):
-            if not touch[na + i]:
-                x = xb[i, 0]
-                y = xb[i, 1]
-                if ax0 <= x <= ax1 and ay0 <= y <= ay1 and _inside(x, y, xa, sa):
-                    return PENETRATING
-                break
+    if _untouched_inside(xa, sa, touch, 0, xb, sb, bx0, bx1, by0, by1):
+        return PENETRATING
+    if _untouched_inside(xb, sb, touch, na, xa, sa, ax0, ax1, ay0, ay1):
+        return PENETRATING
     return CONTACT if any_touch else SEPARATE
 
 
@@ -378,7 +425,7 @@ def _segment_closest(px, py, qx, qy, rx, ry, sx, sy):
         else:
             ux, uy, ax, ay, bx, by, on_first = sx, sy, px, py, qx, qy, False
         cx, cy = _closest_on(ux, uy, ax, ay, bx, by)
-        d = np.hypot(ux - cx, uy - cy)
+        d = _norm(ux - cx, uy - cy)
         if d < best:
             best = d
             if on_first:
@@ -407,14 +454,14 @@ def closest_pair(xa, sa, xb, sb):
     ia = 0
     dmin = np.inf
     for i in range(na):
-        d = np.hypot(xa[i, 0] - cx, xa[i, 1] - cy)
+        d = _norm(xa[i, 0] - cx, xa[i, 1] - cy)
         if d < dmin:
             dmin = d
             ia = i
     best = np.inf
     r0 = r1 = r2 = r3 = 0.0
     for j in range(nb):
-        d = np.hypot(xa[ia, 0] - xb[j, 0], xa[ia, 1] - xb[j, 1])
+        d = _norm(xa[ia, 0] - xb[j, 0], xa[ia, 1] - xb[j, 1])
         if d < best:
             best = d
             r0, r1, r2, r3 = xa[ia, 0], xa[ia, 1], xb[j, 0], xb[j, 1]
@@ -478,6 +525,72 @@ def boundary_distance(xa, sa, xb, sb):
 
 
 @njit(cache=True, nogil=True)
+def _folds(px, py, qx, qy, rx, ry, eps):
+    """Consecutive edges p->q->r fold back (r within eps of pq, or p within eps of qr)."""
+    o = _orient(px, py, qx, qy, rx, ry)
+    l1 = (qx - px) * (qx - px) + (qy - py) * (qy - py)
+    l2 = (rx - qx) * (rx - qx) + (ry - qy) * (ry - qy)
+    if o * o > eps * eps * max(l1, l2):
+        return False
+    return (
+        _point_segment_distance(rx, ry, px, py, qx, qy) <= eps
+        or _point_segment_distance(px, py, qx, qy, rx, ry) <= eps
+    )
+
+
+@njit(cache=True, nogil=True)
+def _meet(px, py, qx, qy, rx, ry, sx, sy, eps):
+    """Closed segments pq and rs meet within eps (same predicate as ``segment_meet``)."""
+    o1 = _orient(px, py, qx, qy, rx, ry)
+    o2 = _orient(px, py, qx, qy, sx, sy)
+    t = eps * _norm(qx - px, qy - py)
+    if (o1 > t and o2 > t) or (o1 < -t and o2 < -t):
+        return False
+    o3 = _orient(rx, ry, sx, sy, px, py)
+    o4 = _orient(rx, ry, sx, sy, qx, qy)
+    t = eps * _norm(sx - rx, sy - ry)
+    if (o3 > t and o4 > t) or (o3 < -t and o4 < -t):
+        return False
+    return segment_meet(px, py, qx, qy, rx, ry, sx, sy, eps)[0]
+
+
+@njit(cache=True, nogil=True)
+def _ring_is_simple(xy, n, eps):
+    """No two edges of the ring meet except consecutive ones at their shared vertex,
+    and no two consecutive edges fold back: the rules of ``validate.first_defect`` for
+    one loop. Short rings test every pair; long ones sweep edges sorted by xmin."""
+    for i in range(n):
+        h = i - 1 if i > 0 else n - 1
+        j = i + 1 if i + 1 < n else 0
+        if _folds(xy[h, 0], xy[h, 1], xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], eps):
+            return False
+    box = np.empty((n, 4))
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        box[i, 0] = min(xy[i, 0], xy[j, 0])
+        box[i, 1] = max(xy[i, 0], xy[j, 0])
+        box[i, 2] = min(xy[i, 1], xy[j, 1])
+        box[i, 3] = max(xy[i, 1], xy[j, 1])
+    order = _sort_by_xmin(box, n)
+    for oi in range(n):
+        i = order[oi]
+        i1 = i + 1 if i + 1 < n else 0
+        for oj in range(oi + 1, n):
+            j = order[oj]
+            if box[j, 0] > box[i, 1] + eps:
+                break
+            if box[j, 2] > box[i, 3] + eps or box[j, 3] < box[i, 2] - eps:
+                continue
+            j1 = j + 1 if j + 1 < n else 0
+            if j == i1 or i == j1:
+                continue
+            if _meet(xy[i, 0], xy[i, 1], xy[i1, 0], xy[i1, 1],
+                     xy[j, 0], xy[j, 1], xy[j1, 0], xy[j1, 1], eps):
+                return False
+    return True
+
+
+@njit(cache=True, nogil=True)
 def _raw_ring(xy, rel):
     """Check one raw (N, 2) ring; returns ``(n, sign, scale)``.
 
@@ -487,6 +600,8 @@ def _raw_ring(xy, rel):
     -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1).
     """
     n = xy.shape[0]
+    if xy.shape[1] != 2:
+        return -1, 1.0, 1.0
     if n >= 2 and xy[n - 1, 0] == xy[0, 0] and xy[n - 1, 1] == xy[0, 1]:
         n -= 1
     if n < 3:
@@ -507,10 +622,7 @@ def _raw_ring(xy, rel):
         j = i
     if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
         return -1, 1.0, 1.0
-    starts = np.empty(2, np.int64)
-    starts[0] = 0
-    starts[1] = n
-    if first_defect(xy[:n], starts, eps)[0] != 0:
+    if not _ring_is_simple(xy, n, eps):
         return -1, 1.0, 1.0
     return n, (1.0 if a2 > 0.0 else -1.0), scale
 
@@ -654,10 +766,10 @@ def _cone_meets_left(xy, starts, loop_of, v, ux, uy):
     ix = xy[prv, 0] - xy[v, 0]
     iy = xy[prv, 1] - xy[v, 1]
     tol = 1e-9
-    lu = np.hypot(ux, uy)
-    if (ux * oy - uy * ox) > tol * lu * np.hypot(ox, oy):
+    lu = _norm(ux, uy)
+    if (ux * oy - uy * ox) > tol * lu * _norm(ox, oy):
         return True
-    if (ux * iy - uy * ix) > tol * lu * np.hypot(ix, iy):
+    if (ux * iy - uy * ix) > tol * lu * _norm(ix, iy):
         return True
     # both rays on the right: the cone meets the left iff it contains the left normal
     return _ccw_angle(ox, oy, -uy, ux) + tol < _ccw_angle(ox, oy, ix, iy)
@@ -778,7 +890,7 @@ def penetration(xa, sa, xb, sb, eps):
         t = min(1.0, max(0.0, -(px * vx + py * vy) / den)) if den > 0.0 else 0.0
         nc = 0
         for cx, cy in ((px + t * vx, py + t * vy), (px, py), (qx, qy)):
-            d = np.hypot(cx, cy)
+            d = _norm(cx, cy)
             if d < best:
                 cand[nc, 0] = d
                 cand[nc, 1] = cx
@@ -802,7 +914,7 @@ def penetration(xa, sa, xb, sb, eps):
                 continue
             cx = px + ts * vx
             cy = py + ts * vy
-            d = np.hypot(cx, cy)
+            d = _norm(cx, cy)
             if d < best:
                 if nc == cand.shape[0]:
                     grown = np.empty((2 * nc, 3))
