@@ -1,0 +1,170 @@
+"""No-fit polygons of the ESICUP nesting instances: polycontact vs pyclipper vs pysfcgal.
+
+For each instance, every ordered pair (orbiting item, fixed item) of its items, the item
+with itself included (nesting needs it when an item's demand is above one), at every
+combination of the allowed orientations (rotations about the origin), with the
+reference point at the origin (nesting convention: E = B ⊕ (−A)).
+
+Timed, in the same run and on the same prepared inputs:
+- ``polycontact.no_fit_polygon`` (region, exact fits and slides); "cold" clears the
+  convex-decomposition cache before each NFP, "warm" reuses it across pairs, as a
+  nesting code calling it repeatedly on the same pieces does;
+- ``pyclipper.MinkowskiSum2`` on integer coordinates scaled by a power of two so the
+  largest reaches 2**50 (Clipper needs integers);
+- ``pysfcgal`` ``Polygon.minkowski_sum`` (CGAL; it ignores B's holes, none here).
+
+With ``--check`` every result is compared with the independent reference of
+``tests/nfp_reference.py``: a region is wrong when the symmetric difference exceeds 1e-9
+of the area or the number of holes differs (a false hole).
+
+Run: ``python benchmarks/bench_nfp.py [--check] [--repeat 3] [instance ...]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+import polycontact as pc
+from polycontact import nfp as nfp_module
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "datasets" / "esicup"
+sys.path.insert(0, str(ROOT / "tests"))
+
+
+def rotated(ring: np.ndarray, degrees: float) -> np.ndarray:
+    """Ring rotated about the origin; exact for multiples of 90 degrees."""
+    t = np.radians(degrees)
+    c, s = np.cos(t), np.sin(t)
+    if degrees % 90 == 0:
+        c, s = round(c), round(s)
+    return ring @ np.array([[c, s], [-s, c]])
+
+
+def load(path: Path) -> list[np.ndarray]:
+    """Every (item, allowed orientation) of an instance as a CCW ring."""
+    data = json.loads(path.read_text())
+    out = []
+    for item in data["items"]:
+        ring = np.asarray(item["shape"]["data"], dtype=float)
+        for deg in item["allowed_orientations"]:
+            out.append(pc.Shape(rotated(ring, deg)).exterior)
+    return out
+
+
+def clipper_region(paths: list, scale: float) -> shapely.Geometry:
+    import pyclipper
+
+    outers = [shapely.Polygon(np.asarray(p) / scale) for p in paths if pyclipper.Orientation(p)]
+    holes = [shapely.Polygon(np.asarray(p) / scale) for p in paths if not pyclipper.Orientation(p)]
+    region = shapely.union_all(outers)
+    if holes:
+        # keep each hole as a hole (difference of the union), so false holes are counted
+        region = shapely.Polygon(region.exterior, [h.exterior for h in holes]) if (
+            region.geom_type == "Polygon") else region.difference(shapely.union_all(holes))
+    return region
+
+
+def run(path: Path, repeat: int, check: bool) -> dict:
+    import pyclipper
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        import pysfcgal.geometry as sg
+    rings = load(path)
+    shapes = [pc.Shape._trusted([r]) for r in rings]
+    scale = 2.0 ** (50 - int(np.ceil(np.log2(max(np.abs(r).max() for r in rings) * 2))))
+    ints = [[tuple(v) for v in np.round(r * scale).astype(np.int64).tolist()] for r in rings]
+    neg_ints = [[(-x, -y) for x, y in p] for p in ints]
+    sf = [sg.Polygon([tuple(v) for v in r.tolist()]) for r in rings]
+    sf_neg = [sg.Polygon([tuple(v) for v in (-r).tolist()]) for r in rings]
+    pairs = [(i, j) for i in range(len(rings)) for j in range(len(rings))]
+
+    def t_pc_warm():
+        return [pc.no_fit_polygon(shapes[i], shapes[j], "origin") for i, j in pairs]
+
+    def t_pc_cold():
+        out = []
+        for i, j in pairs:
+            nfp_module._PIECES_CACHE.clear()
+            out.append(pc.no_fit_polygon(shapes[i], shapes[j], "origin"))
+        return out
+
+    def t_clipper():
+        return [pyclipper.MinkowskiSum2(neg_ints[i], [ints[j]], True) for i, j in pairs]
+
+    def t_sfcgal():
+        return [sf[j].minkowski_sum(sf_neg[i]) for i, j in pairs]
+
+    times: dict[str, list[float]] = {"pc_cold": [], "pc_warm": [], "pyclipper": [], "pysfcgal": []}
+    results = {}
+    for _ in range(repeat):
+        for name, fn in (("pc_cold", t_pc_cold), ("pc_warm", t_pc_warm),
+                         ("pyclipper", t_clipper), ("pysfcgal", t_sfcgal)):
+            t0 = time.perf_counter()
+            results[name] = fn()
+            times[name].append(time.perf_counter() - t0)
+    row = {"instance": path.stem, "pieces": len(rings), "nfps": len(pairs)}
+    row.update({k: statistics.median(v) for k, v in times.items()})
+    if check:
+        from nfp_reference import hole_count, reference_region, same_region
+
+        wrong = {"wrong_pc": 0, "wrong_clip": 0, "clip_false_holes": 0, "wrong_sfcgal": 0}
+        exact = 0
+        for k, (i, j) in enumerate(pairs):
+            ref = reference_region(shapely.Polygon(rings[i]), shapely.Polygon(rings[j]), (0, 0))
+            got = results["pc_warm"][k]
+            exact += len(got.exact_fits) + len(got.slides)
+            if same_region(got.region, ref):
+                wrong["wrong_pc"] += 1
+            clip = clipper_region(results["pyclipper"][k], scale)
+            if same_region(clip, ref):
+                wrong["wrong_clip"] += 1
+            if hole_count(clip) > hole_count(ref):
+                wrong["clip_false_holes"] += 1
+            sfg = shapely.from_wkb(results["pysfcgal"][k].to_wkb(True))
+            if same_region(sfg, ref):
+                wrong["wrong_sfcgal"] += 1
+        row.update(wrong)
+        row["pc_exact_fits_and_slides"] = exact
+    return row
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("instances", nargs="*", help="instance names (default: all)")
+    parser.add_argument("--repeat", type=int, default=3, help="timed runs per tool (median)")
+    parser.add_argument("--check", action="store_true", help="verify against the reference")
+    args = parser.parse_args()
+    paths = sorted(DATA.glob("*.json"))
+    if args.instances:
+        paths = [p for p in paths if p.stem in args.instances]
+    # compile the kernels before timing
+    pc.no_fit_polygon([(0, 0), (2, 0), (2, 2), (1, 1), (0, 2)], [(0, 0), (1, 0), (0, 1)])
+    head = f"{'instance':10} {'NFPs':>6} {'pc cold s':>9} {'pc warm s':>9} {'pyclipper s':>11} {'pysfcgal s':>10} {'clip/pc':>7} {'sfcgal/pc':>9}"
+    if args.check:
+        head += f" {'wrong pc':>8} {'wrong clip (false holes)':>24} {'wrong sfcgal':>12} {'fits+slides':>11}"
+    print(head)
+    for path in paths:
+        r = run(path, args.repeat, args.check)
+        line = (f"{r['instance']:10} {r['nfps']:6d} {r['pc_cold']:9.3f} {r['pc_warm']:9.3f} "
+                f"{r['pyclipper']:11.3f} {r['pysfcgal']:10.3f} "
+                f"{r['pyclipper'] / r['pc_cold']:7.2f} {r['pysfcgal'] / r['pc_cold']:9.2f}")
+        if args.check:
+            line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:>14d} ({r['clip_false_holes']:d})"
+                     f"{'':>6} {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")
+        print(line, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

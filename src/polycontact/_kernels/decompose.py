@@ -1,0 +1,150 @@
+"""Kernel: merge the triangles of a polygon into convex pieces (Hertel–Mehlhorn).
+
+The triangles come from a triangulation without Steiner points (GEOS's constrained
+Delaunay triangulation of the polygon, holes included). Two pieces that share a
+diagonal are merged whenever the result stays convex; greedy merging yields at most
+four times the minimum number of convex pieces, and in practice close to it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, types
+from numba.typed import Dict
+
+_POINT = types.UniTuple(types.float64, 2)
+_INT = types.int64
+
+
+@njit(cache=True, nogil=True)
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@njit(cache=True, nogil=True)
+def convex_pieces(tri, eps):
+    """Convex pieces covering the union of triangles ``tri`` (float64, shape (T, 3, 2)).
+
+    Triangles of either orientation are accepted; triangles whose doubled area is at most
+    ``eps`` times their longest edge are dropped (zero area). Returns ``(xy, starts)``:
+    the pieces packed like a shape's loops, each counter-clockwise, piece ``k`` in rows
+    ``starts[k]:starts[k + 1]``. Vertices where two merged edges continue straight are
+    removed.
+    """
+    n_tri = tri.shape[0]
+    # Vertex ids by exact coordinates (the triangulation reuses the input coordinates).
+    ids = Dict.empty(key_type=_POINT, value_type=_INT)
+    vx = np.empty(3 * n_tri)
+    vy = np.empty(3 * n_tri)
+    org = np.empty(3 * n_tri, np.int64)
+    nxt = np.empty(3 * n_tri, np.int64)
+    prv = np.empty(3 * n_tri, np.int64)
+    alive = np.zeros(3 * n_tri, np.bool_)
+    nv = 0
+    nh = 0
+    for t in range(n_tri):
+        ax, ay = tri[t, 0, 0], tri[t, 0, 1]
+        bx, by = tri[t, 1, 0], tri[t, 1, 1]
+        cx, cy = tri[t, 2, 0], tri[t, 2, 1]
+        o = _orient(ax, ay, bx, by, cx, cy)
+        longest = max(np.hypot(bx - ax, by - ay), np.hypot(cx - bx, cy - by),
+                      np.hypot(ax - cx, ay - cy))
+        if abs(o) <= eps * longest:
+            continue
+        order = (0, 1, 2) if o > 0.0 else (0, 2, 1)
+        for k in range(3):
+            key = (tri[t, order[k], 0], tri[t, order[k], 1])
+            if key in ids:
+                org[nh + k] = ids[key]
+            else:
+                ids[key] = nv
+                vx[nv] = key[0]
+                vy[nv] = key[1]
+                org[nh + k] = nv
+                nv += 1
+            nxt[nh + k] = nh + (k + 1) % 3
+            prv[nh + k] = nh + (k + 2) % 3
+            alive[nh + k] = True
+        nh += 3
+    # Twins: half-edge u->v of one piece and v->u of the neighbour.
+    edge = Dict.empty(key_type=_INT, value_type=_INT)
+    twin = np.full(nh, -1, np.int64)
+    for h in range(nh):
+        u = org[h]
+        v = org[nxt[h]]
+        back = v * nv + u
+        if back in edge:
+            g = edge[back]
+            twin[h] = g
+            twin[g] = h
+        else:
+            edge[u * nv + v] = h
+    # Union-find over pieces (one per triangle at first) to skip diagonals inside a piece.
+    parent = np.arange(nh // 3)
+    for h in range(nh):
+        g = twin[h]
+        if g < h:
+            continue
+        p = h // 3
+        while parent[p] != p:
+            p = parent[p]
+        q = g // 3
+        while parent[q] != q:
+            q = parent[q]
+        if p == q:
+            continue
+        u = org[h]
+        v = org[g]
+        # After the merge: prv[h] -> u -> nxt[g] ... prv[g] -> v -> nxt[h]
+        a = org[prv[h]]
+        b = org[nxt[nxt[g]]]
+        if _orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) < 0.0:
+            continue
+        a = org[prv[g]]
+        b = org[nxt[nxt[h]]]
+        if _orient(vx[a], vy[a], vx[v], vy[v], vx[b], vy[b]) < 0.0:
+            continue
+        nxt[prv[h]] = nxt[g]
+        prv[nxt[g]] = prv[h]
+        nxt[prv[g]] = nxt[h]
+        prv[nxt[h]] = prv[g]
+        alive[h] = False
+        alive[g] = False
+        parent[q] = p
+    # Walk the remaining cycles.
+    out = np.empty((nh, 2))
+    starts = np.empty(nh + 1, np.int64)
+    seen = ~alive
+    n_out = 0
+    n_pieces = 0
+    starts[0] = 0
+    for h0 in range(nh):
+        if seen[h0]:
+            continue
+        h = h0
+        while not seen[h]:
+            seen[h] = True
+            u = org[h]
+            a = org[prv[h]]
+            b = org[nxt[h]]
+            # drop straight-through vertices left by merges (exactly collinear)
+            if _orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) != 0.0:
+                out[n_out, 0] = vx[u]
+                out[n_out, 1] = vy[u]
+                n_out += 1
+            h = nxt[h]
+        n_pieces += 1
+        starts[n_pieces] = n_out
+    return out[:n_out].copy(), starts[: n_pieces + 1].copy()
+
+
+@njit(cache=True, nogil=True)
+def is_convex(xy):
+    """Whether the CCW ring ``xy`` (shape (N, 2)) turns left or goes straight everywhere."""
+    n = xy.shape[0]
+    for i in range(n):
+        j = (i + 1) % n
+        k = (i + 2) % n
+        if _orient(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], xy[k, 0], xy[k, 1]) < 0.0:
+            return False
+    return True

@@ -1,0 +1,573 @@
+"""Kernels for the no-fit polygon: convex Minkowski sums and exact-fit candidates.
+
+``E(A, B)`` is the union of the convex sums ``C_ij = B_i ⊕ (a0 − A_j)`` over convex
+pieces ``B_i`` of B and ``A_j`` of A. The interiors of A and B overlap exactly when the
+reference point lies in the union ``O`` of the OPEN sums; ``E`` is the closure of ``O``.
+The exact fits and slides are ``int(E) \\ O``: points of the sums' boundaries covered by
+no open sum, yet surrounded on every side by closed ones. :func:`degenerate_contacts`
+finds them: it subtracts every open sum (shrunk by ``eps``) from every boundary edge, then
+keeps the remaining parts around which the closed sums cover every direction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _lowest(xy, s, e):
+    best = s
+    for i in range(s + 1, e):
+        if xy[i, 1] < xy[best, 1] or (xy[i, 1] == xy[best, 1] and xy[i, 0] < xy[best, 0]):
+            best = i
+    return best
+
+
+@njit(cache=True, nogil=True)
+def convex_sums(bxy, bstarts, rxy, rstarts):
+    """Minkowski sums of every pair of convex CCW pieces, in O(p + q) each.
+
+    ``(bxy, bstarts)`` and ``(rxy, rstarts)`` are packed convex pieces (B's and the
+    reflected A's). Returns packed sums ``(xy, starts)``, counter-clockwise, ordered
+    with the pieces of B outermost.
+    """
+    nb = bstarts.shape[0] - 1
+    nr = rstarts.shape[0] - 1
+    total = nr * bxy.shape[0] + nb * rxy.shape[0]
+    out = np.empty((total, 2))
+    starts = np.empty(nb * nr + 1, np.int64)
+    starts[0] = 0
+    w = 0
+    k = 0
+    for bi in range(nb):
+        ps = bstarts[bi]
+        pe = bstarts[bi + 1]
+        n = pe - ps
+        i0 = _lowest(bxy, ps, pe)
+        for rj in range(nr):
+            qs = rstarts[rj]
+            qe = rstarts[rj + 1]
+            m = qe - qs
+            j0 = _lowest(rxy, qs, qe)
+            i = 0
+            j = 0
+            while i < n or j < m:
+                pi = ps + (i0 - ps + i) % n
+                qj = qs + (j0 - qs + j) % m
+                out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
+                out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
+                w += 1
+                if i == n:
+                    j += 1
+                    continue
+                if j == m:
+                    i += 1
+                    continue
+                pn = ps + (i0 - ps + i + 1) % n
+                qn = qs + (j0 - qs + j + 1) % m
+                c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
+                    bxy[pn, 1] - bxy[pi, 1]
+                ) * (rxy[qn, 0] - rxy[qj, 0])
+                if c >= 0.0:
+                    i += 1
+                if c <= 0.0:
+                    j += 1
+            k += 1
+            starts[k] = w
+    return out[:w].copy(), starts
+
+
+@njit(cache=True, nogil=True)
+def _bboxes(xy, starts):
+    k = starts.shape[0] - 1
+    bb = np.empty((k, 4))
+    for p in range(k):
+        s = starts[p]
+        e = starts[p + 1]
+        bb[p, 0] = xy[s:e, 0].min()
+        bb[p, 1] = xy[s:e, 1].min()
+        bb[p, 2] = xy[s:e, 0].max()
+        bb[p, 3] = xy[s:e, 1].max()
+    return bb
+
+
+@njit(cache=True, nogil=True)
+def _clip(ax, ay, bx, by, xy, s, e, q_first, eps):
+    """Parts of segment ab (parameter t in [0, 1]) covered by convex polygon s:e.
+
+    Returns ``(lo1, hi1, lo0, hi0)``: the open interval inside the polygon by more than
+    eps (empty when lo >= hi), and the interval to remove from the union's outline:
+    strictly inside, or along a collinear edge of the polygon that runs the other way
+    (a seam between two sums) or the same way when the polygon comes first
+    (``q_first``; the duplicate outline edge is kept once).
+    """
+    lo1 = -np.inf
+    hi1 = np.inf
+    lo0 = -np.inf
+    hi0 = np.inf
+    empty0 = False
+    for i in range(s, e):
+        j = i + 1 if i + 1 < e else s
+        ux = xy[j, 0] - xy[i, 0]
+        uy = xy[j, 1] - xy[i, 1]
+        ln = np.hypot(ux, uy)
+        if ln == 0.0:
+            continue
+        f0 = (ux * (ay - xy[i, 1]) - uy * (ax - xy[i, 0])) / ln
+        f1 = (ux * (by - xy[i, 1]) - uy * (bx - xy[i, 0])) / ln
+        df = f1 - f0
+        # margin eps
+        if df == 0.0:
+            if f0 <= eps:
+                hi1 = -np.inf
+        else:
+            tc = (eps - f0) / df
+            if df > 0.0:
+                lo1 = max(lo1, tc)
+            else:
+                hi1 = min(hi1, tc)
+        # outline: margin 0, collinear edges handled apart
+        if abs(f0) <= eps and abs(f1) <= eps:
+            same = ux * (bx - ax) + uy * (by - ay) > 0.0
+            if same and not q_first:
+                empty0 = True
+            continue
+        if df == 0.0:
+            if f0 <= 0.0:
+                empty0 = True
+        else:
+            tc = -f0 / df
+            if df > 0.0:
+                lo0 = max(lo0, tc)
+            else:
+                hi0 = min(hi0, tc)
+    if empty0:
+        hi0 = -np.inf
+    return lo1, hi1, lo0, hi0
+
+
+@njit(cache=True, nogil=True)
+def _subtract(lo, hi, n, a, b):
+    """Remove the open interval (a, b) from the n closed intervals lo[:n], hi[:n]."""
+    m = n
+    for r in range(n):
+        x = lo[r]
+        y = hi[r]
+        if b <= x or a >= y:
+            continue
+        if a >= x:
+            hi[r] = a
+            if b <= y:
+                lo[m] = b
+                hi[m] = y
+                m += 1
+        elif b <= y:
+            lo[r] = b
+        else:
+            lo[r] = 1.0
+            hi[r] = -1.0  # dropped
+    return m
+
+
+@njit(cache=True, nogil=True)
+def _arc_of(px, py, xy, s, e, eps):
+    """Directions from p entering polygon s:e: (kind, start, length).
+
+    kind 0: p is not within eps of the polygon; 1: p inside by more than eps (every
+    direction); 2: the arc [start, start + length] of entering directions.
+    """
+    n_act = 0
+    th1 = 0.0
+    smax = -np.inf
+    emin = np.inf
+    for i in range(s, e):
+        j = i + 1 if i + 1 < e else s
+        ux = xy[j, 0] - xy[i, 0]
+        uy = xy[j, 1] - xy[i, 1]
+        ln = np.hypot(ux, uy)
+        if ln == 0.0:
+            continue
+        f = (ux * (py - xy[i, 1]) - uy * (px - xy[i, 0])) / ln
+        if f < -eps:
+            return 0, 0.0, 0.0
+        if f > eps:
+            continue
+        th = np.arctan2(uy, ux)
+        if n_act == 0:
+            th1 = th
+        rel = th - th1
+        while rel > np.pi:
+            rel -= 2.0 * np.pi
+        while rel <= -np.pi:
+            rel += 2.0 * np.pi
+        smax = max(smax, rel)
+        emin = min(emin, rel + np.pi)
+        n_act += 1
+    if n_act == 0:
+        return 1, 0.0, 2.0 * np.pi
+    if emin < smax:
+        return 0, 0.0, 0.0
+    start = th1 + smax
+    while start < 0.0:
+        start += 2.0 * np.pi
+    while start >= 2.0 * np.pi:
+        start -= 2.0 * np.pi
+    return 2, start, emin - smax
+
+
+@njit(cache=True, nogil=True)
+def surrounded(px, py, xy, starts, bb, eps, ang_tol):
+    """Whether the closed sums cover every direction around p (p is inside E)."""
+    k = starts.shape[0] - 1
+    starts_a = np.empty(k)
+    lens = np.empty(k)
+    n = 0
+    for p in range(k):
+        if px < bb[p, 0] - eps or px > bb[p, 2] + eps or py < bb[p, 1] - eps or py > bb[p, 3] + eps:
+            continue
+        kind, st, ln = _arc_of(px, py, xy, starts[p], starts[p + 1], eps)
+        if kind == 1:
+            return True
+        if kind == 2:
+            starts_a[n] = st
+            lens[n] = ln
+            n += 1
+    if n == 0:
+        return False
+    order = np.argsort(starts_a[:n])
+    first = starts_a[order[0]]
+    reach = first
+    for rep in range(2):
+        for oi in range(n):
+            st = starts_a[order[oi]] + 2.0 * np.pi * rep
+            if st > reach + ang_tol:
+                return False
+            reach = max(reach, st + lens[order[oi]])
+            if reach >= first + 2.0 * np.pi - ang_tol:
+                return True
+    return reach >= first + 2.0 * np.pi - ang_tol
+
+
+@njit(cache=True, nogil=True)
+def edge_cover(xy, starts, bb, eps):
+    """Uncovered parts of the sums' edges.
+
+    Returns ``(outline, loose)``, both (M, 4) segments x0, y0, x1, y1:
+    ``outline`` are the parts in no other sum's interior and on no seam, each kept once:
+    the boundary of the union, oriented with the union on its left; ``loose`` are the
+    parts in no other open sum shrunk by eps, where exact fits and slides lie.
+    """
+    k = starts.shape[0] - 1
+    cap = 2 * k + 4
+    lo1 = np.empty(cap)
+    hi1 = np.empty(cap)
+    lo0 = np.empty(cap)
+    hi0 = np.empty(cap)
+    n_edges = xy.shape[0]
+    outline = np.empty((4 * n_edges, 4))
+    loose = np.empty((4 * n_edges, 4))
+    no = 0
+    nl = 0
+    for p in range(k):
+        s = starts[p]
+        e = starts[p + 1]
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            ax, ay = xy[i, 0], xy[i, 1]
+            bx, by = xy[j, 0], xy[j, 1]
+            if ax == bx and ay == by:
+                continue
+            x0 = min(ax, bx) - eps
+            x1 = max(ax, bx) + eps
+            y0 = min(ay, by) - eps
+            y1 = max(ay, by) + eps
+            n1 = 1
+            n0 = 1
+            lo1[0] = 0.0
+            hi1[0] = 1.0
+            lo0[0] = 0.0
+            hi0[0] = 1.0
+            for q in range(k):
+                if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
+                    continue
+                a1, b1, a0, b0 = _clip(ax, ay, bx, by, xy, starts[q], starts[q + 1], q < p, eps)
+                if a1 < b1 and n1 > 0:
+                    n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+                if a0 < b0 and n0 > 0:
+                    n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+                if n1 == 0 and n0 == 0:
+                    break
+            dx = bx - ax
+            dy = by - ay
+            for r in range(n0):
+                if no == outline.shape[0]:
+                    outline = _grow(outline)
+                outline[no, 0] = ax + lo0[r] * dx
+                outline[no, 1] = ay + lo0[r] * dy
+                outline[no, 2] = ax + hi0[r] * dx
+                outline[no, 3] = ay + hi0[r] * dy
+                no += 1
+            for r in range(n1):
+                if nl == loose.shape[0]:
+                    loose = _grow(loose)
+                loose[nl, 0] = ax + lo1[r] * dx
+                loose[nl, 1] = ay + lo1[r] * dy
+                loose[nl, 2] = ax + hi1[r] * dx
+                loose[nl, 3] = ay + hi1[r] * dy
+                nl += 1
+    return outline[:no].copy(), loose[:nl].copy()
+
+
+@njit(cache=True, nogil=True)
+def _compact(lo, hi, m):
+    n = 0
+    for r in range(m):
+        if lo[r] <= hi[r]:
+            lo[n] = lo[r]
+            hi[n] = hi[r]
+            n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _grow(arr):
+    out = np.empty((2 * arr.shape[0] + 4, arr.shape[1]))
+    out[: arr.shape[0]] = arr
+    return out
+
+
+@njit(cache=True, nogil=True)
+def assemble_rings(segs, tol):
+    """Link outline segments (interior on the left) into closed rings.
+
+    Segments shorter than ``tol`` are dropped; an end links to the start within ``tol``
+    of it; where several starts are there (rings touching at a point), the one first
+    clockwise from the way back keeps each interior sector in its own ring. A ring that
+    passes twice through one point is split there. Returns ``(ok, xy, starts)``;
+    ``ok`` is False when some end finds no start, or a start is claimed twice.
+    """
+    keep = np.empty(segs.shape[0], np.int64)
+    n = 0
+    for r in range(segs.shape[0]):
+        if np.hypot(segs[r, 2] - segs[r, 0], segs[r, 3] - segs[r, 1]) > tol:
+            keep[n] = r
+            n += 1
+    seg = segs[keep[:n]]
+    order = np.argsort(seg[:, 0])
+    sx = seg[order, 0]
+    nxt = np.full(n, -1, np.int64)
+    taken = np.zeros(n, np.bool_)
+    for r in range(n):
+        ex = seg[r, 2]
+        ey = seg[r, 3]
+        back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
+        best = -1
+        best_turn = np.inf
+        lo = np.searchsorted(sx, ex - tol)
+        for oi in range(lo, n):
+            c = order[oi]
+            if sx[oi] > ex + tol:
+                break
+            if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
+                continue
+            ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
+            turn = back - ang  # clockwise angle from the way back
+            while turn <= 0.0:
+                turn += 2.0 * np.pi
+            while turn > 2.0 * np.pi:
+                turn -= 2.0 * np.pi
+            if turn < best_turn:
+                best_turn = turn
+                best = c
+        if best < 0 or taken[best]:
+            return False, np.empty((0, 2)), np.zeros(1, np.int64)
+        taken[best] = True
+        nxt[r] = best
+    out = np.empty((n, 2))
+    rs = np.empty(n + 1, np.int64)
+    rs[0] = 0
+    w = 0
+    nr = 0
+    seen = np.zeros(n, np.bool_)
+    for r0 in range(n):
+        if seen[r0]:
+            continue
+        r = r0
+        while not seen[r]:
+            seen[r] = True
+            out[w, 0] = seg[r, 0]
+            out[w, 1] = seg[r, 1]
+            w += 1
+            r = nxt[r]
+        if r != r0:
+            return False, np.empty((0, 2)), np.zeros(1, np.int64)
+        nr += 1
+        rs[nr] = w
+    return True, out[:w], _split_pinched(out[:w], rs[: nr + 1], tol)
+
+
+@njit(cache=True, nogil=True)
+def _split_pinched(xy, starts, tol):
+    """Ring starts after cutting every ring at points it passes twice (in place)."""
+    new_starts = [0]
+    buf = np.empty_like(xy)
+    w = 0
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        stack = np.empty(e - s, np.int64)
+        depth = 0
+        for i in range(s, e):
+            # a point met before closes the loop made since then
+            cut = -1
+            for d in range(depth):
+                v = stack[d]
+                if abs(xy[v, 0] - xy[i, 0]) <= tol and abs(xy[v, 1] - xy[i, 1]) <= tol:
+                    cut = d
+                    break
+            if cut >= 0:
+                for d in range(cut, depth):
+                    buf[w] = xy[stack[d]]
+                    w += 1
+                new_starts.append(w)
+                depth = cut
+            stack[depth] = i
+            depth += 1
+        for d in range(depth):
+            buf[w] = xy[stack[d]]
+            w += 1
+        new_starts.append(w)
+    xy[:w] = buf[:w]
+    st = np.empty(len(new_starts), np.int64)
+    for r in range(len(new_starts)):
+        st[r] = new_starts[r]
+    return st
+
+
+@njit(cache=True, nogil=True)
+def _in_some_sum(px, py, xy, starts, bb):
+    """Whether p lies in some closed sum (no tolerance: used at a distance 64 eps)."""
+    for q in range(starts.shape[0] - 1):
+        if px < bb[q, 0] or px > bb[q, 2] or py < bb[q, 1] or py > bb[q, 3]:
+            continue
+        s = starts[q]
+        e = starts[q + 1]
+        inside = True
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            if (xy[j, 0] - xy[i, 0]) * (py - xy[i, 1]) - (xy[j, 1] - xy[i, 1]) * (px - xy[i, 0]) < 0.0:
+                inside = False
+                break
+        if inside:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def degenerate_contacts(xy, starts, bb, loose, eps, ang_tol):
+    """Exact-fit points and slide segments among the ``loose`` parts of :func:`edge_cover`.
+
+    A loose part is an exact fit (when shorter than 8 eps) or a slide where the closed
+    sums cover every direction around it (``ang_tol``: angular gap taken as closed).
+    A part is cut at the sums' vertices lying on it; a sub-part whose right side (the
+    side away from its own sum) is in no sum is outline and skipped at once. Returns
+    ``(points (P, 2), segments (S, 4))``, not deduplicated: the same exact fit is found
+    on every edge through it, a slide on the edges of both sides.
+    """
+    pts = []
+    slides = []
+    off = 64.0 * eps
+    for r in range(loose.shape[0]):
+        ax, ay, bx, by = loose[r, 0], loose[r, 1], loose[r, 2], loose[r, 3]
+        ln = np.hypot(bx - ax, by - ay)
+        if ln <= 8.0 * eps:
+            mx = 0.5 * (ax + bx)
+            my = 0.5 * (ay + by)
+            if surrounded(mx, my, xy, starts, bb, eps, ang_tol):
+                pts.append((mx, my))
+            continue
+        ux = (bx - ax) / ln
+        uy = (by - ay) / ln
+        ts = [0.0, ln]
+        x0 = min(ax, bx) - eps
+        x1 = max(ax, bx) + eps
+        y0 = min(ay, by) - eps
+        y1 = max(ay, by) + eps
+        for v in range(xy.shape[0]):
+            if xy[v, 0] < x0 or xy[v, 0] > x1 or xy[v, 1] < y0 or xy[v, 1] > y1:
+                continue
+            dx = xy[v, 0] - ax
+            dy = xy[v, 1] - ay
+            if abs(ux * dy - uy * dx) <= eps:
+                t = ux * dx + uy * dy
+                if 0.0 < t < ln:
+                    ts.append(t)
+        tarr = np.sort(np.array(ts))
+        open_at = -1.0
+        for q in range(tarr.shape[0] - 1):
+            t0 = tarr[q]
+            t1 = tarr[q + 1]
+            if t1 - t0 <= eps:
+                continue
+            tm = 0.5 * (t0 + t1)
+            mx = ax + tm * ux
+            my = ay + tm * uy
+            inside = _in_some_sum(mx + off * uy, my - off * ux, xy, starts, bb) and surrounded(
+                mx, my, xy, starts, bb, eps, ang_tol
+            )
+            if inside and open_at < 0.0:
+                open_at = t0
+            if not inside and open_at >= 0.0:
+                slides.append((ax + open_at * ux, ay + open_at * uy, ax + t0 * ux, ay + t0 * uy))
+                open_at = -1.0
+        if open_at >= 0.0:
+            slides.append((ax + open_at * ux, ay + open_at * uy, bx, by))
+    p_out = np.empty((len(pts), 2))
+    for r in range(len(pts)):
+        p_out[r, 0], p_out[r, 1] = pts[r]
+    s_out = np.empty((len(slides), 4))
+    for r in range(len(slides)):
+        s_out[r, 0], s_out[r, 1], s_out[r, 2], s_out[r, 3] = slides[r]
+    return p_out, s_out
+
+
+@njit(cache=True, nogil=True)
+def _ring_stats(xy, starts):
+    n = starts.shape[0] - 1
+    area = np.zeros(n)
+    length = np.zeros(n)
+    for k in range(n):
+        s = starts[k]
+        e = starts[k + 1]
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            area[k] += 0.5 * (xy[i, 0] * xy[j, 1] - xy[j, 0] * xy[i, 1])
+            length[k] += np.hypot(xy[j, 0] - xy[i, 0], xy[j, 1] - xy[i, 1])
+    return area, length
+
+
+@njit(cache=True, nogil=True)
+def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
+    """Everything the no-fit polygon needs, in one call.
+
+    ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
+    ``a0 − A``. ``eps <= 0`` means ``rel_tol * max(1, largest |coordinate| of the sums)``.
+    Returns ``(sums, sum_starts, eps, ok, ring_xy, ring_starts, ring_area, ring_length,
+    fit_points, slide_segments)``; ``ok`` is False when the outline parts did not link
+    into rings (the caller then unions the sums another way).
+    """
+    sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
+    if eps <= 0.0:
+        eps = rel_tol * max(1.0, np.abs(sums).max())
+    if starts.shape[0] == 2:
+        rs = np.array([0, sums.shape[0]], np.int64)
+        area, length = _ring_stats(sums, rs)
+        return (sums, starts, eps, True, sums, rs, area, length,
+                np.empty((0, 2)), np.empty((0, 4)))
+    bb = _bboxes(sums, starts)
+    outline, loose = edge_cover(sums, starts, bb, eps)
+    ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
+    area, length = _ring_stats(ring_xy, ring_starts)
+    pts, segs = degenerate_contacts(sums, starts, bb, loose, eps, ang_tol)
+    return sums, starts, eps, ok, ring_xy, ring_starts, area, length, pts, segs

@@ -1,0 +1,417 @@
+"""No-fit polygon and inner-fit polygon of arbitrary polygons with holes.
+
+A orbits, B is fixed. The no-fit polygon is the entrance block seen as a region,
+
+    E(A, B) = B ⊕ (a0 − A) = { a0 + d : (A + d) ∩ B ≠ ∅ },
+
+the set of positions of A's reference point ``a0`` at which A touches or overlaps B;
+its outline is ∂E(A, B) = E(A(1), B(0)) ∪ E(A(0), B(1)) (paper §5(6)). It is built as
+the union of the convex sums ``B_i ⊕ (a0 − A_j)`` of convex pieces of B and A (holes
+included: the pieces come from a triangulation of the solid region, merged
+Hertel–Mehlhorn style), each sum made in O(p + q) by merging edge angles, and the union
+taken by GEOS.
+
+An area union loses the positions where A fits exactly: a jigsaw piece in its socket
+(an isolated point) or a square sliding in a slot of its own width (a segment). They are
+the positions inside ``E`` where the interiors do not overlap; polycontact finds them
+separately (see :mod:`polycontact._kernels.nfp`) and reports them as
+:attr:`NoFitPolygon.exact_fits` and :attr:`NoFitPolygon.slides`.
+
+Examples
+--------
+>>> import polycontact as pc
+>>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+>>> b = pc.Shape([(0, 0), (3, 0), (3, 3), (0, 3)], holes=[[(1, 1), (2, 1), (2, 2), (1, 2)]])
+>>> nfp = pc.no_fit_polygon(a, b, reference="origin")
+>>> nfp.region.area, len(nfp.region.interiors), nfp.exact_fits.tolist()
+(16.0, 0, [[1.0, 1.0]])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidShapeError
+from .shape import Shape, as_shape
+from .tolerances import RELATIVE_TOLERANCE, default_tolerance
+
+__all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]
+
+#: Holes of the union narrower than ``HOLE_WIDTH_FACTOR * tolerance`` (twice the area
+#: over the perimeter) are rounding artefacts where closed sums meet exactly (an exact
+#: fit shows up as a pinhole of about 1e-15 of the coordinates), not positions where A
+#: fits: they are filled.
+HOLE_WIDTH_FACTOR = 16.0
+
+#: Angular gap (radians) below which the sums around a point are taken to close up:
+#: edge directions of sums computed in float64 carry errors near 1e-15 rad.
+ANGLE_TOLERANCE = 1e-9
+
+_PIECES_CACHE: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
+_PIECES_CACHE_SIZE = 4096
+
+
+@dataclass(frozen=True, eq=False)
+class NoFitPolygon:
+    """The no-fit polygon of A orbiting a fixed B.
+
+    Attributes
+    ----------
+    region : shapely Polygon or MultiPolygon
+        The closed set of reference positions where A touches or overlaps B, with its
+        true holes (positions where A sits in a hole or concavity of B, or B in a hole
+        of A, without touching), and no holes narrower than the tolerance.
+    exact_fits : ndarray of shape (P, 2), float64
+        Isolated reference positions inside ``region`` where A touches B without
+        overlapping (every small move makes them overlap).
+    slides : ndarray of shape (S, 2, 2), float64
+        Segments inside ``region`` along which A touches B without overlapping, each
+        as its two end points.
+    reference : ndarray of shape (2,), float64
+        A's reference point ``a0`` (A at its given coordinates has it there).
+    a, b : Shape
+        The orbiting and the fixed shape.
+    tolerance : float
+        Absolute distance tolerance used.
+    """
+
+    region: Any
+    exact_fits: np.ndarray
+    slides: np.ndarray
+    reference: np.ndarray
+    a: Shape = field(repr=False)
+    b: Shape = field(repr=False)
+    tolerance: float = 0.0
+
+    def contains(self, point: Any) -> Any:
+        """How A placed with its reference at ``point`` relates to B: a ``State``.
+
+        Same answer as :func:`polycontact.classify` of the moved A against B:
+        ``PENETRATING`` inside the region (except on exact fits and slides),
+        ``CONTACT`` on its boundary, exact fits and slides, ``SEPARATE`` outside.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> nfp = pc.no_fit_polygon(sq, sq, reference="origin")
+        >>> [nfp.contains(p).value for p in [(0, 0), (1, 0.5), (2, 0)]]
+        ['penetrating', 'contact', 'separate']
+        """
+        from .relation import classify
+
+        p = _as_point(point, "point")
+        moved = self.a.moved(p - self.reference)
+        return classify(moved, self.b, tolerance=self.tolerance).state
+
+    @property
+    def outline(self) -> Any:
+        """The region's boundary (every ring) as a shapely geometry."""
+        return self.region.boundary
+
+
+def no_fit_polygon(
+    a: Any, b: Any, reference: Any = None, *, tolerance: float | None = None
+) -> NoFitPolygon:
+    """No-fit polygon of ``a`` orbiting the fixed ``b``.
+
+    Parameters
+    ----------
+    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
+        The orbiting and the fixed shape; holes allowed.
+    reference : None, "centroid", "origin" or array_like of shape (2,)
+        A's reference point: its area centroid (default), the origin (plain
+        translations of A's coordinates, the convention of nesting codes), or a point.
+    tolerance : float, optional
+        Absolute distance tolerance; default
+        :func:`polycontact.default_tolerance` of the sums' coordinates.
+
+    Returns
+    -------
+    NoFitPolygon
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> a = pc.Shape([(0, 0), (2, 0), (2, 1), (0, 1)])
+    >>> nfp = pc.no_fit_polygon(a, a, reference="origin")
+    >>> nfp.region.bounds, nfp.region.area
+    ((-2.0, -1.0, 2.0, 1.0), 8.0)
+    """
+    a = as_shape(a, "a")
+    b = as_shape(b, "b")
+    a0 = _reference(a, reference)
+    bxy, bst = _convex_pieces(b)
+    axy, ast = _convex_pieces(a)
+    region, pts, segs, eps = _entrance(bxy, bst, a0 - axy, ast, tolerance)
+    fits, slides = _clean_degenerate(pts, segs, eps, _touching(a, b, a0, eps))
+    return NoFitPolygon(region, fits, slides, a0, a, b, eps)
+
+
+def inner_fit_polygon(
+    a: Any, container: Any, reference: Any = None, *, tolerance: float | None = None
+) -> Any:
+    """Reference positions at which ``a`` lies inside ``container`` (touching allowed).
+
+    The inner-fit polygon of nesting: with ``container`` a bin (or a hole, passed as a
+    shape of its own), the positions where A can be placed. It is the set of positions
+    where A does not overlap the complement of the container, i.e. a box around the
+    container minus E(A, box \\ container), plus the exact fits and slides of that
+    entrance block: a piece exactly as wide as the bin slides along a segment, a piece
+    that fits exactly sits at a point.
+
+    Parameters
+    ----------
+    a, container : Shape, shapely Polygon or array_like of shape (N, 2)
+    reference, tolerance :
+        As in :func:`no_fit_polygon`.
+
+    Returns
+    -------
+    shapely geometry
+        A Polygon or MultiPolygon when the free positions have area; a point, segment or
+        GeometryCollection (areas, points, segments) otherwise; empty when A cannot fit.
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> bin_ = pc.Shape([(0, 0), (10, 0), (10, 4), (0, 4)])
+    >>> pc.inner_fit_polygon([(0, 0), (2, 0), (2, 1), (0, 1)], bin_, "origin").bounds
+    (0.0, 0.0, 8.0, 3.0)
+    >>> pc.inner_fit_polygon([(0, 0), (2, 0), (2, 4), (0, 4)], bin_, "origin").wkt
+    'LINESTRING (0 0, 8 0)'
+    """
+    import shapely
+
+    a = as_shape(a, "a")
+    c = as_shape(container, "container")
+    a0 = _reference(a, reference)
+    axy, ast = _convex_pieces(a)
+    r = a0 - axy
+    span = float(np.max(np.ptp(a.exterior, axis=0)))
+    x0, y0 = c.exterior.min(axis=0) - 2.0 * span - 1.0
+    x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
+    outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
+    fxy, fst = _pieces_of_geometry(outside)
+    blocked, pts, segs, eps = _entrance(fxy, fst, r, ast, tolerance)
+    cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
+    cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
+    free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
+    free = _drop_slivers(free, eps)
+    c_poly = c.to_shapely()
+    a_poly = a.to_shapely()
+
+    def fits(p: np.ndarray) -> bool:
+        placed = shapely.affinity.translate(a_poly, *(p - a0))
+        spill = placed.difference(c_poly)
+        return spill.area <= eps * (placed.length + c_poly.length)
+
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, fits)
+    parts = [free] if not free.is_empty else []
+    parts += [shapely.Point(p) for p in fit_pts]
+    parts += [shapely.LineString(s) for s in slide_segs]
+    if not parts:
+        return shapely.Polygon()
+    return shapely.union_all(parts)
+
+
+# -- helpers -----------------------------------------------------------------------------
+
+
+def _as_point(point: Any, what: str) -> np.ndarray:
+    try:
+        p = np.array(point, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise InvalidShapeError(f"{what}: expected two numbers, got {point!r}") from None
+    if p.shape != (2,) or not np.isfinite(p).all():
+        raise InvalidShapeError(f"{what}: expected two finite numbers, got {point!r}")
+    return p
+
+
+def _reference(a: Shape, reference: Any) -> np.ndarray:
+    if reference is None or (isinstance(reference, str) and reference == "centroid"):
+        return np.array(a.centroid, dtype=np.float64)
+    if isinstance(reference, str):
+        if reference == "origin":
+            return np.zeros(2)
+        raise InvalidShapeError(
+            f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
+        )
+    return _as_point(reference, "reference")
+
+
+def _tolerance(tolerance: float | None) -> float:
+    """The tolerance for the kernel: -1 asks it for the default of the sums' coordinates."""
+    if tolerance is None:
+        return -1.0
+    tol = float(tolerance)
+    if not np.isfinite(tol) or tol <= 0.0:
+        raise InvalidShapeError(f"tolerance: expected a finite number > 0, got {tolerance!r}")
+    return tol
+
+
+def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
+    """Convex CCW pieces of a shape, packed; cached by coordinates."""
+    xy, starts = shape.packed
+    key = (xy.tobytes(), starts.tobytes())
+    hit = _PIECES_CACHE.get(key)
+    if hit is not None:
+        return hit
+    from ._kernels import decompose
+
+    if len(starts) == 2 and decompose.is_convex(xy):
+        pieces = (np.ascontiguousarray(xy), np.array([0, len(xy)], dtype=np.int64))
+    else:
+        pieces = _pieces_of_geometry(shape.to_shapely())
+    if len(_PIECES_CACHE) >= _PIECES_CACHE_SIZE:
+        _PIECES_CACHE.pop(next(iter(_PIECES_CACHE)))
+    _PIECES_CACHE[key] = pieces
+    return pieces
+
+
+def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Convex pieces of a shapely (Multi)Polygon: GEOS triangulation, then merging."""
+    import shapely
+
+    from ._kernels import decompose
+
+    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(geom))
+    coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
+    eps = default_tolerance(coords.reshape(-1, 2))
+    return decompose.convex_pieces(np.ascontiguousarray(coords), eps)
+
+
+def _entrance(
+    bxy: np.ndarray, bst: np.ndarray, rxy: np.ndarray, rst: np.ndarray, tolerance: float | None
+) -> tuple[Any, np.ndarray, np.ndarray, float]:
+    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, eps).
+
+    The outline is assembled from the uncovered parts of the sums' edges (see
+    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
+    should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
+    seams and pinholes) are dropped.
+    """
+    import shapely
+
+    from ._kernels import nfp as kn
+
+    (sums, starts, eps, ok, rxy_, rst_, area, length, pts, segs) = kn.entrance_region(
+        bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ANGLE_TOLERANCE
+    )
+    if ok:
+        region = _polygon_from_rings(rxy_, rst_, area, length, HOLE_WIDTH_FACTOR * eps)
+    else:
+        ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
+        polys = shapely.polygons(shapely.linearrings(sums, indices=ids))
+        region = _drop_slivers(shapely.union_all(polys), eps)
+    return region, pts, segs, eps
+
+
+def _polygon_from_rings(
+    xy: np.ndarray, starts: np.ndarray, area: np.ndarray, length: np.ndarray, width: float
+) -> Any:
+    """(Multi)Polygon from CCW shells and CW holes; rings thinner than width dropped."""
+    import shapely
+
+    shells = []
+    holes = []
+    for k in range(len(starts) - 1):
+        if 2.0 * abs(area[k]) <= width * length[k]:
+            continue
+        (shells if area[k] > 0 else holes).append(xy[starts[k] : starts[k + 1]])
+    if not shells:
+        return shapely.Polygon()
+    if len(shells) == 1:
+        if not holes:
+            return shapely.polygons(shapely.linearrings(shells[0]))
+        return shapely.Polygon(shells[0], holes)
+    shell_polys = [shapely.Polygon(r) for r in shells]
+    owned: list[list[np.ndarray]] = [[] for _ in shells]
+    for h in holes:
+        nxt = np.roll(h, -1, axis=0)
+        i = int(np.argmax(np.hypot(*(nxt - h).T)))
+        mx, my = 0.5 * (h[i] + nxt[i])
+        inside = [k for k, sp in enumerate(shell_polys) if shapely.contains_xy(sp, mx, my)]
+        best = min(inside, key=lambda k: shell_polys[k].area) if inside else 0
+        owned[best].append(h)
+    return shapely.MultiPolygon([shapely.Polygon(r, hs) for r, hs in zip(shells, owned)])
+
+
+def _drop_slivers(geom: Any, eps: float) -> Any:
+    """Fill holes and drop parts thinner than the tolerance (twice area over length)."""
+    import shapely
+
+    width = HOLE_WIDTH_FACTOR * eps
+    out = []
+    changed = False
+    for part in shapely.get_parts(geom):
+        if part.geom_type != "Polygon":
+            changed = True
+            continue
+        if 2.0 * part.area <= width * part.exterior.length:
+            changed = True
+            continue
+        holes = [r for r in part.interiors if 2.0 * shapely.Polygon(r).area > width * r.length]
+        if len(holes) != len(part.interiors):
+            changed = True
+            part = shapely.Polygon(part.exterior, holes)
+        out.append(part)
+    if not changed:
+        return geom
+    if not out:
+        return shapely.Polygon()
+    return out[0] if len(out) == 1 else shapely.MultiPolygon(out)
+
+
+def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
+    """Check that A with its reference at p touches B without overlapping (area test)."""
+    import shapely
+
+    cache: list[Any] = []
+
+    def check(p: np.ndarray) -> bool:
+        if not cache:
+            cache.extend([a.to_shapely(), b.to_shapely()])
+        a_poly, b_poly = cache
+        placed = shapely.affinity.translate(a_poly, *(p - a0))
+        return placed.intersection(b_poly).area <= eps * (a_poly.length + b_poly.length)
+
+    return check
+
+
+def _clean_degenerate(pts: np.ndarray, segs: np.ndarray, eps: float, check) -> tuple[np.ndarray, np.ndarray]:
+    """Merge duplicates, drop points on slides, keep only verified positions."""
+    import shapely
+
+    near = HOLE_WIDTH_FACTOR * eps
+    slides = np.empty((0, 2, 2))
+    if len(pts) == 0 and len(segs) == 0:
+        return np.empty((0, 2)), slides
+    if len(segs):
+        lines = shapely.line_merge(
+            shapely.union_all(shapely.linestrings(segs.reshape(-1, 2, 2))), directed=False
+        )
+        merged = [
+            seg
+            for g in shapely.get_parts(shapely.simplify(lines, 0.0))
+            for seg in np.lib.stride_tricks.sliding_window_view(
+                np.asarray(g.coords), (2, 2)
+            ).reshape(-1, 2, 2)
+        ]
+        kept = [s for s in merged if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
+        if kept:
+            slides = np.array(kept)
+    fits: list[np.ndarray] = []
+    for p in pts:
+        if any(np.hypot(*(p - q)) <= near for q in fits):
+            continue
+        if len(slides) and shapely.distance(
+            shapely.Point(p), shapely.linestrings(slides)
+        ).min() <= near:
+            continue
+        if check(p):
+            fits.append(p)
+    return (np.array(fits) if fits else np.empty((0, 2))), slides
