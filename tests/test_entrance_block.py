@@ -186,6 +186,8 @@ def test_inputs_untouched_and_result_read_only():
 def test_the_two_methods_give_the_same_region(a, b):
     pairs = pc.entrance_block(a, b, method="pairs")
     swept = pc.entrance_block(a, b, method="swept")
+    # B ⊕ (a0 − A) is connected, and so is the union of the components
+    assert pairs.to_shapely().geom_type == swept.to_shapely().geom_type == "Polygon"
     _same_region(pairs.to_shapely(), swept.to_shapely())
     assert pairs.area == pytest.approx(swept.area, rel=1e-9)
 

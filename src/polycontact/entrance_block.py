@@ -455,12 +455,15 @@ def _parallelograms(corners: np.ndarray, eps: float) -> np.ndarray:
 
 
 def _grid(eps: float) -> float:
-    """Snap-rounding grid for GEOS overlays: the power of two just below ``eps``.
+    """Snap-rounding grid for GEOS overlays: the power of two just below ``eps / 256``.
 
-    A power of two keeps every coordinate that is a short binary fraction (0.5, 3.25)
-    exact on the grid, so simple inputs give exact unions.
+    Snapping moves a vertex by less than a grid step, so the outline stays well within
+    the tolerance (a slight shift across a nearly parallel edge pair can change the
+    relation by much more than the shift); the grid keeps coordinates of scale s below
+    2**53 steps (s / (s·1e-12 / 256) ≈ 2.6e14). A power of two keeps short binary
+    fractions (0.5, 3.25) exact on the grid, so simple inputs give exact unions.
     """
-    return float(2.0 ** np.floor(np.log2(eps)))
+    return float(2.0 ** np.floor(np.log2(eps / 256.0)))
 
 
 def _flat(corners: np.ndarray, eps: float) -> np.ndarray:
@@ -472,13 +475,12 @@ def _flat(corners: np.ndarray, eps: float) -> np.ndarray:
 
 
 def _polygonal(geom: Any) -> Any:
-    """The polygonal part of a geometry (zero-width parts dropped)."""
+    """The polygonal part of an overlay result: a Polygon when there is one piece."""
     import shapely
 
-    if geom.geom_type in ("Polygon", "MultiPolygon"):
-        return geom
-    parts = [g for g in shapely.get_parts(geom) if g.geom_type in ("Polygon", "MultiPolygon")]
-    return parts[0] if len(parts) == 1 else shapely.union_all(parts)
+    flat = shapely.get_parts(shapely.get_parts(geom))  # collections may hold multi-parts
+    parts = [g for g in flat if g.geom_type == "Polygon" and not g.is_empty]
+    return parts[0] if len(parts) == 1 else shapely.MultiPolygon(parts)
 
 
 def _outline(geom: Any) -> Any:
