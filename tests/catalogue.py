@@ -1,0 +1,180 @@
+"""A catalogue of canonical and degenerate placements of two bodies.
+
+Every coordinate is exactly representable (small integers and halves), so Shapely
+decides each case exactly and can serve as the oracle. Each :class:`Case` names the
+expected state; tests may import :data:`CASES` (and :func:`shifted`) freely. The end of
+the module holds hypothesis strategies for random star-shaped bodies (on the integer
+grid, so that degenerate placements are exact, or not; with or without a hole) and the
+Shapely oracle :func:`shapely_state`.
+
+The shapes: unit squares, a U-shaped socket with a rectangular tab, a dovetail socket
+and its piece (the overhangs hold the piece: it cannot move up, down or sideways), a
+frame with a square hole, a square with a triangular hole whose tip touches the outer
+boundary, crossing bars, triangles on edges and corners.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from hypothesis import assume
+from hypothesis import strategies as st
+
+from polycontact import Shape
+from polycontact.errors import InvalidShapeError
+
+
+@dataclass(frozen=True)
+class Case:
+    """Two bodies and the state they are in (``"separate"``, ``"contact"``,
+    ``"penetrating"``)."""
+
+    name: str
+    a: Shape
+    b: Shape
+    state: str
+
+
+def _sq(x0: float, y0: float, x1: float, y1: float) -> list[tuple[float, float]]:
+    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+
+def _shape(outer, holes=()) -> Shape:
+    return Shape(np.array(outer, dtype=float), [np.array(h, dtype=float) for h in holes])
+
+
+UNIT = _shape(_sq(0, 0, 1, 1))
+BIG = _shape(_sq(0, 0, 4, 4))
+# U-shaped socket: a 4 x 2 block with a 2 x 1 notch cut from the middle of its top.
+SOCKET = _shape([(0, 0), (4, 0), (4, 2), (3, 2), (3, 1), (1, 1), (1, 2), (0, 2)])
+# The tab that fills the notch exactly and covers the top of the socket.
+TAB = _shape([(1, 1), (3, 1), (3, 2), (4, 2), (4, 3), (0, 3), (0, 2), (1, 2)])
+# Dovetail: the socket is wider at the bottom (1..5) than at the top (2..4).
+DOVETAIL_SOCKET = _shape([(0, 0), (6, 0), (6, 3), (4, 3), (5, 1), (1, 1), (2, 3), (0, 3)])
+DOVETAIL_PIECE = _shape([(1, 1), (5, 1), (4, 3), (4, 4), (2, 4), (2, 3)])
+# A 4 x 4 frame with a 2 x 2 hole in the middle.
+FRAME = _shape(_sq(0, 0, 4, 4), [_sq(1, 1, 3, 3)])
+# A square whose triangular hole touches the outer boundary at (2, 0): valid (OGC).
+PINCHED = _shape(_sq(0, 0, 4, 4), [[(2, 0), (3, 2), (1, 2)]])
+HOLE_TRIANGLE = _shape([(2, 0), (3, 2), (1, 2)])
+BAR_H = _shape(_sq(0, 1, 4, 2))
+BAR_V = _shape(_sq(1, 0, 2, 4))
+TRIANGLE_UP = _shape([(0, 0), (2, 0), (1, 1)])
+
+
+def _moved(s: Shape, dx: float, dy: float) -> Shape:
+    d = np.array([dx, dy])
+    return _shape(s.exterior + d, [h + d for h in s.holes])
+
+
+CASES: tuple[Case, ...] = (
+    Case("identical squares", UNIT, UNIT, "penetrating"),
+    Case("apart", UNIT, _moved(UNIT, 2, 0), "separate"),
+    Case("apart diagonally, corners close", UNIT, _moved(UNIT, 1.5, 1.5), "separate"),
+    Case("flush edges", UNIT, _moved(UNIT, 1, 0), "contact"),
+    Case("flush, partly overlapping edges", BIG, _moved(UNIT, 4, 0.5), "contact"),
+    Case("collinear edges, same side (overlap)", UNIT, _moved(UNIT, 0.5, 0), "penetrating"),
+    Case("vertex on vertex", UNIT, _moved(UNIT, 1, 1), "contact"),
+    Case("vertex on edge", UNIT, _shape([(0.5, 1), (1, 2), (0, 2)]), "contact"),
+    Case("vertex into edge", UNIT, _shape([(0.5, 0.5), (1, 2), (0, 2)]), "penetrating"),
+    Case("edge through vertex, inward", UNIT, _shape([(1, 0.5), (0.5, 2), (0, 2)]), "penetrating"),
+    Case("triangle tip on corner", UNIT, _shape([(1, 1), (2, 3), (0, 3)]), "contact"),
+    Case("triangle tip on corner, outward", UNIT, _shape([(1, 1), (3, 2), (2, 3)]), "contact"),
+    Case("tab in its socket", SOCKET, TAB, "contact"),
+    Case("tab above its socket", SOCKET, _moved(TAB, 0, 1), "contact"),
+    Case("tab sunk into its socket", SOCKET, _moved(TAB, 0, -0.5), "penetrating"),
+    Case("tab slid sideways", SOCKET, _moved(TAB, 0.5, 0), "penetrating"),
+    Case("dovetail piece in its socket", DOVETAIL_SOCKET, DOVETAIL_PIECE, "contact"),
+    Case("dovetail piece lifted", DOVETAIL_SOCKET, _moved(DOVETAIL_PIECE, 0, 0.5), "penetrating"),
+    Case("square sliding in a slot of its width", SOCKET, _shape(_sq(1, 1, 3, 3)), "contact"),
+    Case("square filling a hole exactly", FRAME, _shape(_sq(1, 1, 3, 3)), "contact"),
+    Case("square in a hole, touching one side", FRAME, _shape(_sq(1, 1.5, 2, 2.5)), "contact"),
+    Case("square in a hole, not touching", FRAME, _shape(_sq(1.5, 1.5, 2.5, 2.5)), "separate"),
+    Case("square in a hole, poking out", FRAME, _shape(_sq(0.5, 1.5, 1.5, 2.5)), "penetrating"),
+    Case("frame around a bigger square", FRAME, _shape(_sq(0.5, 0.5, 3.5, 3.5)), "penetrating"),
+    Case("two frames, identical", FRAME, FRAME, "penetrating"),
+    Case("square strictly inside a square", BIG, _shape(_sq(1, 1, 2, 2)), "penetrating"),
+    Case("square inside, flush with one side", BIG, _shape(_sq(0, 1, 1, 2)), "penetrating"),
+    Case("square inside, in a corner", BIG, _shape(_sq(0, 0, 1, 1)), "penetrating"),
+    Case("triangle filling a pinched hole", PINCHED, HOLE_TRIANGLE, "contact"),
+    Case("crossing bars (no vertex inside)", BAR_H, BAR_V, "penetrating"),
+    Case("bar end flush on a bar side", BAR_H, _shape(_sq(1, 2, 2, 4)), "contact"),
+    Case("triangle on an edge, base flush", UNIT, _moved(TRIANGLE_UP, -0.5, 1), "contact"),
+    Case("triangles tip to tip", TRIANGLE_UP, _shape([(1, 1), (2, 2), (0, 2)]), "contact"),
+)
+
+
+def shifted(case: Case, dx: float, dy: float) -> Case:
+    """The case with body B translated by (dx, dy); the state is left for the oracle."""
+    return Case(f"{case.name} shifted by ({dx:g}, {dy:g})", case.a, _moved(case.b, dx, dy), "")
+
+
+# -- random placements (hypothesis) and the Shapely oracle ---------------------------
+
+STATES = ("separate", "contact", "penetrating")
+
+
+def star_ring(draw, n_min: int, n_max: int, r_lo: float, r_hi: float, grid: bool) -> np.ndarray:
+    """A star-shaped (generally concave) ring around the origin, angles evenly spread
+    with jitter; rounded to integers when ``grid``."""
+    n = draw(st.integers(n_min, n_max))
+    jitter = np.array(draw(st.lists(st.floats(-0.4, 0.4), min_size=n, max_size=n)))
+    angles = (np.arange(n) + jitter) * 2 * np.pi / n + draw(st.floats(0, 2 * np.pi))
+    radii = np.array(draw(st.lists(st.floats(r_lo, r_hi), min_size=n, max_size=n)))
+    ring = np.c_[np.cos(angles) * radii, np.sin(angles) * radii]
+    return np.round(ring) if grid else ring
+
+
+@st.composite
+def shapes(draw, grid: bool | None = None, holes: bool | None = None, n_max: int = 10) -> Shape:
+    """A valid Shape: random star polygon, on the integer grid or not, maybe with a hole."""
+    grid = draw(st.booleans()) if grid is None else grid
+    holes = draw(st.booleans()) if holes is None else holes
+    if holes:
+        outer = star_ring(draw, 7, max(n_max, 7), 4.0, 9.0, grid)
+        inner = [star_ring(draw, 3, 6, 0.5, 2.0, grid)]
+    else:
+        outer = star_ring(draw, 3, n_max, 1.0, 9.0, grid)
+        inner = []
+    try:
+        return Shape(outer, inner)
+    except InvalidShapeError:
+        assume(False)
+        raise  # unreachable: assume(False) raises
+
+
+def translated(s: Shape, d) -> Shape:
+    """``s`` translated exactly by ``d`` (no rotation about the centroid)."""
+    d = np.asarray(d, dtype=float)
+    return Shape._trusted([loop + d for loop in s.loops])
+
+
+@st.composite
+def pairs(draw, grid: bool | None = None, holes: bool | None = None, n_max: int = 10):
+    """Two shapes; B is placed at a random offset or with one vertex on one of A."""
+    grid = draw(st.booleans()) if grid is None else grid
+    a = draw(shapes(grid=grid, holes=holes, n_max=n_max))
+    b = draw(shapes(grid=grid, holes=holes, n_max=n_max))
+    if draw(st.booleans()):
+        va = a.loops[0][draw(st.integers(0, len(a.loops[0]) - 1))]
+        vb = b.loops[0][draw(st.integers(0, len(b.loops[0]) - 1))]
+        d = va - vb
+    elif grid:
+        d = np.array(draw(st.lists(st.integers(-12, 12), min_size=2, max_size=2)), dtype=float)
+    else:
+        d = np.array(draw(st.lists(st.floats(-12, 12), min_size=2, max_size=2)))
+    return a, translated(b, d), grid
+
+
+def shapely_state(a: Shape, b: Shape) -> str:
+    """The oracle: interiors meet in 2 dimensions, or boundaries meet, or neither."""
+    pa, pb = a.to_shapely(), b.to_shapely()
+    if pa.relate(pb)[0] == "2":
+        return "penetrating"
+    return "contact" if pa.intersects(pb) else "separate"
+
+
+def boundary_gap(a: Shape, b: Shape) -> float:
+    return float(shapely.distance(a.to_shapely().boundary, b.to_shapely().boundary))

@@ -1,0 +1,210 @@
+"""classify: states against Shapely, symmetry, the lean array path, classify_many."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+import shapely.affinity
+from catalogue import CASES, boundary_gap, pairs, shapely_state, shifted, translated
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from polycontact import Shape, State, classify, classify_many
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+def test_catalogue_state(case):
+    assert shapely_state(case.a, case.b) == case.state  # the catalogue itself is right
+    assert classify(case.a, case.b).state.value == case.state
+    assert classify(case.b, case.a).state.value == case.state
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+@pytest.mark.parametrize(
+    "direction", [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)]
+)
+def test_catalogue_shifted_by_1e9_of_size(case, direction):
+    # 2**-30 (about 0.93e-9) times the size: the shifted coordinates stay exact, so
+    # Shapely decides exactly, and the shift is far above the tolerance (1e-12 relative).
+    size = max(np.ptp(case.a.exterior, axis=0).max(), np.ptp(case.b.exterior, axis=0).max())
+    moved = shifted(case, *(2.0**-30 * size * np.array(direction, dtype=float)))
+    assert classify(moved.a, moved.b).state.value == shapely_state(moved.a, moved.b)
+
+
+@pytest.mark.parametrize("case", [c for c in CASES if not c.a.holes and not c.b.holes],
+                         ids=lambda c: c.name)
+def test_arrays_match_shapes(case):
+    a, b = case.a.exterior, case.b.exterior
+    for aa, bb in ((a, b), (a[::-1].copy(), b), (a, np.vstack([b, b[:1]]))):
+        assert classify(aa, bb).state.value == case.state
+    poly = classify(case.a.to_shapely(), case.b.to_shapely())
+    assert poly.state.value == case.state
+
+
+def _agrees(a, b, grid):
+    ours = classify(a, b).state.value
+    want = shapely_state(a, b)
+    if ours == want:
+        return True
+    # Off the grid, a vertex snapped onto another may land a rounding error away:
+    # within the tolerance, the two answers may differ.
+    return not grid and boundary_gap(a, b) <= 10 * classify(a, b).tolerance
+
+
+@given(pairs())
+def test_random_pairs_match_shapely(pair):
+    a, b, grid = pair
+    assert _agrees(a, b, grid)
+    assert classify(a, b).state is classify(b, a).state
+
+
+@given(pairs(grid=True, holes=True))
+def test_random_pairs_with_holes_on_grid_match_shapely(pair):
+    a, b, _ = pair
+    assert classify(a, b).state.value == shapely_state(a, b)
+    assert classify(b, a).state.value == shapely_state(a, b)
+
+
+@given(pairs())
+def test_distance_separate_and_contact(pair):
+    a, b, grid = pair
+    r = classify(a, b)
+    if r.state is State.SEPARATE:
+        gap = float(shapely.distance(a.to_shapely(), b.to_shapely()))
+        assert r.distance == pytest.approx(gap, rel=1e-9, abs=1e-12)
+        assert r.normal is None
+        witness = shapely.Point(r.point)  # the midpoint of a closest pair
+        assert shapely.distance(witness, a.to_shapely().boundary) == pytest.approx(
+            gap / 2, rel=1e-9, abs=1e-12
+        )
+    elif r.state is State.CONTACT:
+        assert r.distance == 0.0
+        assert float(shapely.distance(a.to_shapely(), b.to_shapely())) <= 10 * r.tolerance
+        assert np.hypot(*r.normal) == pytest.approx(1.0)
+    else:
+        assert r.distance < 0.0
+
+
+def _escape_along(a: Shape, b: Shape, directions: np.ndarray, t_max: float) -> np.ndarray:
+    """Smallest t with A + t u not overlapping B, per unit direction u (scan + bisection)."""
+    pa = a.to_shapely()
+    pb = b.to_shapely()
+
+    def overlapping(t):
+        moved = [shapely.affinity.translate(pa, *(tt * u)) for tt, u in zip(t, directions)]
+        return np.array([shapely.relate(m, pb)[0] == "2" for m in moved])
+
+    steps = np.linspace(0.0, t_max, 41)
+    lo = np.zeros(len(directions))
+    hi = np.full(len(directions), t_max)
+    found = np.zeros(len(directions), dtype=bool)
+    for t0, t1 in zip(steps[:-1], steps[1:]):
+        free = ~overlapping(np.full(len(directions), t1)) & ~found
+        lo[free] = t0
+        hi[free] = t1
+        found |= free
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        over = overlapping(mid)
+        lo = np.where(over, mid, lo)
+        hi = np.where(over, hi, mid)
+    return hi
+
+
+@settings(max_examples=15)
+@given(pairs(n_max=7, holes=False))
+def test_depth_against_brute_force(pair):
+    a, b, _ = pair
+    r = classify(a, b)
+    if r.state is not State.PENETRATING:
+        return
+    depth = -r.distance
+    # the escape really ends the overlap, and has the reported length
+    moved = translated(a, r.escape)
+    assert classify(moved, b).state is not State.PENETRATING
+    assert np.hypot(*r.escape) == pytest.approx(depth)
+    assert r.normal == pytest.approx(-r.escape / depth)
+    # no sampled direction escapes sooner; the best sampled one is close
+    angles = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    dirs = np.c_[np.cos(angles), np.sin(angles)]
+    span = np.ptp(np.vstack([a.exterior, b.exterior]), axis=0).sum()
+    ref = _escape_along(a, b, dirs, span).min()
+    assert depth <= ref + 1e-7
+    assert ref <= 1.1 * depth + 1e-7
+
+
+def test_depth_of_simple_cases():
+    sq = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
+    r = classify(sq, sq + [1.5, 0.5])
+    assert r.distance == pytest.approx(-0.5)
+    assert r.escape == pytest.approx([0.0, -1.5]) or r.escape == pytest.approx([-0.5, 0.0])
+    assert classify(sq, sq).distance == pytest.approx(-2.0)
+    # the jigsaw tab pushed 0.25 into its socket comes out upwards
+    case = next(c for c in CASES if c.name == "tab sunk into its socket")
+    r = classify(case.a, case.b)
+    assert r.distance == pytest.approx(-0.5)
+    assert r.normal == pytest.approx([0.0, 1.0])
+
+
+@given(pairs(holes=False), st.booleans(), st.booleans())
+def test_array_path_matches_shape_path(pair, flip_a, close_b):
+    a, b, _ = pair
+    xa = a.exterior[::-1].copy() if flip_a else a.exterior.copy()
+    xb = np.vstack([b.exterior, b.exterior[:1]]) if close_b else b.exterior.copy()
+    before = (xa.copy(), xb.copy())
+    ra = classify(xa, xb)
+    rs = classify(a, b)
+    assert ra.state is rs.state
+    assert ra.tolerance == rs.tolerance
+    assert ra.features == rs.features  # indices refer to the stored (CCW) loops
+    assert ra.distance == pytest.approx(rs.distance)
+    np.testing.assert_array_equal(xa, before[0])
+    np.testing.assert_array_equal(xb, before[1])
+
+
+@settings(max_examples=30)
+@given(st.lists(pairs(), min_size=1, max_size=12))
+def test_classify_many_matches_classify(many):
+    shapes_a = [p[0] for p in many]
+    shapes_b = [p[1] for p in many]
+    batch = classify_many(shapes_a, shapes_b)
+    single = [classify(a, b) for a, b in zip(shapes_a, shapes_b)]
+    assert len(batch) == len(many)
+    assert [batch.state(i) for i in range(len(batch))] == [r.state for r in single]
+    np.testing.assert_allclose(batch.distances, [r.distance for r in single], atol=1e-9)
+
+
+def test_classify_many_packed_array_and_mixed_inputs():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    a = np.stack([sq, sq[::-1], sq, sq])
+    b = np.stack([sq + 2.0, sq + [1.0, 0.0], sq + 0.5, np.vstack([sq[1:], sq[:1]])])
+    keep = (a.copy(), b.copy())
+    batch = classify_many(a, b)
+    assert batch.states.tolist() == [0, 1, 2, 2]
+    np.testing.assert_allclose(batch.distances, [np.sqrt(2), 0.0, -0.5, -1.0])
+    np.testing.assert_array_equal(a, keep[0])
+    np.testing.assert_array_equal(b, keep[1])
+    frame = Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]])
+    mixed = classify_many(
+        [frame, shapely.box(0, 0, 1, 1), [(0, 0), (1, 0), (0, 1)], sq],
+        [sq + 1.5, sq + 1, sq, np.vstack([sq, sq[:1]]) + [0.0, 1.0]],
+    )
+    assert mixed.states.tolist() == [0, 1, 2, 1]
+
+
+def test_holes_and_raw_duplicates():
+    # repeated vertices make the lean path defer to Shape, which cleans them
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    assert classify(sq, sq + [1.0, 0.0]).state is State.CONTACT
+    ints = [[0, 0], [1, 0], [1, 1], [0, 1]]  # integer lists go through Shape too
+    assert classify(ints, ints).state is State.PENETRATING
+
+
+def test_read_only_and_non_contiguous_inputs():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    ro = sq.copy()
+    ro.flags.writeable = False
+    assert classify(ro, ro + 1).state is State.CONTACT
+    fortran = np.asfortranarray(sq)
+    assert classify(fortran, sq + 0.5).state is State.PENETRATING
