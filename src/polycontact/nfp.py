@@ -86,10 +86,11 @@ class NoFitPolygon:
     b: Shape = field(repr=False)
     tolerance: float = 0.0
 
-    def contains(self, point: Any) -> Any:
+    def contains(self, point: Any, *, tolerance: float | None = None) -> Any:
         """How A placed with its reference at ``point`` relates to B: a ``State``.
 
-        Same answer as :func:`polycontact.classify` of the moved A against B:
+        The answer of :func:`polycontact.classify` (same ``tolerance``) for A moved so
+        that its reference is at ``point``, against B:
         ``PENETRATING`` inside the region (except on exact fits and slides),
         ``CONTACT`` on its boundary, exact fits and slides, ``SEPARATE`` outside.
 
@@ -105,7 +106,7 @@ class NoFitPolygon:
 
         p = _as_point(point, "point")
         moved = self.a.moved(p - self.reference)
-        return classify(moved, self.b, tolerance=self.tolerance).state
+        return classify(moved, self.b, tolerance=tolerance).state
 
     @property
     def outline(self) -> Any:
@@ -146,8 +147,8 @@ def no_fit_polygon(
     a0 = _reference(a, reference)
     bxy, bst = _convex_pieces(b)
     axy, ast = _convex_pieces(a)
-    region, pts, segs, eps = _entrance(bxy, bst, a0 - axy, ast, tolerance)
-    fits, slides = _clean_degenerate(pts, segs, eps, _touching(a, b, a0, eps))
+    region, pts, segs, sums, sum_starts, eps = _entrance(bxy, bst, a0 - axy, ast, tolerance)
+    fits, slides = _clean_degenerate(pts, segs, sums, sum_starts, eps, _touching(a, b, a0, eps))
     return NoFitPolygon(region, fits, slides, a0, a, b, eps)
 
 
@@ -196,7 +197,7 @@ def inner_fit_polygon(
     x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
     outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
     fxy, fst = _pieces_of_geometry(outside)
-    blocked, pts, segs, eps = _entrance(fxy, fst, r, ast, tolerance)
+    blocked, pts, segs, sums, sum_starts, eps = _entrance(fxy, fst, r, ast, tolerance)
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -209,7 +210,7 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return spill.area <= eps * (placed.length + c_poly.length)
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, fits)
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, sums, sum_starts, eps, fits)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -286,8 +287,10 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def _entrance(
     bxy: np.ndarray, bst: np.ndarray, rxy: np.ndarray, rst: np.ndarray, tolerance: float | None
-) -> tuple[Any, np.ndarray, np.ndarray, float]:
-    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, eps).
+) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, sums, eps).
+
+    Returns the region, the candidate exact fits and slides, the packed sums and eps.
 
     The outline is assembled from the uncovered parts of the sums' edges (see
     :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
@@ -307,7 +310,7 @@ def _entrance(
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         polys = shapely.polygons(shapely.linearrings(sums, indices=ids))
         region = _drop_slivers(shapely.union_all(polys), eps)
-    return region, pts, segs, eps
+    return region, pts, segs, sums, starts, eps
 
 
 def _polygon_from_rings(
@@ -367,45 +370,108 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 
 def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
-    """Check that A with its reference at p touches B without overlapping (area test)."""
-    import shapely
+    """Check that A with its reference at p touches B without overlapping (classifier)."""
+    from ._kernels.relation import relate_state
 
-    cache: list[Any] = []
+    xa, sa = a.packed
+    xb, sb = b.packed
+    tol = HOLE_WIDTH_FACTOR * eps
 
     def check(p: np.ndarray) -> bool:
-        if not cache:
-            cache.extend([a.to_shapely(), b.to_shapely()])
-        a_poly, b_poly = cache
-        placed = shapely.affinity.translate(a_poly, *(p - a0))
-        return placed.intersection(b_poly).area <= eps * (a_poly.length + b_poly.length)
+        return relate_state(xa + (p - a0), sa, xb, sb, tol) == 1
 
     return check
 
 
-def _clean_degenerate(pts: np.ndarray, segs: np.ndarray, eps: float, check) -> tuple[np.ndarray, np.ndarray]:
-    """Merge duplicates, drop points on slides, keep only verified positions."""
+def _edges(xy: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end points of every edge of packed loops."""
+    nxt = np.arange(1, len(xy) + 1)
+    nxt[starts[1:] - 1] = starts[:-1]
+    return xy, xy[nxt]
+
+
+def _snap(p: np.ndarray, along: np.ndarray | None, edges: tuple, tol: float) -> np.ndarray:
+    """A candidate position made exact: the nearest vertex of the sums within ``tol``;
+    else the crossing, nearest to ``p``, of the line through ``p`` along ``along`` (a
+    slide's end) or of the sum edge nearest to ``p`` (an exact fit) with another sum
+    edge passing within ``tol``; else ``p`` itself."""
+    e0, e1 = edges
+    d = np.hypot(e0[:, 0] - p[0], e0[:, 1] - p[1])
+    i = int(np.argmin(d))
+    if d[i] <= tol:
+        return e0[i].copy()
+    u = e1 - e0
+    ln = np.hypot(u[:, 0], u[:, 1])
+    t = np.clip(((p - e0) * u).sum(axis=1) / np.where(ln > 0, ln * ln, 1.0), 0.0, 1.0)
+    dist = np.hypot(*(e0 + t[:, None] * u - p).T)
+    close = np.flatnonzero((dist <= tol) & (ln > 0))
+    if len(close) == 0:
+        return p
+    if along is None:
+        k = close[np.argmin(dist[close])]
+        base, direction = e0[k], u[k] / ln[k]
+    else:
+        base, direction = p, along / np.hypot(*along)
+    best = p
+    best_d = np.inf
+    for k in close:
+        w = u[k] / ln[k]
+        den = direction[0] * w[1] - direction[1] * w[0]
+        if abs(den) < 1e-6:
+            continue
+        s_ = ((e0[k, 0] - base[0]) * w[1] - (e0[k, 1] - base[1]) * w[0]) / den
+        q = base + s_ * direction
+        dq = np.hypot(*(q - p))
+        if dq < best_d:
+            best, best_d = q, dq
+    return best if best_d <= tol else p
+
+
+def _clean_degenerate(
+    pts: np.ndarray,
+    segs: np.ndarray,
+    sums: np.ndarray,
+    sum_starts: np.ndarray,
+    eps: float,
+    check: Any,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
+
+    The candidates found on the edges with the margin ``eps`` are within a few eps of
+    the true positions; exact fits and slide ends are mostly vertices of some sum, and
+    are snapped to them (within ``64 eps``).
+    """
     import shapely
 
     near = HOLE_WIDTH_FACTOR * eps
+    snap = 64.0 * eps
     slides = np.empty((0, 2, 2))
     if len(pts) == 0 and len(segs) == 0:
         return np.empty((0, 2)), slides
+    edges = _edges(sums, sum_starts)
     if len(segs):
-        lines = shapely.line_merge(
-            shapely.union_all(shapely.linestrings(segs.reshape(-1, 2, 2))), directed=False
-        )
+        ends = segs.reshape(-1, 2, 2).copy()
+        for k in range(len(ends)):
+            along = ends[k, 1] - ends[k, 0]
+            ends[k, 0] = _snap(ends[k, 0], along, edges, snap)
+            ends[k, 1] = _snap(ends[k, 1], along, edges, snap)
+        ends = ends[np.hypot(*(ends[:, 1] - ends[:, 0]).T) > near]
+        lines = shapely.line_merge(shapely.union_all(shapely.linestrings(ends)), directed=False)
         merged = [
             seg
-            for g in shapely.get_parts(shapely.simplify(lines, 0.0))
+            for g in shapely.get_parts(shapely.simplify(lines, near))
             for seg in np.lib.stride_tricks.sliding_window_view(
                 np.asarray(g.coords), (2, 2)
             ).reshape(-1, 2, 2)
         ]
         kept = [s for s in merged if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
         if kept:
-            slides = np.array(kept)
+            # each slide from its lexicographically smaller end; slides sorted
+            slides = np.array([s if tuple(s[0]) <= tuple(s[1]) else s[::-1] for s in kept])
+            slides = slides[np.lexsort((slides[:, 0, 1], slides[:, 0, 0]))]
     fits: list[np.ndarray] = []
     for p in pts:
+        p = _snap(p, None, edges, snap)
         if any(np.hypot(*(p - q)) <= near for q in fits):
             continue
         if len(slides) and shapely.distance(
@@ -414,4 +480,7 @@ def _clean_degenerate(pts: np.ndarray, segs: np.ndarray, eps: float, check) -> t
             continue
         if check(p):
             fits.append(p)
-    return (np.array(fits) if fits else np.empty((0, 2))), slides
+    if not fits:
+        return np.empty((0, 2)), slides
+    out = np.array(fits)
+    return out[np.lexsort((out[:, 1], out[:, 0]))], slides

@@ -1,0 +1,299 @@
+"""No-fit polygon: a catalogue of hard cases, random shapes and ESICUP pieces, all
+checked against the independent reference in ``nfp_reference.py``; exact fits and
+slides checked by brute force on integer lattices with the classifier."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from nfp_reference import hole_count, reference_region, same_region
+
+import polycontact as pc
+from polycontact import State
+
+SQ = [(0, 0), (1, 0), (1, 1), (0, 1)]
+H = 1e-7  # "a hair" in the narrow-entry cases
+U_SLOT = [(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]
+FRAME = ([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]])
+DOVETAIL_A = [(0, 2), (1.7, 2), (1.4, 1), (2.6, 1), (2.3, 2), (4, 2), (4, 3), (0, 3)]
+DOVETAIL_B = [(0, 0), (4, 0), (4, 2), (2.3, 2), (2.6, 1), (1.4, 1), (1.7, 2), (0, 2)]
+C_CAVITY = [(0, 0), (5, 0), (5, 5), (3, 5), (3, 4), (4, 4), (4, 1), (1, 1), (1, 4), (2, 4),
+            (2, 5), (0, 5)]
+COMB_A = [(0, 0), (5, 0), (5, 1), (4, 1), (4, 2), (3, 2), (3, 1), (2, 1), (2, 2), (1, 2),
+          (1, 1), (0, 1)]
+
+
+def shape(spec):
+    return pc.Shape(*spec) if isinstance(spec, tuple) else pc.Shape(spec)
+
+
+# name, A, B, holes, exact fits, slides (reference at the origin)
+CATALOGUE = [
+    ("jigsaw dovetail: isolated exact fit", DOVETAIL_A, DOVETAIL_B, 0, [(0, 0)], []),
+    ("square in a square hole of B", [(0, 0), (2, 0), (2, 2), (0, 2)], FRAME, 0, [(1, 1)], []),
+    ("square hole of A around B exactly", FRAME, [(0, 0), (2, 0), (2, 2), (0, 2)], 0,
+     [(-1, -1)], []),
+    ("small square in a hole of B", SQ, FRAME, 1, [], []),
+    ("B in a hole of A", FRAME, SQ, 1, [], []),
+    ("slot exactly as wide", SQ, U_SLOT, 0, [], [((1, 1), (1, 3))]),
+    ("slot a hair wider", SQ, [(0, 0), (3, 0), (3, 3), (2 + H, 3), (2 + H, 1), (1, 1), (1, 3),
+                               (0, 3)], 0, [], []),
+    ("slot a hair narrower", SQ, [(0, 0), (3, 0), (3, 3), (2 - H, 3), (2 - H, 1), (1, 1),
+                                  (1, 3), (0, 3)], 0, [], []),
+    ("slot with a shorter right wall", SQ, [(0, 0), (3, 0), (3, 2), (2, 2), (2, 1), (1, 1),
+                                            (1, 3), (0, 3)], 0, [], [((1, 1), (1, 2))]),
+    ("closed channel exactly as wide", SQ, ([(0, 0), (5, 0), (5, 3), (0, 3)],
+                                           [[(1, 1), (4, 1), (4, 2), (1, 2)]]), 0, [],
+     [((1, 1), (3, 1))]),
+    ("closed channel a hair wider", SQ, ([(0, 0), (5, 0), (5, 3), (0, 3)],
+                                        [[(1, 1), (4, 1), (4, 2 + H), (1, 2 + H)]]), 1, [], []),
+    ("cavity with a narrow mouth", [(0, 0), (1.5, 0), (1.5, 1.5), (0, 1.5)], C_CAVITY, 1, [],
+     []),
+    ("interlocking combs", COMB_A, [(0, 0), (5, 0), (5, 2), (4, 2), (4, 1), (3, 1), (3, 2),
+                                    (2, 2), (2, 1), (1, 1), (1, 2), (0, 2)], 0, [], []),
+    ("collinear vertices and sliding edges", [(0, 0), (0.5, 0), (1, 0), (1, 1), (0, 1)],
+     [(0, 0), (1, 0), (2, 0), (2, 1), (1, 1), (0, 1)], 0, [], []),
+    ("hole touching the outer loop", SQ, ([(0, 0), (4, 0), (4, 4), (0, 4)],
+                                         [[(2, 0), (3, 1), (1, 1)]]), 0, [], []),
+    ("holes in both: B in the hole of A", FRAME, (SQ, [[(0.25, 0.25), (0.75, 0.25),
+                                                      (0.75, 0.75), (0.25, 0.75)]]), 1, [], []),
+    ("holes in both: thick frames", FRAME, ([(0, 0), (6, 0), (6, 6), (0, 6)],
+                                          [[(2, 2), (4, 2), (4, 4), (2, 4)]]), 0, [], []),
+]
+
+
+@pytest.mark.parametrize("name,a,b,holes,fits,slides", CATALOGUE, ids=[c[0] for c in CATALOGUE])
+def test_catalogue(name, a, b, holes, fits, slides):
+    a, b = shape(a), shape(b)
+    nfp = pc.no_fit_polygon(a, b, reference="origin")
+    ref = reference_region(a.to_shapely(), b.to_shapely(), (0.0, 0.0))
+    assert same_region(nfp.region, ref) is None
+    assert hole_count(nfp.region) == holes
+    assert nfp.exact_fits.tolist() == [list(map(float, p)) for p in fits]
+    assert nfp.slides.tolist() == [[list(map(float, p)), list(map(float, q))] for p, q in slides]
+    for p in nfp.exact_fits:
+        assert nfp.contains(p) is State.CONTACT
+        assert shapely.contains_xy(nfp.region, *p)  # inside the area, not on its outline
+        for d in [(1e-6, 0), (-1e-6, 0), (0, 1e-6), (0, -1e-6)]:
+            assert nfp.contains(p + np.array(d)) is State.PENETRATING
+    for s in nfp.slides:
+        for t in (0.25, 0.5, 0.75):
+            assert nfp.contains(s[0] + t * (s[1] - s[0])) is State.CONTACT
+
+
+def test_hair_wider_channel_hole_is_as_thin_as_the_clearance():
+    b = shape(CATALOGUE[10][2])
+    nfp = pc.no_fit_polygon(SQ, b, reference="origin")
+    hole = shapely.Polygon(nfp.region.interiors[0])
+    assert hole.area == pytest.approx(2 * H, rel=1e-6)
+
+
+def test_contains_agrees_with_classify():
+    a, b = shape(DOVETAIL_A), shape(C_CAVITY)
+    nfp = pc.no_fit_polygon(a, b)
+    rng = np.random.default_rng(7)
+    x0, y0, x1, y1 = nfp.region.bounds
+    pts = rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), size=(200, 2))
+    pts = np.vstack([pts, shapely.get_coordinates(nfp.region)[:40]])
+    for p in pts:
+        want = pc.classify(a.moved(p - nfp.reference), b).state
+        assert nfp.contains(p) is want
+        if want is State.PENETRATING:
+            assert shapely.contains_xy(nfp.region, *p)
+        if want is State.SEPARATE:
+            assert not shapely.intersects_xy(nfp.region, *p)
+
+
+def test_reference_point_translates_the_region():
+    a, b = shape(COMB_A), shape(C_CAVITY)
+    base = pc.no_fit_polygon(a, b, reference="origin")
+    for ref, a0 in [(None, a.centroid), ("centroid", a.centroid), ((2.5, -1.0), (2.5, -1.0)),
+                    ("origin", (0.0, 0.0))]:
+        nfp = pc.no_fit_polygon(a, b, reference=ref)
+        assert np.allclose(nfp.reference, a0)
+        moved = shapely.affinity.translate(base.region, *a0)
+        assert shapely.symmetric_difference(nfp.region, moved).area < 1e-9 * moved.area
+
+
+def test_region_is_valid_and_closed_under_swapping():
+    # E(B, A) is E(A, B) reflected through the origin (reference at the origin)
+    a, b = shape(FRAME), shape(C_CAVITY)
+    ab = pc.no_fit_polygon(a, b, reference="origin").region
+    ba = pc.no_fit_polygon(b, a, reference="origin").region
+    assert ab.is_valid and ba.is_valid
+    flipped = shapely.affinity.scale(ba, -1, -1, origin=(0, 0))
+    assert shapely.symmetric_difference(ab, flipped).area < 1e-9 * ab.area
+
+
+@pytest.mark.parametrize(
+    "reference,message",
+    [("middle", "reference"), ((1, 2, 3), "reference"), ((np.nan, 0), "reference"),
+     ([["x", 1]], "reference")],
+)
+def test_bad_reference(reference, message):
+    with pytest.raises(pc.InvalidShapeError, match=message):
+        pc.no_fit_polygon(SQ, SQ, reference=reference)
+
+
+def test_bad_shapes_and_tolerance():
+    with pytest.raises(pc.InvalidShapeError, match="self-intersection"):
+        pc.no_fit_polygon([(0, 0), (1, 1), (1, 0), (0, 1)], SQ)
+    with pytest.raises(pc.InvalidShapeError, match="fewer than 3"):
+        pc.no_fit_polygon(SQ, [(0, 0), (1, 1)])
+    with pytest.raises(pc.InvalidShapeError, match="tolerance"):
+        pc.no_fit_polygon(SQ, SQ, tolerance=-1.0)
+    with pytest.raises(pc.InvalidShapeError, match="point"):
+        pc.no_fit_polygon(SQ, SQ).contains((0, np.inf))
+
+
+def test_inputs_are_not_modified():
+    a = np.array(COMB_A, dtype=float)
+    b = np.array(C_CAVITY, dtype=float)
+    a0, b0 = a.copy(), b.copy()
+    pc.no_fit_polygon(a, b)
+    pc.inner_fit_polygon(a, b)
+    assert np.array_equal(a, a0) and np.array_equal(b, b0)
+
+
+def test_degenerate_inputs_give_the_same_region():
+    # repeated vertices (zero-length edges) and collinear vertices change nothing
+    a = [(0, 0), (1.5, 0), (1.5, 1.5), (0, 1.5)]
+    plain = pc.no_fit_polygon(a, C_CAVITY, reference="origin").region
+    noisy_a = [a[0], a[0], (0.75, 0), a[1], (1.5, 0.5), (1.5, 1.0), *a[2:], a[-1]]
+    noisy_b = [C_CAVITY[0], (2.5, 0), *C_CAVITY[1:], (0, 2.5)]
+    noisy = pc.no_fit_polygon(noisy_a, noisy_b, reference="origin").region
+    assert shapely.symmetric_difference(plain, noisy).area < 1e-12 * plain.area
+    assert hole_count(plain) == hole_count(noisy) == 1
+
+
+# -- random shapes ----------------------------------------------------------------------
+
+
+@st.composite
+def star_shapes(draw, holes=True):
+    """Star-shaped polygon (concave in general), maybe with a star-shaped hole."""
+    n = draw(st.integers(3, 12))
+    radii = draw(st.lists(st.floats(0.6, 3.0), min_size=n, max_size=n))
+    phase = draw(st.floats(0, 1))
+    ang = 2 * np.pi * (np.arange(n) + phase) / n
+    cx, cy = draw(st.floats(-5, 5)), draw(st.floats(-5, 5))
+    ring = np.c_[cx + np.array(radii) * np.cos(ang), cy + np.array(radii) * np.sin(ang)]
+    hole_rings = []
+    if holes and draw(st.booleans()):
+        m = draw(st.integers(3, 6))
+        # inside the circle inscribed in the star's kernel around the centre
+        r = draw(st.floats(0.1, 0.9)) * min(radii) * np.cos(np.pi / n) ** 2 / 2
+        t = 2 * np.pi * np.arange(m) / m
+        hole_rings.append(np.c_[cx + r * np.cos(t), cy + r * np.sin(t)])
+    return pc.Shape(ring, hole_rings)
+
+
+@st.composite
+def grid_shapes(draw, size=4):
+    """Union of unit cells of a small integer grid: collinear edges, exact fits, holes."""
+    cells = draw(st.lists(st.tuples(st.integers(0, size - 1), st.integers(0, size - 1)),
+                          min_size=1, max_size=size * size, unique=True))
+    geom = shapely.union_all([shapely.box(x, y, x + 1, y + 1) for x, y in cells])
+    part = max(shapely.get_parts(geom), key=lambda g: g.area)
+    try:
+        return pc.Shape.from_shapely(part)
+    except pc.InvalidShapeError:
+        assume(False)
+
+
+@settings(max_examples=60)
+@given(star_shapes(), star_shapes())
+def test_random_concave_with_holes_against_reference(a, b):
+    nfp = pc.no_fit_polygon(a, b)
+    ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
+    assert same_region(nfp.region, ref) is None
+
+
+@settings(max_examples=60)
+@given(grid_shapes(), grid_shapes())
+def test_grid_shapes_against_reference_and_lattice(a, b):
+    nfp = pc.no_fit_polygon(a, b, reference="origin")
+    ref = reference_region(a.to_shapely(), b.to_shapely(), (0.0, 0.0))
+    assert same_region(nfp.region, ref) is None
+    # Exact fits and slides of integer shapes lie on the integer lines: every lattice
+    # point (and mid-point of a lattice edge) inside the region's area where A only
+    # touches B is an exact fit or on a slide, and nothing else is reported.
+    x0, y0, x1, y1 = (int(v) for v in nfp.region.bounds)
+    boundary = nfp.region.boundary
+    slides = shapely.linestrings(nfp.slides) if len(nfp.slides) else None
+    fits = {tuple(p) for p in nfp.exact_fits.tolist()}
+    for x2 in range(2 * x0, 2 * x1 + 1):
+        for y2 in range(2 * y0, 2 * y1 + 1):
+            if x2 % 2 and y2 % 2:
+                continue
+            p = shapely.Point(x2 / 2, y2 / 2)
+            if shapely.distance(boundary, p) < 1e-9 or not shapely.contains(nfp.region, p):
+                continue
+            touching = pc.classify(a.moved((p.x, p.y)), b).state is State.CONTACT
+            on_slide = slides is not None and shapely.distance(slides, p).min() < 1e-9
+            listed = on_slide or (p.x, p.y) in fits
+            assert touching == listed, (p, touching, on_slide)
+    for x, y in fits:
+        assert float(x).is_integer() and float(y).is_integer()
+
+
+# -- ESICUP pieces ----------------------------------------------------------------------
+
+ESICUP = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "esicup"
+
+
+def _rotated(ring, degrees):
+    t = np.radians(degrees)
+    c, s = (round(np.cos(t)), round(np.sin(t))) if degrees % 90 == 0 else (np.cos(t), np.sin(t))
+    return np.asarray(ring, dtype=float) @ np.array([[c, s], [-s, c]])
+
+
+@pytest.mark.skipif(not ESICUP.is_dir(), reason="ESICUP instances not available")
+@pytest.mark.parametrize("instance", ["shapes0", "shapes1", "blaz1", "shirts"])
+def test_esicup_every_pair_against_reference(instance):
+    data = json.loads((ESICUP / f"{instance}.json").read_text())
+    pieces = [pc.Shape(_rotated(it["shape"]["data"], deg))
+              for it in data["items"] for deg in it["allowed_orientations"]]
+    wrong = []
+    for i, a in enumerate(pieces):
+        for j, b in enumerate(pieces):
+            nfp = pc.no_fit_polygon(a, b, reference="origin")
+            why = same_region(nfp.region, reference_region(a.to_shapely(), b.to_shapely(),
+                                                           (0.0, 0.0)))
+            if why:
+                wrong.append((i, j, why))
+    assert wrong == []
+
+
+# -- inner-fit polygon --------------------------------------------------------------------
+
+
+def test_inner_fit_rectangle_in_bin():
+    bin_ = [(0, 0), (10, 0), (10, 4), (0, 4)]
+    ifp = pc.inner_fit_polygon([(0, 0), (2, 0), (2, 1), (0, 1)], bin_, reference="origin")
+    assert shapely.equals(ifp, shapely.box(0, 0, 8, 3))
+    exact = pc.inner_fit_polygon([(0, 0), (2, 0), (2, 4), (0, 4)], bin_, reference="origin")
+    assert exact.geom_type == "LineString" and shapely.equals(
+        exact, shapely.LineString([(0, 0), (8, 0)]))
+    both = pc.inner_fit_polygon([(0, 0), (10, 0), (10, 4), (0, 4)], bin_, reference="origin")
+    assert both.geom_type == "Point" and (both.x, both.y) == (0.0, 0.0)
+    assert pc.inner_fit_polygon([(0, 0), (11, 0), (11, 1)], bin_).is_empty
+
+
+@settings(max_examples=40)
+@given(grid_shapes(size=3), grid_shapes(size=5))
+def test_inner_fit_against_brute_force(a, container):
+    ifp = pc.inner_fit_polygon(a, container, reference="origin")
+    c = container.to_shapely()
+    ap = a.to_shapely()
+    for x in np.arange(-4, 6, 0.5):
+        for y in np.arange(-4, 6, 0.5):
+            placed = shapely.affinity.translate(ap, x, y)
+            inside = placed.difference(c).area < 1e-12
+            assert inside == shapely.intersects_xy(ifp, x, y), (x, y)
