@@ -216,23 +216,30 @@ class Relation:
         if self.state is State.PENETRATING:
             d = -np.asarray(self._penetration[1:])
             return d / np.hypot(*d) + 0.0
-        a, b = self.shapes
         xa, sa, xb, sb = self._packed
-        a_on, b_on, _, _ = self._raw_features[:4]
+        a_on, b_on, _, _, _ = self._raw_features
         best = None
         # A vertex of A on an edge of B: B's inward normal; a vertex of B on an edge of
-        # A: A's outward normal. Prefer the touch farthest from the edge's ends.
-        for own, xo, so, rows, sign in ((xa, xb, sb, a_on, 1.0), (xb, xa, sa, b_on, -1.0)):
+        # A: A's outward normal. A candidate must keep the touching vertex's own edges
+        # on its side (so a square's corner on the end of a flush edge does not offer
+        # the normal of the perpendicular edge); among those, prefer the touch farthest
+        # from the ends of the edge.
+        for xv, sv, xo, so, rows, sign in ((xa, sa, xb, sb, a_on, 1.0), (xb, sb, xa, sa, b_on, -1.0)):
             for v, e, _ in rows:
                 k, ei = _local(so, e)
                 loop = xo[so[k] : so[k + 1]]
                 p, q = loop[ei], loop[(ei + 1) % len(loop)]
                 u = q - p
                 length = float(np.hypot(*u))
-                t = float(np.dot(own[v] - p, u)) / length
-                margin = min(t, length - t)
-                if best is None or margin > best[0]:
-                    best = (margin, sign * np.array([-u[1], u[0]]) / length + 0.0)
+                n = sign * np.array([-u[1], u[0]]) / length + 0.0
+                t = float(np.dot(xv[v] - p, u)) / length
+                kv, vi = _local(sv, v)
+                own = xv[sv[kv] : sv[kv + 1]]
+                rays = own[[(vi - 1) % len(own), (vi + 1) % len(own)]] - own[vi]
+                fits = bool(np.all(sign * (rays @ n) <= 1e-9 * np.hypot(rays[:, 0], rays[:, 1])))
+                score = (fits, min(t, length - t))
+                if best is None or score > best[0]:
+                    best = (score, n)
         return None if best is None else best[1]
 
 

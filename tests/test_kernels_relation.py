@@ -1,0 +1,183 @@
+"""The relation kernels against plain NumPy / Shapely references, on small inputs.
+
+Also run as plain Python (NUMBA_DISABLE_JIT=1) by the CI script.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from catalogue import CASES, boundary_gap, pairs, shapely_state
+from hypothesis import given
+from hypothesis import strategies as st
+
+from polycontact import Shape
+from polycontact._kernels import relation as kr
+from polycontact._kernels import relation_many as km
+from polycontact.errors import InvalidShapeError
+from polycontact.tolerances import RELATIVE_TOLERANCE, default_tolerance
+
+STATE_NAMES = ("separate", "contact", "penetrating")
+
+
+def _eps(a: Shape, b: Shape) -> float:
+    return default_tolerance(a.packed[0], b.packed[0])
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
+def test_relate_state_catalogue(case):
+    a, b = case.a, case.b
+    assert STATE_NAMES[kr.relate_state(*a.packed, *b.packed, _eps(a, b))] == case.state
+
+
+@given(pairs(grid=True))
+def test_relate_state_matches_shapely_on_grid(pair):
+    a, b, _ = pair
+    eps = _eps(a, b)
+    assert STATE_NAMES[kr.relate_state(*a.packed, *b.packed, eps)] == shapely_state(a, b)
+    assert kr.relate_state(*b.packed, *a.packed, eps) == kr.relate_state(*a.packed, *b.packed, eps)
+
+
+@given(pairs())
+def test_boundary_distance_and_closest_pair(pair):
+    a, b, _ = pair
+    want = boundary_gap(a, b)
+    assert kr.boundary_distance(*a.packed, *b.packed) == pytest.approx(want, rel=1e-9, abs=1e-12)
+    d, xa, ya, xb, yb = kr.closest_pair(*a.packed, *b.packed)
+    assert np.hypot(xa - xb, ya - yb) == pytest.approx(d, rel=1e-9, abs=1e-12)
+    on_a = shapely.distance(shapely.Point(xa, ya), a.to_shapely().boundary)
+    on_b = shapely.distance(shapely.Point(xb, yb), b.to_shapely().boundary)
+    assert on_a <= 1e-9 and on_b <= 1e-9
+
+
+@given(
+    st.lists(st.integers(-5, 5), min_size=4, max_size=4),
+    st.lists(st.integers(1, 4), min_size=4, max_size=4),
+)
+def test_penetration_of_boxes_is_the_smallest_overlap(corner, size):
+    ax, ay, bx, by = corner
+    wa, ha, wb, hb = size
+    a = Shape(shapely.box(ax, ay, ax + wa, ay + ha).exterior.coords[:-1])
+    b = Shape(shapely.box(bx, by, bx + wb, by + hb).exterior.coords[:-1])
+    ox = min(ax + wa, bx + wb) - max(ax, bx)
+    oy = min(ay + ha, by + hb) - max(ay, by)
+    if ox <= 0 or oy <= 0:
+        return
+    # leave along x: right (bx + wb - ax) or left (ax + wa - bx); same along y
+    want = min(bx + wb - ax, ax + wa - bx, by + hb - ay, ay + ha - by)
+    depth, dx, dy = kr.penetration(*a.packed, *b.packed, _eps(a, b))
+    assert depth == pytest.approx(want)
+    assert np.hypot(dx, dy) == pytest.approx(depth)
+    moved = a.packed[0] + np.array([dx, dy])
+    assert kr.relate_state(moved, a.packed[1], *b.packed, _eps(a, b)) != kr.PENETRATING
+
+
+@given(pairs(n_max=7))
+def test_penetration_escape_ends_the_overlap(pair):
+    a, b, _ = pair
+    eps = _eps(a, b)
+    if kr.relate_state(*a.packed, *b.packed, eps) != kr.PENETRATING:
+        return
+    depth, dx, dy = kr.penetration(*a.packed, *b.packed, eps)
+    moved = a.packed[0] + np.array([dx, dy])
+    assert kr.relate_state(moved, a.packed[1], *b.packed, eps) != kr.PENETRATING
+    # the escape is no longer than leaving B's bounding box along an axis
+    (ax0, ay0), (ax1, ay1) = a.packed[0].min(0), a.packed[0].max(0)
+    (bx0, by0), (bx1, by1) = b.packed[0].min(0), b.packed[0].max(0)
+    assert depth <= min(bx1 - ax0, ax1 - bx0, by1 - ay0, ay1 - by0) + 1e-12
+
+
+def _reference_touches(xv: np.ndarray, other: Shape, eps: float) -> set[tuple[int, int]]:
+    """Vertex-on-edge pairs by plain NumPy: every vertex against every edge."""
+    xo, so = other.packed
+    nxt = np.concatenate([np.roll(np.arange(so[k], so[k + 1]), -1) for k in range(len(so) - 1)])
+    p, q = xo, xo[nxt]
+    u = q - p
+    out = set()
+    for i, v in enumerate(xv):
+        t = np.clip(np.einsum("ij,ij->i", v - p, u) / np.einsum("ij,ij->i", u, u), 0, 1)
+        d = np.hypot(*(p + t[:, None] * u - v).T)
+        out |= {(i, int(e)) for e in np.flatnonzero(d <= eps)}
+    return out
+
+
+@given(pairs())
+def test_features_kernel_against_numpy(pair):
+    a, b, _ = pair
+    eps = _eps(a, b)
+    a_on, b_on, a_in, b_in, cross = kr.features(*a.packed, *b.packed, eps)
+    assert {(v, e) for v, e, _ in a_on} == _reference_touches(a.packed[0], b, eps)
+    assert {(v, e) for v, e, _ in b_on} == _reference_touches(b.packed[0], a, eps)
+    pb, pa = b.to_shapely(), a.to_shapely()
+    for rows, xv, poly in ((a_in, a.packed[0], pb), (b_in, b.packed[0], pa)):
+        inside = {i for i, v in enumerate(xv) if poly.contains(shapely.Point(v))}
+        on = {v for v, _, _ in (a_on if poly is pb else b_on)}
+        assert {v for v, _, _ in rows} == inside - on
+    for e, f, x, y in cross:
+        assert shapely.distance(shapely.Point(x, y), pa.boundary) <= 1e-9
+        assert shapely.distance(shapely.Point(x, y), pb.boundary) <= 1e-9
+
+
+@given(st.lists(st.floats(-100, 100), min_size=0, max_size=60))
+def test_sort_by_xmin(keys):
+    box = np.zeros((len(keys), 4))
+    box[:, 0] = keys
+    order = kr._sort_by_xmin(box, len(keys))
+    assert sorted(order.tolist()) == list(range(len(keys)))
+    assert np.all(np.diff(box[order, 0]) >= 0)
+
+
+@given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
+def test_raw_ring_agrees_with_shape(points):
+    ring = np.array(points, dtype=float)
+    n, sign, scale = kr._raw_ring(ring, RELATIVE_TOLERANCE)
+    try:
+        shape = Shape(ring)
+    except InvalidShapeError:
+        assert n == -1
+        return
+    distinct = np.any(ring != np.roll(ring, 1, axis=0), axis=1).all()
+    if distinct:  # repeated vertices are left to Shape, which drops them
+        assert n == len(ring)
+        assert sign == (1.0 if np.array_equal(shape.exterior, ring) else -1.0)
+        assert scale == max(1.0, np.abs(ring).max())
+
+
+def test_classify_raw_orientation_and_codes():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
+    assert kr.classify_raw(sq, sq[::-1] + 1.0, -1.0, 1e-12)[0] == kr.CONTACT
+    assert kr.classify_raw(sq, sq[::-1] + 0.5, -1.0, 1e-12)[0] == kr.PENETRATING
+    assert kr.classify_raw(bow, sq, -1.0, 1e-12)[0] == -1
+    assert kr.classify_raw(sq, bow, -1.0, 1e-12)[0] == -2
+    closed = np.vstack([sq, sq[:1]])
+    code, eps, na, fa, nb, fb = kr.classify_raw(closed, sq[::-1] + 3.0, 0.5, 1e-12)
+    assert (code, eps, na, fa, nb, fb) == (kr.SEPARATE, 0.5, 4, 1.0, 4, -1.0)
+
+
+@given(st.lists(pairs(n_max=6), min_size=1, max_size=5))
+def test_many_kernels_match_single(many):
+    def pack(shapes):
+        xy = np.concatenate([s.packed[0] for s in shapes])
+        ls, bs, row = [], [0], 0
+        for s in shapes:
+            ls += (s.packed[1] + row).tolist()
+            row += len(s.packed[0])
+            bs.append(len(ls))
+        return xy, np.array(ls), np.array(bs), np.ones(len(shapes))
+
+    sa = [p[0] for p in many]
+    sb = [p[1] for p in many]
+    pa, pb = pack(sa), pack(sb)
+    states, eps = km.many_states(*pa, *pb, -1.0, RELATIVE_TOLERANCE)
+    want = [kr.relate_state(*a.packed, *b.packed, _eps(a, b)) for a, b in zip(sa, sb)]
+    assert states.tolist() == want
+    dist = km.many_distances(*pa, *pb, states, eps)
+    for d, s, a, b in zip(dist, states, sa, sb):
+        if s == kr.SEPARATE:
+            assert d == pytest.approx(kr.boundary_distance(*a.packed, *b.packed))
+        elif s == kr.CONTACT:
+            assert d == 0.0
+        else:
+            assert -d == pytest.approx(kr.penetration(*a.packed, *b.packed, _eps(a, b))[0])
