@@ -1,0 +1,91 @@
+"""``polycontact classify A.json B.json``: separate, contact or penetrating."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from typing import Any
+
+from ._io import read_shape
+
+
+def _tolerance(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return value
+
+
+def add_parser(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "classify",
+        help="whether two bodies are separate, in contact or penetrating",
+        description="Classify two bodies where they stand: separate, contact (touching, "
+        "interiors disjoint) or penetrating (interiors overlap). Each file is a JSON "
+        'body {"vertices": [[x, y], ...], "holes": [...]}, a GeoJSON Polygon or WKT.',
+    )
+    p.add_argument("a", metavar="A.json", help="first body (A)")
+    p.add_argument("b", metavar="B.json", help="second body (B)")
+    p.add_argument("--tolerance", type=_tolerance, default=None, metavar="T",
+                   help="absolute distance that counts as touching "
+                   "(default 1e-12 × the largest coordinate, at least 1e-12)")
+    p.add_argument("--repair", action="store_true",
+                   help="repair invalid polygons with shapely.make_valid and say so")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+
+
+def relation_report(relation: Any) -> dict:
+    """The relation as a JSON-ready dict (the object printed by ``--json``)."""
+    features = []
+    for f in relation.features:
+        item = {"body": f.body, "loop": f.loop, "vertex": f.vertex,
+                "other_loop": f.other_loop, "edge": f.edge, "kind": f.kind}
+        if f.own_edge is not None:
+            item["own_edge"] = f.own_edge
+        features.append(item)
+    return {
+        "state": relation.state.value,
+        "distance": float(relation.distance),
+        "features": features,
+        "point": None if relation.point is None else [float(v) for v in relation.point],
+        "normal": None if relation.normal is None else [float(v) for v in relation.normal],
+        "tolerance": float(relation.tolerance),
+    }
+
+
+def relation_text(rep: dict) -> list[str]:
+    """The relation as lines of text."""
+    lines = [f"state: {rep['state']}", f"distance: {rep['distance']:.12g}",
+             "features:" if rep["features"] else "features: none"]
+    for f in rep["features"]:
+        other = "b" if f["body"] == "a" else "a"
+        if f["kind"] == "edges-cross":
+            lines.append(f"  edge {f['own_edge']} (loop {f['loop']}) of {f['body']} crosses "
+                         f"edge {f['edge']} (loop {f['other_loop']}) of {other}")
+        else:
+            where = "on" if f["kind"] == "vertex-on-edge" else "inside, nearest"
+            lines.append(f"  vertex {f['vertex']} (loop {f['loop']}) of {f['body']} {where} "
+                         f"edge {f['edge']} (loop {f['other_loop']}) of {other}")
+    for key in ("point", "normal"):
+        if rep[key] is not None:
+            lines.append(f"{key}: ({rep[key][0]:.12g}, {rep[key][1]:.12g})")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..relation import classify
+
+    a = read_shape(args.a, repair=args.repair)
+    b = read_shape(args.b, repair=args.repair)
+    for path, shape in ((args.a, a), (args.b, b)):
+        for note in shape.repairs:
+            print(f"polycontact classify: repaired {path}: {note}", file=sys.stderr)
+    rep = relation_report(classify(a, b, tolerance=args.tolerance))
+    print(json.dumps(rep) if args.json else "\n".join(relation_text(rep)))
+    return 0
