@@ -77,9 +77,10 @@ def check_against_oracle(a, ma, b, mb, t_max, n=1500):
     return hit, first
 
 
-# -- random concave bodies (the paper's generator: random radii at sorted angles) ---
+# -- random concave bodies (like the paper's: random radii at increasing angles) ----
 def star_polygon(rng: np.random.Generator, n: int, scale: float) -> np.ndarray:
-    angles = np.sort(rng.choice(360, size=n, replace=False)) * math.pi / 180
+    # one vertex per sector of 360/n degrees, so no gap reaches 180° (a simple polygon)
+    angles = (np.arange(n) + rng.uniform(0.05, 0.95, size=n)) * 2 * math.pi / n
     radii = rng.uniform(0.25, 1.0, size=n) * scale
     return np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
 

@@ -146,3 +146,24 @@ def test_sampled_search_follows_the_paper_steps():
                                                          n, 1e-12)
         expected = _paper_sampled(sq, m_a, b, Motion(), 0.5, 4.0, n, 1e-3)
         assert code == ki.HIT and math.isclose(hi, expected, abs_tol=1e-12)
+
+
+@given(vec, st.floats(-4, 4), vec, st.floats(-4, 4), st.floats(-1, 1), st.floats(0, 1))
+def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
+    from polycontact._kernels.relation import boundary_distance
+
+    a = Shape([(0, 0), (2, 0.5), (1, 0.7), (0.5, 1.5)])
+    b = Shape([(0, 0), (1, 0), (1, 3), (0.5, 1), (0, 3)]).moved((3.0, dy))
+    ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
+    ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
+    lin, ra_w, rb_w = ki._window_rates(ma.array, mb.array, 0.0, 1.0)
+    d, step = ki.pair_step(a.packed[0], a.packed[1], np.hypot(*ra.T), b.packed[0],
+                           b.packed[1], np.hypot(*rb.T), lin, ra_w, rb_w)
+    assert math.isclose(d, boundary_distance(*a.packed, *b.packed), rel_tol=1e-12)
+    speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
+                           0.0, 1.0)
+    if speed > 0:
+        assert step >= d / speed * (1 - 1e-12)
+    t = min(step, 1.0) * frac
+    moved = boundary_distance(*a.at(ma, t).packed, *b.at(mb, t).packed)
+    assert moved > 0 or frac == 1

@@ -53,6 +53,72 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     norm of an affine function of t, hence convex, so its maximum over [t0, t1] is at
     an end.
     """
+    lin, wa, wb = _window_rates(ma, mb, t0, t1)
+    return lin + wa * la + wb * lb
+
+
+#: Largest m·n for which :func:`pair_step` (all vertex–edge pairs, no allocation) is
+#: used; above it the sweep of ``boundary_distance`` is cheaper per iteration.
+PAIR_STEP_MAX = 1024
+
+
+@njit(cache=True, nogil=True)
+def _point_segment2(px, py, ax, ay, bx, by):
+    """Squared distance from p to the segment ab."""
+    dx = bx - ax
+    dy = by - ay
+    den = dx * dx + dy * dy
+    u = 0.0
+    if den > 0.0:
+        u = ((px - ax) * dx + (py - ay) * dy) / den
+        u = min(1.0, max(0.0, u))
+    ex = ax + u * dx - px
+    ey = ay + u * dy - py
+    return ex * ex + ey * ey
+
+
+@njit(cache=True, nogil=True)
+def _one_way_step(xa, ra_len, sa, xb, sb, rb_len, lin, wa, wb, dmin2, step):
+    for k in range(sb.shape[0] - 1):
+        s = sb[k]
+        e = sb[k + 1]
+        for j in range(s, e):
+            j1 = j + 1 if j + 1 < e else s
+            reach_b = wb * max(rb_len[j], rb_len[j1])
+            for i in range(xa.shape[0]):
+                d2 = _point_segment2(xa[i, 0], xa[i, 1], xb[j, 0], xb[j, 1], xb[j1, 0],
+                                     xb[j1, 1])
+                dmin2 = min(dmin2, d2)
+                speed = lin + wa * ra_len[i] + reach_b
+                reach = step * speed
+                if d2 < reach * reach:   # this pair closes sooner than the best so far
+                    step = np.sqrt(d2) / speed
+    return dmin2, step
+
+
+@njit(cache=True, nogil=True)
+def pair_step(xa, sa, ra_len, xb, sb, rb_len, lin, wa, wb):
+    """``(distance, step)``: the boundary distance, and a time step that no vertex–edge
+    pair can close.
+
+    ``ra_len[i]`` is the distance of vertex i of A from A's centroid (likewise B);
+    ``lin``, ``wa``, ``wb`` bound |Δv + Δa t|, |ω_A + α_A t|, |ω_B + α_B t| over the
+    window. A point q of edge e of B moves relative to a vertex p of A at most at
+    ``lin + wa |r_p| + wb max(|r_e0|, |r_e1|)`` (|r| is convex along the edge), so the
+    distance from p to e cannot close before distance / speed. Boundaries that do not
+    cross are at the distance of their nearest vertex–edge pair, and they cannot begin
+    to meet without some vertex reaching an edge, so the smallest such time over all
+    pairs (both ways) is a step without contact. Per pair, a vertex near its centroid
+    is not charged the speed of the farthest one: the step is never shorter than
+    distance / :func:`speed_bound`.
+    """
+    dmin2, step = _one_way_step(xa, ra_len, sa, xb, sb, rb_len, lin, wa, wb, np.inf, np.inf)
+    dmin2, step = _one_way_step(xb, rb_len, sb, xa, sa, ra_len, lin, wb, wa, dmin2, step)
+    return np.sqrt(dmin2), step
+
+
+@njit(cache=True, nogil=True)
+def _window_rates(ma, mb, t0, t1):
     dvx = ma[0] - mb[0]
     dvy = ma[1] - mb[1]
     dax = ma[2] - mb[2]
@@ -60,7 +126,7 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     lin = max(np.hypot(dvx + dax * t0, dvy + day * t0), np.hypot(dvx + dax * t1, dvy + day * t1))
     wa = max(abs(ma[4] + ma[5] * t0), abs(ma[4] + ma[5] * t1))
     wb = max(abs(mb[4] + mb[5] * t0), abs(mb[4] + mb[5] * t1))
-    return lin + wa * la + wb * lb
+    return lin, wa, wb
 
 
 @njit(cache=True, nogil=True)
@@ -86,7 +152,9 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     t with boundary distance d and speed bound S over a window [t, t + H]:
 
     - ``d / S`` is a step during which the boundaries cannot meet (the distance is
-      S-Lipschitz), so no penetration can start; if it is at least the probe length
+      S-Lipschitz), so no penetration can start; for small bodies (m·n <=
+      ``PAIR_STEP_MAX``) the longer step of :func:`pair_step` (each vertex–edge pair
+      charged its own speed) is used. If the step is at least the probe length
       ``tau = min(time_tol / 2, lam / S)`` it is taken;
     - otherwise the step is ``tau``: a penetration that begins and ends inside it lasts
       less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
@@ -96,6 +164,13 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     """
     xa = np.empty_like(ra)
     xb = np.empty_like(rb)
+    ra_len = np.empty(ra.shape[0])
+    for i in range(ra.shape[0]):
+        ra_len[i] = np.hypot(ra[i, 0], ra[i, 1])
+    rb_len = np.empty(rb.shape[0])
+    for i in range(rb.shape[0]):
+        rb_len[i] = np.hypot(rb[i, 0], rb[i, 1])
+    small = ra.shape[0] * rb.shape[0] <= PAIR_STEP_MAX
     first_contact = -1.0
     it = 0
     t = 0.0
@@ -114,17 +189,19 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
             it += 1
             if it > max_iter:
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
-            d = boundary_distance(xa, sa, xb, sb)
+            t_end = min(t2, t + window)
+            lin, wa, wb = _window_rates(ma, mb, t, t_end)
+            s = lin + wa * la + wb * lb
+            if small:
+                d, h = pair_step(xa, sa, ra_len, xb, sb, rb_len, lin, wa, wb)
+            else:
+                d = boundary_distance(xa, sa, xb, sb)
+                h = d / s if s > 0.0 else np.inf
             if d <= lam and first_contact < 0.0:
                 first_contact = t
-            if t >= t2:
-                break
-            t_end = min(t2, t + window)
-            s = speed_bound(ma, la, mb, lb, t, t_end)
-            if s <= 0.0:
-                break  # no relative motion: the state at t holds to t2
+            if t >= t2 or s <= 0.0:
+                break  # at the end, or no relative motion: the state at t holds to t2
             tau = min(0.5 * time_tol, lam / s)
-            h = d / s
             if h >= t_end - t:
                 h = t_end - t
                 window = 2.0 * window
@@ -147,7 +224,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
             if st == _PENETRATING:
                 lo = t
                 hi = t_new
-                goal = 0.01 * tau
+                goal = 0.1 * tau
                 while hi - lo > goal:
                     mid = 0.5 * (lo + hi)
                     if mid <= lo or mid >= hi:
