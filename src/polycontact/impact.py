@@ -199,7 +199,11 @@ def time_of_impact(
     of distances |p(t) − q(t)| of material points, hence S-Lipschitz on the window:
     the boundaries cannot meet before t + d(t)/S, and interiors cannot begin to overlap
     without the boundaries meeting (at the first overlap the boundaries touch). So
-    each step min(H, d/S) lands no later than the first contact. Near contact the step
+    each step min(H, d/S) lands no later than the first contact. For small bodies
+    (m·n ≤ 1024) the step is the smallest, over every vertex p and edge e of the other
+    body, of dist(p, e) / (|Δv + Δa t| + |ω_A + α_A t| |r_p| + |ω_B + α_B t| max |r_e|)
+    (maxima over the window): boundaries meet first where a vertex reaches an edge,
+    so this longer step has the same guarantee. Near contact the step
     d/S shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
     λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and classifies
     the end. A penetrating end is bisected back to the non-penetrating start, which
@@ -239,10 +243,10 @@ def time_of_impact(
     ...                      t_max=5)
     >>> hit.collides, abs(hit.time - 2.0) < 1e-4, hit.status.value
     (True, True, 'hit')
-    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((-3, 1)), Motion(),
-    ...                        t_max=1)
-    >>> slide.collides, slide.first_contact, slide.state.value
-    (False, 0.0, 'contact')
+    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((1.9, 1)), Motion(),
+    ...                        t_max=1)                     # slides along from t = 0.9
+    >>> slide.collides, round(slide.first_contact, 4), slide.state.value
+    (False, 0.9, 'contact')
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
