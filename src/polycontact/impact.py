@@ -19,6 +19,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -72,6 +73,10 @@ _STATUS = {
 class Impact:
     """Result of :func:`time_of_impact`.
 
+    ``features``, ``point`` and ``normal`` classify the bodies at the moment of impact;
+    they are computed on first access (a query that only needs the time does not pay
+    for them) and cached.
+
     Attributes
     ----------
     collides : bool
@@ -85,13 +90,6 @@ class Impact:
         The relation at the reported instant: ``time`` for a hit, t = 0 when
         penetrating at the start, ``first_contact`` for a contact without collision;
         None when nothing happened.
-    features : tuple of Feature
-        At the touching configuration: which vertex of which body meets which edge of
-        the other (0-based indices into ``Shape.loops``, body "a" or "b").
-    point : ndarray of shape (2,) or None
-        Contact point at the moment of impact (or of first contact).
-    normal : ndarray of shape (2,) or None
-        Unit contact normal there, from A towards B.
     status : ImpactStatus
         How the search ended; OUT_OF_ITERATIONS means no verdict.
     method : str
@@ -104,21 +102,74 @@ class Impact:
         Number of placements classified.
     searched_to : float
         How far in time the search got (t_max when it finished).
+    features : tuple of Feature
+        At the touching configuration: which vertex of which body meets which edge of
+        the other (0-based indices into ``Shape.loops``, body "a" or "b").
+    point : ndarray of shape (2,) or None
+        Contact point at the moment of impact (or of first contact).
+    normal : ndarray of shape (2,) or None
+        Unit contact normal there, from A towards B.
     """
 
     collides: bool
     time: float | None
     first_contact: float | None
     state: State | None
-    features: tuple[Feature, ...]
-    point: np.ndarray | None = field(repr=False)
-    normal: np.ndarray | None = field(repr=False)
     status: ImpactStatus
     method: str
     broad_phase: tuple[tuple[float, float], ...] = field(repr=False)
     time_bracket: tuple[float, float] | None = field(repr=False)
     iterations: int = field(repr=False)
     searched_to: float = field(repr=False)
+    _bodies: tuple = field(repr=False, compare=False, default=())
+
+    @cached_property
+    def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
+        if self.state is None:
+            return (), None, None
+        a, ma, b, mb, eps = self._bodies
+        if self.status is ImpactStatus.HIT:
+            t_lo, t_hi = self.time_bracket
+            rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
+            rel = rel_hi
+            if self.method == "exact":
+                from ._kernels.impact import speed_bound
+
+                reach = (t_hi - t_lo) * speed_bound(ma.array, a.bounding_radius, mb.array,
+                                                    b.bounding_radius, t_lo, t_hi)
+                rel_lo = _relation_at(a, ma, b, mb, t_lo, eps, reach)
+                rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
+            # the normal opposes the smallest translation that ends the (tiny) overlap
+            # at `time`: at a corner-on-corner or flush touch it is the push direction
+            normal = rel_hi.normal if rel_hi.state is State.PENETRATING else rel.normal
+            point = rel.point
+            features = rel.features
+        elif self.status is ImpactStatus.PENETRATING_AT_START:
+            rel = classify(a.at(ma, 0.0), b.at(mb, 0.0), tolerance=eps)
+            features, point, normal = rel.features, rel.point, rel.normal
+        else:
+            rel = _relation_at(a, ma, b, mb, self.first_contact, eps)
+            features, point, normal = rel.features, rel.point, rel.normal
+        return (
+            tuple(features),
+            None if point is None else np.asarray(point, dtype=np.float64),
+            None if normal is None else np.asarray(normal, dtype=np.float64),
+        )
+
+    @property
+    def features(self) -> tuple[Feature, ...]:
+        """Which vertex of which body meets which edge of the other (see class doc)."""
+        return self._details[0]
+
+    @property
+    def point(self) -> np.ndarray | None:
+        """Contact point at the moment of impact (or of first contact)."""
+        return self._details[1]
+
+    @property
+    def normal(self) -> np.ndarray | None:
+        """Unit contact normal at the moment of impact, from A towards B."""
+        return self._details[2]
 
 
 def _positive(value: Any, what: str) -> float:
@@ -290,48 +341,27 @@ def time_of_impact(
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
             t_max, eps) -> Impact:
     first_contact = t_contact if t_contact >= 0.0 else None
-    broad = tuple((float(s), float(e)) for s, e in intervals)
-    features: tuple[Feature, ...] = ()
-    point = normal = None
     state = None
     time = bracket = None
     if status is ImpactStatus.HIT:
-        time, bracket = t_hi, (t_lo, t_hi)
-        rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
-        state = rel_hi.state
-        rel = rel_hi
-        if method == "exact":
-            from ._kernels.impact import speed_bound
-
-            reach = (t_hi - t_lo) * speed_bound(ma.array, a.bounding_radius, mb.array,
-                                                b.bounding_radius, t_lo, t_hi)
-            rel_lo = _relation_at(a, ma, b, mb, t_lo, eps, reach)
-            rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
-        features, point = rel.features, rel.point
-        # the normal opposes the smallest translation that ends the (tiny) overlap at
-        # `time`: at a corner-on-corner or flush touch it is the direction of the push
-        normal = rel_hi.normal if rel_hi.state is State.PENETRATING else rel.normal
+        # the kernel found the interiors overlapping at t_hi
+        time, bracket, state = t_hi, (t_lo, t_hi), State.PENETRATING
     elif status is ImpactStatus.PENETRATING_AT_START:
-        first_contact = 0.0
-        rel = classify(a.at(ma, 0.0), b.at(mb, 0.0), tolerance=eps)
-        state, features, point, normal = rel.state, rel.features, rel.point, rel.normal
+        first_contact, state = 0.0, State.PENETRATING
     elif first_contact is not None:
-        rel = _relation_at(a, ma, b, mb, first_contact, eps)
-        state, features, point, normal = State.CONTACT, rel.features, rel.point, rel.normal
-    if status is not ImpactStatus.OUT_OF_ITERATIONS:
-        reached = t_max if status is ImpactStatus.NO_HIT else reached
+        state = State.CONTACT
+    if status is ImpactStatus.NO_HIT:
+        reached = t_max
     return Impact(
         collides=status is ImpactStatus.HIT,
         time=time,
         first_contact=first_contact,
         state=state,
-        features=tuple(features),
-        point=None if point is None else np.asarray(point, dtype=np.float64),
-        normal=None if normal is None else np.asarray(normal, dtype=np.float64),
         status=status,
         method=method,
-        broad_phase=broad,
+        broad_phase=tuple((float(s), float(e)) for s, e in intervals),
         time_bracket=bracket,
         iterations=iters,
         searched_to=reached,
+        _bodies=(a, ma, b, mb, eps),
     )
