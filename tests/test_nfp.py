@@ -196,9 +196,14 @@ def star_shapes(draw, holes=True):
 
 @st.composite
 def grid_shapes(draw, size=4):
-    """Union of unit cells of a small integer grid: collinear edges, exact fits, holes."""
-    cells = draw(st.lists(st.tuples(st.integers(0, size - 1), st.integers(0, size - 1)),
-                          min_size=1, max_size=size * size, unique=True))
+    """Unit cells of a small integer grid (some drawn, or all but a few for holes):
+    collinear edges, exact fits, slides, holes touching at corners."""
+    cell = st.tuples(st.integers(0, size - 1), st.integers(0, size - 1))
+    if draw(st.booleans()):
+        cells = draw(st.lists(cell, min_size=1, max_size=size * size, unique=True))
+    else:
+        gone = set(draw(st.lists(cell, max_size=size, unique=True)))
+        cells = [(x, y) for x in range(size) for y in range(size) if (x, y) not in gone]
     geom = shapely.union_all([shapely.box(x, y, x + 1, y + 1) for x, y in cells])
     part = max(shapely.get_parts(geom), key=lambda g: g.area)
     try:
