@@ -178,12 +178,11 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
         t1 = intervals[k, 0]
         t2 = intervals[k, 1]
         t = t1
-        st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps)
-        if st == _PENETRATING:
-            if t == 0.0:
-                return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
-            # unreachable but for rounding: the circles only just touch at t1 > 0
-            return HIT, t, t, t, it, t
+        place(ra, ca, ma, t, xa)
+        place(rb, cb, mb, t, xb)
+        # after t = 0 an interval opens with the bounding circles just touching: apart
+        if t == 0.0 and relate_state(xa, sa, xb, sb, eps) == _PENETRATING:
+            return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
         while True:
             it += 1
