@@ -1,0 +1,126 @@
+"""NFP kernels against plain Shapely references (also run with NUMBA_DISABLE_JIT=1).
+
+Inputs stay small so that the pure-Python run is quick.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from polycontact._kernels import decompose
+from polycontact._kernels import nfp as kn
+
+
+def _packed(polys):
+    xy = np.concatenate(polys).astype(float)
+    starts = np.r_[0, np.cumsum([len(p) for p in polys])].astype(np.int64)
+    return xy, starts
+
+
+def _split(xy, starts):
+    return [xy[starts[k]:starts[k + 1]] for k in range(len(starts) - 1)]
+
+
+@st.composite
+def convex_polys(draw, grid=4):
+    """Convex hull of a few lattice points (collinear edges and shared lines are common)."""
+    pts = draw(st.lists(st.tuples(st.integers(0, grid), st.integers(0, grid)), min_size=3,
+                        max_size=7, unique=True))
+    hull = shapely.convex_hull(shapely.MultiPoint(pts))
+    if hull.geom_type != "Polygon":
+        hull = shapely.box(pts[0][0], pts[0][1], pts[0][0] + 1, pts[0][1] + 1)
+    hull = shapely.orient_polygons(hull)  # CCW exterior
+    return np.asarray(hull.exterior.coords)[:-1].astype(float)
+
+
+@settings(max_examples=100)
+@given(convex_polys(), convex_polys())
+def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
+    xy, starts = kn.convex_sums(*_packed([p]), *_packed([q]))
+    got = shapely.Polygon(xy)
+    want = shapely.convex_hull(shapely.MultiPoint((p[:, None, :] + q[None, :, :]).reshape(-1, 2)))
+    assert got.is_valid
+    assert shapely.symmetric_difference(got, want).area < 1e-12
+    assert kn._ring_stats(xy, starts)[0][0] > 0  # counter-clockwise
+
+
+@settings(max_examples=60)
+@given(st.lists(convex_polys(), min_size=2, max_size=4))
+def test_outline_rings_are_the_union(polys):
+    xy, starts = _packed(polys)
+    bb = kn._bboxes(xy, starts)
+    outline, loose = kn.edge_cover(xy, starts, bb, 1e-12)
+    ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
+    assert ok
+    area, _ = kn._ring_stats(rxy, rst)
+    want = shapely.union_all([shapely.Polygon(p) for p in polys])
+    assert abs(area.sum() - want.area) < 1e-9
+    shells = [shapely.Polygon(r) for r, a in zip(_split(rxy, rst), area) if a > 0]
+    holes = [shapely.Polygon(r) for r, a in zip(_split(rxy, rst), area) if a < 0]
+    got = shapely.union_all(shells).difference(shapely.union_all(holes)) if holes else (
+        shapely.union_all(shells))
+    assert shapely.symmetric_difference(got, want).area < 1e-9
+
+
+def test_two_squares_sharing_an_edge_have_one_outline_and_a_seam():
+    left = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy, starts = _packed([left, left + [1, 0]])
+    bb = kn._bboxes(xy, starts)
+    outline, loose = kn.edge_cover(xy, starts, bb, 1e-12)
+    ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
+    assert ok and len(rst) == 2
+    assert kn._ring_stats(rxy, rst)[0][0] == 2.0
+    # the shared edge x = 1 is loose (no open square covers it) and surrounded
+    pts, segs = kn.degenerate_contacts(xy, starts, bb, loose, 1e-12, 1e-9)
+    assert len(pts) == 0
+    assert {tuple(sorted([tuple(s[:2]), tuple(s[2:])])) for s in segs} == {((1, 0), (1, 1))}
+
+
+def test_surrounded_on_an_l_of_three_squares():
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1]])
+    bb = kn._bboxes(xy, starts)
+    assert not kn.surrounded(1.0, 1.0, xy, starts, bb, 1e-12, 1e-9)  # reflex corner
+    assert kn.surrounded(0.5, 1.0, xy, starts, bb, 1e-12, 1e-9)  # shared edge
+    assert kn.surrounded(1.0, 0.5, xy, starts, bb, 1e-12, 1e-9)
+    assert not kn.surrounded(0.0, 0.5, xy, starts, bb, 1e-12, 1e-9)  # outline
+
+
+def test_surrounded_at_a_shared_corner_of_four_squares():
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
+    bb = kn._bboxes(xy, starts)
+    assert kn.surrounded(1.0, 1.0, xy, starts, bb, 1e-12, 1e-9)
+    assert not kn.surrounded(2.0, 1.0, xy, starts, bb, 1e-12, 1e-9)
+
+
+@st.composite
+def lattice_polygons(draw):
+    cells = draw(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3)), min_size=1,
+                          max_size=10, unique=True))
+    geom = shapely.union_all([shapely.box(x, y, x + 1, y + 1) for x, y in cells])
+    return max(shapely.get_parts(geom), key=lambda g: g.area)
+
+
+@settings(max_examples=60)
+@given(lattice_polygons())
+@example(shapely.Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]]))
+def test_convex_pieces_tile_the_polygon(poly):
+    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
+    coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
+    xy, starts = decompose.convex_pieces(np.ascontiguousarray(coords), 1e-12)
+    pieces = [shapely.Polygon(p) for p in _split(xy, starts)]
+    assert len(pieces) <= len(tris)
+    for p, ring in zip(pieces, _split(xy, starts)):
+        assert p.is_valid and decompose.is_convex(ring)
+        assert shapely.convex_hull(p).area - p.area < 1e-12
+    assert abs(sum(p.area for p in pieces) - poly.area) < 1e-9  # interiors disjoint
+    assert shapely.symmetric_difference(shapely.union_all(pieces), poly).area < 1e-9
+
+
+def test_is_convex():
+    assert decompose.is_convex(np.array([[0, 0], [1, 0], [2, 0], [1, 1]], float))
+    assert not decompose.is_convex(np.array([[0, 0], [2, 0], [1, 0.5], [1, 2]], float))
