@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import given, note, settings
 from hypothesis import strategies as st
 
 import polycontact as pc
@@ -47,6 +47,12 @@ def _minkowski_reference(a: pc.Shape, b: pc.Shape, a0) -> shapely.Geometry:
     pb = shapely.get_coordinates(tb).reshape(len(tb), 4, 2)[:, :3]
     sums = (pa[:, None, :, None] + pb[None, :, None, :]).reshape(-1, 9, 2)
     return shapely.union_all(shapely.convex_hull(shapely.multipoints(sums)))
+
+
+def note_bodies(*shapes: pc.Shape) -> None:
+    """Print the coordinates of a failing example (a Shape's repr omits them)."""
+    for s in shapes:
+        note(repr([loop.tolist() for loop in s.loops]))
 
 
 def _same_region(g1, g2, rel=1e-9):
@@ -184,6 +190,7 @@ def test_inputs_untouched_and_result_read_only():
 # -- random bodies -----------------------------------------------------------------------
 @given(bodies(), bodies())
 def test_the_two_methods_give_the_same_region(a, b):
+    note_bodies(a, b)
     pairs = pc.entrance_block(a, b, method="pairs")
     swept = pc.entrance_block(a, b, method="swept")
     # B ⊕ (a0 − A) is connected, and so is the union of the components
@@ -195,12 +202,14 @@ def test_the_two_methods_give_the_same_region(a, b):
 @settings(max_examples=60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_union_is_the_minkowski_sum(a, b):
+    note_bodies(a, b)
     _same_region(pc.entrance_block(a, b).to_shapely(), _minkowski_reference(a, b, a.centroid))
 
 
 @settings(max_examples=60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
+    note_bodies(a, b)
     pairs = pc.entrance_block(a, b, method="pairs")
     swept = pc.entrance_block(a, b, method="swept")
     n_b = b.n_vertices
@@ -218,6 +227,7 @@ def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
 @settings(max_examples=60)
 @given(bodies(max_vertices=7), bodies(max_vertices=7), st.data())
 def test_components_mean_what_their_features_say(a, b, data):
+    note_bodies(a, b)
     """a0 in a component iff its features meet when A is moved there (closed sets)."""
     for method in ("pairs", "swept"):
         eb = pc.entrance_block(a, b, method=method)

@@ -7,7 +7,7 @@ import pytest
 import shapely
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from test_entrance_block import FRAME, NOTCHED_HOLE, SQUARE, bodies
+from test_entrance_block import FRAME, NOTCHED_HOLE, SQUARE, bodies, note_bodies
 
 import polycontact as pc
 
@@ -22,6 +22,7 @@ def _shapely_state(a: pc.Shape, b: pc.Shape) -> str:
 @settings(max_examples=80)
 @given(bodies(max_vertices=8), bodies(max_vertices=8), st.data())
 def test_classify_agrees_with_shapely_away_from_the_boundary(a, b, data):
+    note_bodies(a, b)
     eb = pc.entrance_block(a, b)
     union = eb.to_shapely()
     lo, hi = np.array(union.bounds).reshape(2, 2)
@@ -49,6 +50,7 @@ def _min_angle(a: pc.Shape, b: pc.Shape) -> float:
 @settings(max_examples=60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_classify_is_contact_on_the_boundary_of_the_block(a, b):
+    note_bodies(a, b)
     # The outline's vertices are computed (rounded): moved a rounding error across an
     # edge nearly parallel to the other body's edge, A overlaps B by a sliver much
     # deeper than the shift, which Shapely would also call overlap. Edge pairs are

@@ -99,7 +99,7 @@ class Component:
 
     @property
     def label(self) -> str:
-        """The paper's notation, e.g. ``E(A(2), B(0)[B vertex 3])``."""
+        """The paper's notation, e.g. ``E(A(2), B(0))[B vertex 3]``."""
         inner = ", ".join(str(f) for f in self.features)
         left, right = {
             "A2-B0": ("A(2)", "B(0)"),
@@ -165,12 +165,22 @@ class EntranceBlock:
     def _union(self) -> Any:
         import shapely
 
-        geoms = [c.geometry for c in self.components if not c.is_degenerate]
         # Components share edges up to rounding; floating-point GEOS overlay can fail on
         # such near-coincident edges ("Ring edge missing"), snap-rounding to the
-        # tolerance grid cannot.
-        areas = [_polygonal(g) for g in geoms]
-        return _polygonal(shapely.union_all(areas, grid_size=_grid(self.tolerance)))
+        # tolerance grid cannot. The vertex components are joined first; the edge
+        # components they cover (most of them) are then left out of the union.
+        grid = _grid(self.tolerance)
+        vertex = shapely.union_all(
+            [c.geometry for c in self.components if c.family != "A1-B1"], grid_size=grid
+        )
+        shapely.prepare(vertex)
+        edge = np.array(
+            [_polygonal(c.geometry) for c in self.components
+             if c.family == "A1-B1" and not c.is_degenerate],
+            dtype=object,
+        )
+        rest = edge[~shapely.covers(vertex, edge)] if len(edge) else edge
+        return _polygonal(shapely.union_all([vertex, *rest], grid_size=grid))
 
     @property
     def area(self) -> float:
