@@ -172,6 +172,26 @@ def test_degenerate_inputs_give_the_same_region():
     assert hole_count(plain) == hole_count(noisy) == 1
 
 
+def test_geos_fallback_gives_the_same_region(monkeypatch):
+    # If the outline parts ever failed to link into rings, GEOS unions the sums.
+    from polycontact._kernels import nfp as kn
+
+    a, b = shape(FRAME), shape(C_CAVITY)
+    want = pc.no_fit_polygon(a, b).region
+    real = kn.entrance_region
+
+    def unlinked(*args):
+        rings, starts, stats, cand, meta = real(*args)
+        meta = meta.copy()
+        meta[1] = 0.0
+        return rings, starts, stats, cand, meta
+
+    monkeypatch.setattr(kn, "entrance_region", unlinked)
+    got = pc.no_fit_polygon(a, b).region
+    assert shapely.symmetric_difference(got, want).area < 1e-12 * want.area
+    assert hole_count(got) == hole_count(want)
+
+
 # -- random shapes ----------------------------------------------------------------------
 
 

@@ -29,10 +29,14 @@ Examples
 
 from __future__ import annotations
 
+import functools
+import struct
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import shapely
 
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
@@ -49,6 +53,18 @@ HOLE_WIDTH_FACTOR = 16.0
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
+
+@functools.cache
+def _kernels() -> SimpleNamespace:
+    """The compiled kernels, imported on first use (Numba loads only when needed)."""
+    from ._kernels import decompose, nfp
+    from ._kernels.relation import relate_state
+
+    return SimpleNamespace(nfp=nfp, decompose=decompose, relate_state=relate_state)
+
+
+#: Little-endian WKB header of a one-ring polygon: byte order, type 3, rings, points.
+_WKB_POLYGON = struct.Struct("<BIII")
 
 _PIECES_CACHE: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
 _PIECES_CACHE_SIZE = 4096
@@ -147,8 +163,11 @@ def no_fit_polygon(
     a0 = _reference(a, reference)
     bxy, bst = _convex_pieces(b)
     axy, ast = _convex_pieces(a)
-    region, pts, segs, sums, sum_starts, eps = _entrance(bxy, bst, a0 - axy, ast, tolerance)
-    fits, slides = _clean_degenerate(pts, segs, sums, sum_starts, eps, _touching(a, b, a0, eps))
+    r = a0 - axy
+    region, pts, segs, eps = _entrance(bxy, bst, r, ast, tolerance)
+    fits, slides = _clean_degenerate(
+        pts, segs, (bxy, bst, r, ast), eps, lambda: _touching(a, b, a0, eps)
+    )
     return NoFitPolygon(region, fits, slides, a0, a, b, eps)
 
 
@@ -185,8 +204,6 @@ def inner_fit_polygon(
     >>> pc.inner_fit_polygon([(0, 0), (2, 0), (2, 4), (0, 4)], bin_, "origin").wkt
     'LINESTRING (0 0, 8 0)'
     """
-    import shapely
-
     a = as_shape(a, "a")
     c = as_shape(container, "container")
     a0 = _reference(a, reference)
@@ -197,7 +214,7 @@ def inner_fit_polygon(
     x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
     outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
     fxy, fst = _pieces_of_geometry(outside)
-    blocked, pts, segs, sums, sum_starts, eps = _entrance(fxy, fst, r, ast, tolerance)
+    blocked, pts, segs, eps = _entrance(fxy, fst, r, ast, tolerance)
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -210,7 +227,7 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return spill.area <= eps * (placed.length + c_poly.length)
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, sums, sum_starts, eps, fits)
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, (fxy, fst, r, ast), eps, lambda: fits)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -261,9 +278,7 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     hit = _PIECES_CACHE.get(key)
     if hit is not None:
         return hit
-    from ._kernels import decompose
-
-    if len(starts) == 2 and decompose.is_convex(xy):
+    if len(starts) == 2 and _kernels().decompose.is_convex(xy):
         pieces = (np.ascontiguousarray(xy), np.array([0, len(xy)], dtype=np.int64))
     else:
         pieces = _pieces_of_geometry(shape.to_shapely())
@@ -275,61 +290,56 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
 
 def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     """Convex pieces of a shapely (Multi)Polygon: GEOS triangulation, then merging."""
-    import shapely
-
-    from ._kernels import decompose
-
     tris = shapely.get_parts(shapely.constrained_delaunay_triangles(geom))
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
     eps = default_tolerance(coords.reshape(-1, 2))
-    return decompose.convex_pieces(np.ascontiguousarray(coords), eps)
+    return _kernels().decompose.convex_pieces(np.ascontiguousarray(coords), eps)
 
 
 def _entrance(
     bxy: np.ndarray, bst: np.ndarray, rxy: np.ndarray, rst: np.ndarray, tolerance: float | None
-) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
-    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, sums, eps).
-
-    Returns the region, the candidate exact fits and slides, the packed sums and eps.
+) -> tuple[Any, np.ndarray, np.ndarray, float]:
+    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, eps).
 
     The outline is assembled from the uncovered parts of the sums' edges (see
     :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
     should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
     seams and pinholes) are dropped.
     """
-    import shapely
-
-    from ._kernels import nfp as kn
-
-    (sums, starts, eps, ok, rxy_, rst_, area, length, pts, segs) = kn.entrance_region(
+    kn = _kernels().nfp
+    rxy_, rst_, stats, cand, meta = kn.entrance_region(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ANGLE_TOLERANCE
     )
-    if ok:
-        region = _polygon_from_rings(rxy_, rst_, area, length, HOLE_WIDTH_FACTOR * eps)
+    eps = float(meta[0])
+    if meta[1]:
+        region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
     else:
+        sums, starts = kn.convex_sums(bxy, bst, rxy, rst)
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         polys = shapely.polygons(shapely.linearrings(sums, indices=ids))
         region = _drop_slivers(shapely.union_all(polys), eps)
-    return region, pts, segs, sums, starts, eps
+    n_pts = int(meta[2])
+    return region, cand[:n_pts, :2], cand[n_pts:], eps
 
 
 def _polygon_from_rings(
-    xy: np.ndarray, starts: np.ndarray, area: np.ndarray, length: np.ndarray, width: float
+    xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float
 ) -> Any:
     """(Multi)Polygon from CCW shells and CW holes; rings thinner than width dropped."""
-    import shapely
-
+    if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
+        # one ring, the common case: WKB is the quickest way to hand it to GEOS
+        ring = np.concatenate([xy, xy[:1]])
+        return shapely.from_wkb(_WKB_POLYGON.pack(1, 3, 1, len(ring)) + ring.astype("<f8").tobytes())
     shells = []
     holes = []
     for k in range(len(starts) - 1):
-        if 2.0 * abs(area[k]) <= width * length[k]:
+        area, length = stats[k]
+        if 2.0 * abs(area) <= width * length:
             continue
-        (shells if area[k] > 0 else holes).append(xy[starts[k] : starts[k + 1]])
+        (shells if area > 0 else holes).append(xy[starts[k] : starts[k + 1]])
     if not shells:
         return shapely.Polygon()
     if len(shells) == 1:
-        if not holes:
-            return shapely.polygons(shapely.linearrings(shells[0]))
         return shapely.Polygon(shells[0], holes)
     shell_polys = [shapely.Polygon(r) for r in shells]
     owned: list[list[np.ndarray]] = [[] for _ in shells]
@@ -345,8 +355,6 @@ def _polygon_from_rings(
 
 def _drop_slivers(geom: Any, eps: float) -> Any:
     """Fill holes and drop parts thinner than the tolerance (twice area over length)."""
-    import shapely
-
     width = HOLE_WIDTH_FACTOR * eps
     out = []
     changed = False
@@ -371,8 +379,7 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
     """Check that A with its reference at p touches B without overlapping (classifier)."""
-    from ._kernels.relation import relate_state
-
+    relate_state = _kernels().relate_state
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
@@ -428,27 +435,22 @@ def _snap(p: np.ndarray, along: np.ndarray | None, edges: tuple, tol: float) -> 
 
 
 def _clean_degenerate(
-    pts: np.ndarray,
-    segs: np.ndarray,
-    sums: np.ndarray,
-    sum_starts: np.ndarray,
-    eps: float,
-    check: Any,
+    pts: np.ndarray, segs: np.ndarray, pieces: tuple, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
-    the true positions; exact fits and slide ends are mostly vertices of some sum, and
-    are snapped to them (within ``64 eps``).
+    the true positions; exact fits and slide ends are vertices of some sum or crossings
+    of sum edges, and are snapped to them (within ``64 eps``). ``pieces`` are the convex
+    pieces the sums are made of; ``make_check()`` gives the verifying predicate.
     """
-    import shapely
-
     near = HOLE_WIDTH_FACTOR * eps
     snap = 64.0 * eps
     slides = np.empty((0, 2, 2))
     if len(pts) == 0 and len(segs) == 0:
         return np.empty((0, 2)), slides
-    edges = _edges(sums, sum_starts)
+    check = make_check()
+    edges = _edges(*_kernels().nfp.convex_sums(*pieces))
     if len(segs):
         ends = segs.reshape(-1, 2, 2).copy()
         for k in range(len(ends)):

@@ -549,25 +549,33 @@ def _ring_stats(xy, starts):
 
 @njit(cache=True, nogil=True)
 def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
-    """Everything the no-fit polygon needs, in one call.
+    """Everything the no-fit polygon needs, in one call (few arrays: boxing costs).
 
     ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
     ``a0 − A``. ``eps <= 0`` means ``rel_tol * max(1, largest |coordinate| of the sums)``.
-    Returns ``(sums, sum_starts, eps, ok, ring_xy, ring_starts, ring_area, ring_length,
-    fit_points, slide_segments)``; ``ok`` is False when the outline parts did not link
-    into rings (the caller then unions the sums another way).
+    Returns ``(ring_xy, ring_starts, ring_stats, candidates, meta)``: the outline's
+    rings; their signed area and length (R, 2); candidate exact fits then candidate
+    slides as segments (C, 4), an exact fit as a zero-length segment; ``meta`` =
+    ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
+    did not link into rings (the caller then unions the sums another way).
     """
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
     if eps <= 0.0:
         eps = rel_tol * max(1.0, np.abs(sums).max())
+    meta = np.array([eps, 1.0, 0.0])
     if starts.shape[0] == 2:
         rs = np.array([0, sums.shape[0]], np.int64)
         area, length = _ring_stats(sums, rs)
-        return (sums, starts, eps, True, sums, rs, area, length,
-                np.empty((0, 2)), np.empty((0, 4)))
+        return sums, rs, np.column_stack((area, length)), np.empty((0, 4)), meta
     bb = _bboxes(sums, starts)
     outline, loose = edge_cover(sums, starts, bb, eps)
     ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
     area, length = _ring_stats(ring_xy, ring_starts)
     pts, segs = degenerate_contacts(sums, starts, bb, loose, eps, ang_tol)
-    return sums, starts, eps, ok, ring_xy, ring_starts, area, length, pts, segs
+    cand = np.empty((pts.shape[0] + segs.shape[0], 4))
+    cand[: pts.shape[0], 0:2] = pts
+    cand[: pts.shape[0], 2:4] = pts
+    cand[pts.shape[0]:] = segs
+    meta[1] = 1.0 if ok else 0.0
+    meta[2] = pts.shape[0]
+    return ring_xy, ring_starts, np.column_stack((area, length)), cand, meta
