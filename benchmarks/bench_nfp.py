@@ -150,19 +150,31 @@ def main() -> int:
         paths = [p for p in paths if p.stem in args.instances]
     # compile the kernels before timing
     pc.no_fit_polygon([(0, 0), (2, 0), (2, 2), (1, 1), (0, 2)], [(0, 0), (1, 0), (0, 1)])
-    head = f"{'instance':10} {'NFPs':>6} {'pc cold s':>9} {'pc warm s':>9} {'pyclipper s':>11} {'pysfcgal s':>10} {'clip/pc':>7} {'sfcgal/pc':>9}"
+    head = (f"{'instance':10} {'NFPs':>6} {'pc cold s':>9} {'pc warm s':>9} {'pyclipper s':>11} "
+            f"{'pysfcgal s':>10} {'clip/cold':>9} {'sfcgal/cold':>11} {'clip/warm':>9} "
+            f"{'sfcgal/warm':>11}")
     if args.check:
-        head += f" {'wrong pc':>8} {'wrong clip (false holes)':>24} {'wrong sfcgal':>12} {'fits+slides':>11}"
+        head += f" {'wrong pc':>8} {'wrong clip':>10} {'false holes clip':>16} {'wrong sfcgal':>12} {'fits+slides':>11}"
     print(head)
+    total = {"pc_cold": 0.0, "pc_warm": 0.0, "pyclipper": 0.0, "pysfcgal": 0.0, "nfps": 0}
     for path in paths:
         r = run(path, args.repeat, args.check)
-        line = (f"{r['instance']:10} {r['nfps']:6d} {r['pc_cold']:9.3f} {r['pc_warm']:9.3f} "
-                f"{r['pyclipper']:11.3f} {r['pysfcgal']:10.3f} "
-                f"{r['pyclipper'] / r['pc_cold']:7.2f} {r['pysfcgal'] / r['pc_cold']:9.2f}")
-        if args.check:
-            line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:>14d} ({r['clip_false_holes']:d})"
-                     f"{'':>6} {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")
-        print(line, flush=True)
+        for key in total:
+            total[key] += r[key]
+        print(_line(r, args.check), flush=True)
+    print(_line({"instance": "all", **total}, False))
+    return 0
+
+
+def _line(r: dict, check: bool) -> str:
+    line = (f"{r['instance']:10} {r['nfps']:6d} {r['pc_cold']:9.3f} {r['pc_warm']:9.3f} "
+            f"{r['pyclipper']:11.3f} {r['pysfcgal']:10.3f} "
+            f"{r['pyclipper'] / r['pc_cold']:9.2f} {r['pysfcgal'] / r['pc_cold']:11.2f} "
+            f"{r['pyclipper'] / r['pc_warm']:9.2f} {r['pysfcgal'] / r['pc_warm']:11.2f}")
+    if check:
+        line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:10d} {r['clip_false_holes']:16d}"
+                 f" {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")
+    return line
     return 0
 
 

@@ -124,3 +124,17 @@ def test_convex_pieces_tile_the_polygon(poly):
 def test_is_convex():
     assert decompose.is_convex(np.array([[0, 0], [1, 0], [2, 0], [1, 1]], float))
     assert not decompose.is_convex(np.array([[0, 0], [2, 0], [1, 0.5], [1, 2]], float))
+
+
+@settings(max_examples=80)
+@given(lattice_polygons())
+@example(shapely.Polygon([(0, 0), (2, 0), (4, 0), (4, 1), (2, 1), (2, 3), (0, 3), (0, 1)]))
+def test_ear_triangles_tile_a_simple_polygon(poly):
+    poly = shapely.Polygon(shapely.orient_polygons(poly).exterior)  # holes dropped
+    ring = np.asarray(poly.exterior.coords)[:-1]
+    ok, tri = decompose.ear_triangles(np.ascontiguousarray(ring))
+    assert ok
+    tris = [shapely.Polygon(t) for t in tri]
+    assert all(t.area > 0 for t in tris)
+    assert abs(sum(t.area for t in tris) - poly.area) < 1e-9  # no overlaps
+    assert shapely.symmetric_difference(shapely.union_all(tris), poly).area < 1e-9

@@ -66,6 +66,10 @@ def _kernels() -> SimpleNamespace:
 #: Little-endian WKB header of a one-ring polygon: byte order, type 3, rings, points.
 _WKB_POLYGON = struct.Struct("<BIII")
 
+#: Rings up to this many vertices are triangulated by ear clipping (quadratic, but
+#: without the cost of a GEOS call); larger ones and shapes with holes by GEOS.
+_EAR_CLIPPING_MAX = 64
+
 _PIECES_CACHE: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
 _PIECES_CACHE_SIZE = 4096
 
@@ -278,10 +282,20 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     hit = _PIECES_CACHE.get(key)
     if hit is not None:
         return hit
-    if len(starts) == 2 and _kernels().decompose.is_convex(xy):
+    dec = _kernels().decompose
+    ok = False
+    if len(starts) == 2 and dec.is_convex(xy):
         pieces = (np.ascontiguousarray(xy), np.array([0, len(xy)], dtype=np.int64))
-    else:
-        pieces = _pieces_of_geometry(shape.to_shapely())
+        ok = True
+    elif len(starts) == 2 and len(xy) <= _EAR_CLIPPING_MAX:
+        ok, tri = dec.ear_triangles(xy)
+        if ok:
+            pieces = dec.convex_pieces(tri, default_tolerance(xy))
+    if not ok:
+        # (shapely.Polygon is slow with an empty hole list)
+        geom = (shapely.Polygon(shape.exterior, shape.holes) if shape.holes
+                else shapely.polygons(shapely.linearrings(shape.exterior)))
+        pieces = _pieces_of_geometry(geom)
     if len(_PIECES_CACHE) >= _PIECES_CACHE_SIZE:
         _PIECES_CACHE.pop(next(iter(_PIECES_CACHE)))
     _PIECES_CACHE[key] = pieces

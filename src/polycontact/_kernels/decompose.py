@@ -148,3 +148,80 @@ def is_convex(xy):
         if _orient(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], xy[k, 0], xy[k, 1]) < 0.0:
             return False
     return True
+
+
+@njit(cache=True, nogil=True)
+def ear_triangles(xy):
+    """Triangles of a simple CCW ring by ear clipping (O(n^2) per ear; small rings).
+
+    Vertices where the ring goes straight on are skipped first. An ear is a strictly
+    convex vertex whose triangle holds no other remaining vertex, boundary included.
+    Returns ``(ok, tri)`` with ``tri`` of shape (T, 3, 2); ``ok`` is False when no ear
+    is found (only possible through rounding in a near-degenerate ring).
+    """
+    n = xy.shape[0]
+    nxt = np.empty(n, np.int64)
+    prv = np.empty(n, np.int64)
+    for i in range(n):
+        nxt[i] = (i + 1) % n
+        prv[i] = (i - 1) % n
+    tri = np.empty((max(n - 2, 1), 3, 2))
+    nt = 0
+    left = n
+    i = 0
+    misses = 0
+    while left > 3:
+        p = prv[i]
+        q = nxt[i]
+        o = _orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1])
+        ear = False
+        if o == 0.0:
+            # straight on (or a spike, refused by Shape): drop the vertex
+            nxt[p] = q
+            prv[q] = p
+            left -= 1
+            i = p
+            misses = 0
+            continue
+        if o > 0.0:
+            ear = True
+            j = nxt[q]
+            while j != p:
+                x = xy[j, 0]
+                y = xy[j, 1]
+                if not ((x == xy[p, 0] and y == xy[p, 1]) or (x == xy[i, 0] and y == xy[i, 1])
+                        or (x == xy[q, 0] and y == xy[q, 1])):
+                    if (_orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], x, y) >= 0.0
+                            and _orient(xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1], x, y) >= 0.0
+                            and _orient(xy[q, 0], xy[q, 1], xy[p, 0], xy[p, 1], x, y) >= 0.0):
+                        ear = False
+                        break
+                j = nxt[j]
+        if ear:
+            tri[nt, 0, 0] = xy[p, 0]
+            tri[nt, 0, 1] = xy[p, 1]
+            tri[nt, 1, 0] = xy[i, 0]
+            tri[nt, 1, 1] = xy[i, 1]
+            tri[nt, 2, 0] = xy[q, 0]
+            tri[nt, 2, 1] = xy[q, 1]
+            nt += 1
+            nxt[p] = q
+            prv[q] = p
+            left -= 1
+            i = p
+            misses = 0
+        else:
+            i = q
+            misses += 1
+            if misses > left:
+                return False, tri[:0]
+    p = prv[i]
+    q = nxt[i]
+    tri[nt, 0, 0] = xy[p, 0]
+    tri[nt, 0, 1] = xy[p, 1]
+    tri[nt, 1, 0] = xy[i, 0]
+    tri[nt, 1, 1] = xy[i, 1]
+    tri[nt, 2, 0] = xy[q, 0]
+    tri[nt, 2, 1] = xy[q, 1]
+    nt += 1
+    return True, tri[:nt].copy()
