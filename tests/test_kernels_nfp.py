@@ -52,7 +52,8 @@ def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
 def test_outline_rings_are_the_union(polys):
     xy, starts = _packed(polys)
     bb = kn._bboxes(xy, starts)
-    outline, loose = kn.edge_cover(xy, starts, bb, 1e-12)
+    fr = kn._frames(xy, starts)
+    outline, loose = kn.edge_cover(xy, starts, bb, fr, 1e-12)
     ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
     assert ok
     area, _ = kn._ring_stats(rxy, rst)
@@ -69,12 +70,13 @@ def test_two_squares_sharing_an_edge_have_one_outline_and_a_seam():
     left = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([left, left + [1, 0]])
     bb = kn._bboxes(xy, starts)
-    outline, loose = kn.edge_cover(xy, starts, bb, 1e-12)
+    fr = kn._frames(xy, starts)
+    outline, loose = kn.edge_cover(xy, starts, bb, fr, 1e-12)
     ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
     assert ok and len(rst) == 2
     assert kn._ring_stats(rxy, rst)[0][0] == 2.0
     # the shared edge x = 1 is loose (no open square covers it) and surrounded
-    pts, segs = kn.degenerate_contacts(xy, starts, bb, loose, 1e-12, 1e-9)
+    pts, segs = kn.degenerate_contacts(xy, starts, bb, fr, loose, 1e-12, 1e-9)
     assert len(pts) == 0
     assert {tuple(sorted([tuple(s[:2]), tuple(s[2:])])) for s in segs} == {((1, 0), (1, 1))}
 
@@ -83,18 +85,20 @@ def test_surrounded_on_an_l_of_three_squares():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1]])
     bb = kn._bboxes(xy, starts)
-    assert not kn.surrounded(1.0, 1.0, xy, starts, bb, 1e-12, 1e-9)  # reflex corner
-    assert kn.surrounded(0.5, 1.0, xy, starts, bb, 1e-12, 1e-9)  # shared edge
-    assert kn.surrounded(1.0, 0.5, xy, starts, bb, 1e-12, 1e-9)
-    assert not kn.surrounded(0.0, 0.5, xy, starts, bb, 1e-12, 1e-9)  # outline
+    fr = kn._frames(xy, starts)
+    assert not kn.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)  # reflex corner
+    assert kn.surrounded(0.5, 1.0, starts, bb, fr, 1e-12, 1e-9)  # shared edge
+    assert kn.surrounded(1.0, 0.5, starts, bb, fr, 1e-12, 1e-9)
+    assert not kn.surrounded(0.0, 0.5, starts, bb, fr, 1e-12, 1e-9)  # outline
 
 
 def test_surrounded_at_a_shared_corner_of_four_squares():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
     bb = kn._bboxes(xy, starts)
-    assert kn.surrounded(1.0, 1.0, xy, starts, bb, 1e-12, 1e-9)
-    assert not kn.surrounded(2.0, 1.0, xy, starts, bb, 1e-12, 1e-9)
+    fr = kn._frames(xy, starts)
+    assert kn.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
+    assert not kn.surrounded(2.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
 
 
 @st.composite

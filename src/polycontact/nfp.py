@@ -7,9 +7,12 @@ A orbits, B is fixed. The no-fit polygon is the entrance block seen as a region,
 the set of positions of A's reference point ``a0`` at which A touches or overlaps B;
 its outline is ∂E(A, B) = E(A(1), B(0)) ∪ E(A(0), B(1)) (paper §5(6)). It is built as
 the union of the convex sums ``B_i ⊕ (a0 − A_j)`` of convex pieces of B and A (holes
-included: the pieces come from a triangulation of the solid region, merged
-Hertel–Mehlhorn style), each sum made in O(p + q) by merging edge angles, and the union
-taken by GEOS.
+included: the pieces come from a triangulation of the solid region, by ear clipping or
+GEOS, merged Hertel–Mehlhorn style), each sum made in O(p + q) by merging edge angles.
+The union's outline is assembled directly: the parts of the sums' edges that lie inside
+no other sum are linked into rings (GEOS unions the sums only if that ever failed).
+Decompositions are cached by coordinates, so a nesting code calling this for many pairs
+of the same pieces decomposes each piece once.
 
 An area union loses the positions where A fits exactly: a jigsaw piece in its socket
 (an isolated point) or a square sliding in a slot of its own width (a segment). They are
@@ -37,6 +40,7 @@ from typing import Any
 
 import numpy as np
 import shapely
+import shapely.affinity
 
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
@@ -53,6 +57,7 @@ HOLE_WIDTH_FACTOR = 16.0
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
+
 
 @functools.cache
 def _kernels() -> SimpleNamespace:

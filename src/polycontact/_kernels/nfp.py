@@ -93,14 +93,41 @@ def _bboxes(xy, starts):
 
 
 @njit(cache=True, nogil=True)
-def _clip(ax, ay, bx, by, xy, s, e, q_first, eps):
+def _frames(xy, starts):
+    """Per edge of packed loops: unit direction (ux, uy), offset c, and 1 if not zero-length.
+
+    The signed distance of p from edge i's line (positive on its left) is
+    ``ux * py - uy * px - c``.
+    """
+    fr = np.zeros((xy.shape[0], 4))
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            ux = xy[j, 0] - xy[i, 0]
+            uy = xy[j, 1] - xy[i, 1]
+            ln = np.hypot(ux, uy)
+            if ln > 0.0:
+                ux /= ln
+                uy /= ln
+                fr[i, 0] = ux
+                fr[i, 1] = uy
+                fr[i, 2] = ux * xy[i, 1] - uy * xy[i, 0]
+                fr[i, 3] = 1.0
+    return fr
+
+
+@njit(cache=True, nogil=True)
+def _clip(ax, ay, bx, by, fr, s, e, q_first, eps):
     """Parts of segment ab (parameter t in [0, 1]) covered by convex polygon s:e.
 
-    Returns ``(lo1, hi1, lo0, hi0)``: the open interval inside the polygon by more than
-    eps (empty when lo >= hi), and the interval to remove from the union's outline:
-    strictly inside, or along a collinear edge of the polygon that runs the other way
-    (a seam between two sums) or the same way when the polygon comes first
-    (``q_first``; the duplicate outline edge is kept once).
+    ``fr`` holds the edge frames of :func:`_frames`. Returns ``(lo1, hi1, lo0, hi0)``:
+    the open interval inside the polygon by more than eps (empty when lo >= hi), and the
+    interval to remove from the union's outline: strictly inside, or along a collinear
+    edge of the polygon that runs the other way (a seam between two sums) or the same
+    way when the polygon comes first (``q_first``; the duplicate outline edge is kept
+    once).
     """
     lo1 = -np.inf
     hi1 = np.inf
@@ -108,14 +135,12 @@ def _clip(ax, ay, bx, by, xy, s, e, q_first, eps):
     hi0 = np.inf
     empty0 = False
     for i in range(s, e):
-        j = i + 1 if i + 1 < e else s
-        ux = xy[j, 0] - xy[i, 0]
-        uy = xy[j, 1] - xy[i, 1]
-        ln = np.hypot(ux, uy)
-        if ln == 0.0:
+        if fr[i, 3] == 0.0:
             continue
-        f0 = (ux * (ay - xy[i, 1]) - uy * (ax - xy[i, 0])) / ln
-        f1 = (ux * (by - xy[i, 1]) - uy * (bx - xy[i, 0])) / ln
+        ux = fr[i, 0]
+        uy = fr[i, 1]
+        f0 = ux * ay - uy * ax - fr[i, 2]
+        f1 = ux * by - uy * bx - fr[i, 2]
         df = f1 - f0
         # margin eps
         if df == 0.0:
@@ -132,8 +157,7 @@ def _clip(ax, ay, bx, by, xy, s, e, q_first, eps):
             same = ux * (bx - ax) + uy * (by - ay) > 0.0
             if same and not q_first:
                 empty0 = True
-            continue
-        if df == 0.0:
+        elif df == 0.0:
             if f0 <= 0.0:
                 empty0 = True
         else:
@@ -142,6 +166,8 @@ def _clip(ax, ay, bx, by, xy, s, e, q_first, eps):
                 lo0 = max(lo0, tc)
             else:
                 hi0 = min(hi0, tc)
+        if lo1 >= hi1 and (empty0 or lo0 >= hi0):
+            break
     if empty0:
         hi0 = -np.inf
     return lo1, hi1, lo0, hi0
@@ -171,8 +197,8 @@ def _subtract(lo, hi, n, a, b):
 
 
 @njit(cache=True, nogil=True)
-def _arc_of(px, py, xy, s, e, eps):
-    """Directions from p entering polygon s:e: (kind, start, length).
+def _arc_of(px, py, fr, s, e, eps):
+    """Directions from p entering polygon s:e (edge frames ``fr``): (kind, start, length).
 
     kind 0: p is not within eps of the polygon; 1: p inside by more than eps (every
     direction); 2: the arc [start, start + length] of entering directions.
@@ -182,13 +208,11 @@ def _arc_of(px, py, xy, s, e, eps):
     smax = -np.inf
     emin = np.inf
     for i in range(s, e):
-        j = i + 1 if i + 1 < e else s
-        ux = xy[j, 0] - xy[i, 0]
-        uy = xy[j, 1] - xy[i, 1]
-        ln = np.hypot(ux, uy)
-        if ln == 0.0:
+        if fr[i, 3] == 0.0:
             continue
-        f = (ux * (py - xy[i, 1]) - uy * (px - xy[i, 0])) / ln
+        ux = fr[i, 0]
+        uy = fr[i, 1]
+        f = ux * py - uy * px - fr[i, 2]
         if f < -eps:
             return 0, 0.0, 0.0
         if f > eps:
@@ -217,8 +241,12 @@ def _arc_of(px, py, xy, s, e, eps):
 
 
 @njit(cache=True, nogil=True)
-def surrounded(px, py, xy, starts, bb, eps, ang_tol):
-    """Whether the closed sums cover every direction around p (p is inside E)."""
+def surrounded(px, py, starts, bb, fr, eps, ang_tol):
+    """Whether the closed sums cover every direction around p (p is inside E).
+
+    ``bb``: the sums' bounding boxes (:func:`_bboxes`); ``fr``: their edge frames
+    (:func:`_frames`).
+    """
     k = starts.shape[0] - 1
     starts_a = np.empty(k)
     lens = np.empty(k)
@@ -226,7 +254,7 @@ def surrounded(px, py, xy, starts, bb, eps, ang_tol):
     for p in range(k):
         if px < bb[p, 0] - eps or px > bb[p, 2] + eps or py < bb[p, 1] - eps or py > bb[p, 3] + eps:
             continue
-        kind, st, ln = _arc_of(px, py, xy, starts[p], starts[p + 1], eps)
+        kind, st, ln = _arc_of(px, py, fr, starts[p], starts[p + 1], eps)
         if kind == 1:
             return True
         if kind == 2:
@@ -250,7 +278,7 @@ def surrounded(px, py, xy, starts, bb, eps, ang_tol):
 
 
 @njit(cache=True, nogil=True)
-def edge_cover(xy, starts, bb, eps):
+def edge_cover(xy, starts, bb, fr, eps):
     """Uncovered parts of the sums' edges.
 
     Returns ``(outline, loose)``, both (M, 4) segments x0, y0, x1, y1:
@@ -269,6 +297,7 @@ def edge_cover(xy, starts, bb, eps):
     loose = np.empty((4 * n_edges, 4))
     no = 0
     nl = 0
+    hint = -1
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
@@ -288,15 +317,21 @@ def edge_cover(xy, starts, bb, eps):
             hi1[0] = 1.0
             lo0[0] = 0.0
             hi0[0] = 1.0
-            for q in range(k):
+            # The sum that swallowed the previous edge whole is tried first: an edge
+            # inside the union is then usually done after one test.
+            for qi in range(-1, k):
+                q = hint if qi < 0 else qi
+                if q < 0 or (qi >= 0 and q == hint):
+                    continue
                 if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
                     continue
-                a1, b1, a0, b0 = _clip(ax, ay, bx, by, xy, starts[q], starts[q + 1], q < p, eps)
+                a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
                 if a1 < b1 and n1 > 0:
                     n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
                 if a0 < b0 and n0 > 0:
                     n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
                 if n1 == 0 and n0 == 0:
+                    hint = q
                     break
             dx = bx - ax
             dy = by - ay
@@ -446,17 +481,14 @@ def _split_pinched(xy, starts, tol):
 
 
 @njit(cache=True, nogil=True)
-def _in_some_sum(px, py, xy, starts, bb):
+def _in_some_sum(px, py, starts, bb, fr):
     """Whether p lies in some closed sum (no tolerance: used at a distance 64 eps)."""
     for q in range(starts.shape[0] - 1):
         if px < bb[q, 0] or px > bb[q, 2] or py < bb[q, 1] or py > bb[q, 3]:
             continue
-        s = starts[q]
-        e = starts[q + 1]
         inside = True
-        for i in range(s, e):
-            j = i + 1 if i + 1 < e else s
-            if (xy[j, 0] - xy[i, 0]) * (py - xy[i, 1]) - (xy[j, 1] - xy[i, 1]) * (px - xy[i, 0]) < 0.0:
+        for i in range(starts[q], starts[q + 1]):
+            if fr[i, 3] != 0.0 and fr[i, 0] * py - fr[i, 1] * px - fr[i, 2] < 0.0:
                 inside = False
                 break
         if inside:
@@ -465,7 +497,7 @@ def _in_some_sum(px, py, xy, starts, bb):
 
 
 @njit(cache=True, nogil=True)
-def degenerate_contacts(xy, starts, bb, loose, eps, ang_tol):
+def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
     """Exact-fit points and slide segments among the ``loose`` parts of :func:`edge_cover`.
 
     A loose part is an exact fit (when shorter than 8 eps) or a slide where the closed
@@ -484,7 +516,7 @@ def degenerate_contacts(xy, starts, bb, loose, eps, ang_tol):
         if ln <= 8.0 * eps:
             mx = 0.5 * (ax + bx)
             my = 0.5 * (ay + by)
-            if surrounded(mx, my, xy, starts, bb, eps, ang_tol):
+            if surrounded(mx, my, starts, bb, fr, eps, ang_tol):
                 pts.append((mx, my))
             continue
         ux = (bx - ax) / ln
@@ -494,15 +526,18 @@ def degenerate_contacts(xy, starts, bb, loose, eps, ang_tol):
         x1 = max(ax, bx) + eps
         y0 = min(ay, by) - eps
         y1 = max(ay, by) + eps
-        for v in range(xy.shape[0]):
-            if xy[v, 0] < x0 or xy[v, 0] > x1 or xy[v, 1] < y0 or xy[v, 1] > y1:
+        for q in range(starts.shape[0] - 1):
+            if bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
                 continue
-            dx = xy[v, 0] - ax
-            dy = xy[v, 1] - ay
-            if abs(ux * dy - uy * dx) <= eps:
-                t = ux * dx + uy * dy
-                if 0.0 < t < ln:
-                    ts.append(t)
+            for v in range(starts[q], starts[q + 1]):
+                if xy[v, 0] < x0 or xy[v, 0] > x1 or xy[v, 1] < y0 or xy[v, 1] > y1:
+                    continue
+                dx = xy[v, 0] - ax
+                dy = xy[v, 1] - ay
+                if abs(ux * dy - uy * dx) <= eps:
+                    t = ux * dx + uy * dy
+                    if 0.0 < t < ln:
+                        ts.append(t)
         tarr = np.sort(np.array(ts))
         open_at = -1.0
         for q in range(tarr.shape[0] - 1):
@@ -513,8 +548,8 @@ def degenerate_contacts(xy, starts, bb, loose, eps, ang_tol):
             tm = 0.5 * (t0 + t1)
             mx = ax + tm * ux
             my = ay + tm * uy
-            inside = _in_some_sum(mx + off * uy, my - off * ux, xy, starts, bb) and surrounded(
-                mx, my, xy, starts, bb, eps, ang_tol
+            inside = _in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr) and surrounded(
+                mx, my, starts, bb, fr, eps, ang_tol
             )
             if inside and open_at < 0.0:
                 open_at = t0
@@ -568,10 +603,11 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
         area, length = _ring_stats(sums, rs)
         return sums, rs, np.column_stack((area, length)), np.empty((0, 4)), meta
     bb = _bboxes(sums, starts)
-    outline, loose = edge_cover(sums, starts, bb, eps)
+    fr = _frames(sums, starts)
+    outline, loose = edge_cover(sums, starts, bb, fr, eps)
     ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
     area, length = _ring_stats(ring_xy, ring_starts)
-    pts, segs = degenerate_contacts(sums, starts, bb, loose, eps, ang_tol)
+    pts, segs = degenerate_contacts(sums, starts, bb, fr, loose, eps, ang_tol)
     cand = np.empty((pts.shape[0] + segs.shape[0], 4))
     cand[: pts.shape[0], 0:2] = pts
     cand[: pts.shape[0], 2:4] = pts

@@ -12,6 +12,7 @@ __all__ = ["plot_nfp"]
 def _patch(geom: Any, **style: Any) -> Any:
     """A matplotlib patch for a shapely (Multi)Polygon, holes left open."""
     import shapely
+    import shapely.affinity
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
 
@@ -56,6 +57,7 @@ def plot_nfp(nfp: Any, placement: Any = None, ax: Any = None) -> Any:
     """
     import matplotlib.pyplot as plt
     import shapely
+    import shapely.affinity
 
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 7), layout="constrained")
