@@ -1,0 +1,188 @@
+"""Benchmark: polycontact.classify against Shapely, and import time.
+
+Run: ``python benchmarks/bench_classify.py`` (add ``--quick`` for fewer repeats).
+
+What is timed (medians of several repeats, peers measured in the same run):
+- one pair at a time, from raw (N, 2) float64 arrays: ``classify(a, b)`` (which
+  validates both rings and classifies them) against ``shapely.Polygon(a)``,
+  ``shapely.Polygon(b)`` then ``.intersects`` / ``.relate`` (Shapely does not check
+  validity on construction);
+- 100 000 pairs of 12-gons in one call: ``classify_many`` on a (P, N, 2) array against
+  ``shapely.relate`` / ``shapely.intersects`` vectorised on prebuilt polygon arrays (and
+  with their construction by ``shapely.polygons`` counted);
+- growth from 8 to 1024 vertices;
+- ``python -X importtime -c "import polycontact"``.
+
+The bodies are random concave star polygons: a radius of 1 + 0.3 sin(k t + phase) with
+k in 2..5, plus a jitter of half the vertex spacing. The pairs are a third separate (B
+placed near A without touching), a third contact (A moved out of a random overlap along
+a random direction, by bisection, until the boundaries touch within the tolerance) and a
+third penetrating.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+import shapely
+
+import polycontact as pc
+
+
+def star(rng: np.random.Generator, n: int) -> np.ndarray:
+    """A random concave star polygon with n vertices, counter-clockwise."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False) + rng.uniform(0, 2 * np.pi)
+    k = rng.integers(2, 6)
+    r = 1 + 0.3 * np.sin(k * t + rng.uniform(0, 2 * np.pi))
+    r += 0.5 * (2 * np.pi / n) * rng.uniform(-1, 1, n)
+    return np.ascontiguousarray(np.c_[np.cos(t) * r, np.sin(t) * r])
+
+
+def touching(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+    """A moved along a random direction until it just touches B (bisection on the state)."""
+    u = rng.normal(size=2)
+    u /= np.hypot(*u)
+    lo, hi = 0.0, 6.0  # A + lo u overlaps B, A + hi u is clear of it
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        state = pc.classify(a + mid * u, b).state
+        if state is pc.State.CONTACT:
+            return np.ascontiguousarray(a + mid * u)
+        if state is pc.State.PENETRATING:
+            lo = mid
+        else:
+            hi = mid
+    return None
+
+
+def make_pairs(rng: np.random.Generator, n: int, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``count`` pairs of n-gons: separate, contact and penetrating in equal parts."""
+    out: list[tuple[np.ndarray, np.ndarray]] = []
+    want = ["separate", "contact", "penetrating"]
+    while len(out) < count:
+        kind = want[len(out) % 3]
+        a = star(rng, n)
+        b = star(rng, n) + rng.uniform(-1.2, 1.2, 2)
+        state = pc.classify(a, b).state
+        if kind == "separate" and state is pc.State.SEPARATE:
+            out.append((a, b))
+        elif kind == "penetrating" and state is pc.State.PENETRATING:
+            out.append((a, b))
+        elif kind == "contact" and state is pc.State.PENETRATING:
+            moved = touching(a, b, rng)
+            if moved is not None:
+                out.append((moved, b))
+    return out
+
+
+def per_call(fn, pairs, repeats: int) -> float:
+    """Median over repeats of the mean time per pair, in microseconds."""
+    fn(*pairs[0])
+    runs = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for a, b in pairs:
+            fn(a, b)
+        runs.append((time.perf_counter() - t0) / len(pairs) * 1e6)
+    return statistics.median(runs)
+
+
+def ours(a, b):
+    return pc.classify(a, b).state
+
+
+def shapely_intersects(a, b):
+    return shapely.Polygon(a).intersects(shapely.Polygon(b))
+
+
+def shapely_relate(a, b):
+    return shapely.Polygon(a).relate(shapely.Polygon(b))
+
+
+def median_time(fn, repeats: int) -> float:
+    fn()
+    runs = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        runs.append(time.perf_counter() - t0)
+    return statistics.median(runs)
+
+
+def import_time() -> float:
+    """Cumulative import time of polycontact (seconds), from ``-X importtime``."""
+    runs = []
+    for _ in range(5):
+        res = subprocess.run(
+            [sys.executable, "-X", "importtime", "-c", "import polycontact"],
+            capture_output=True, text=True, check=True,
+        )
+        line = [ln for ln in res.stderr.splitlines() if ln.rstrip().endswith("| polycontact")]
+        runs.append(int(line[-1].split("|")[1]) / 1e6)
+    return statistics.median(runs)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer pairs and repeats")
+    args = parser.parse_args()
+    repeats = 3 if args.quick else 7
+    rng = np.random.default_rng(20261122)
+    pc.warmup()
+
+    print("classify from raw arrays vs Shapely construction + predicate (us per pair)")
+    print(f"{'vertices':>8} {'classify':>10} {'intersects':>11} {'relate':>10} "
+          f"{'x intersects':>13} {'x relate':>9}")
+    for n in (12, 96, 1024):
+        count = 600 if n < 1000 else 90
+        pairs = make_pairs(rng, n, count)
+        t_ours = per_call(ours, pairs, repeats)
+        t_int = per_call(shapely_intersects, pairs, repeats)
+        t_rel = per_call(shapely_relate, pairs, repeats)
+        print(f"{n:>8} {t_ours:>10.2f} {t_int:>11.2f} {t_rel:>10.2f} "
+              f"{t_int / t_ours:>13.1f} {t_rel / t_ours:>9.1f}")
+
+    print("\nclassify_many: 100 000 pairs of 12-gons (seconds)")
+    base = make_pairs(rng, 12, 3000)
+    idx = rng.integers(0, len(base), 100_000)
+    arr_a = np.stack([base[i][0] for i in idx])
+    arr_b = np.stack([base[i][1] for i in idx])
+    poly_a = shapely.polygons(arr_a)
+    poly_b = shapely.polygons(arr_b)
+    t_many = median_time(lambda: pc.classify_many(arr_a, arr_b).states, repeats)
+    t_rel = median_time(lambda: shapely.relate(poly_a, poly_b), repeats)
+    t_int = median_time(lambda: shapely.intersects(poly_a, poly_b), repeats)
+    t_build = median_time(lambda: (shapely.polygons(arr_a), shapely.polygons(arr_b)), repeats)
+    t_dist = median_time(lambda: pc.classify_many(arr_a, arr_b).distances, max(3, repeats // 2))
+    print(f"  classify_many (validate + states)      {t_many:8.3f}")
+    print(f"  classify_many + signed distances       {t_dist:8.3f}")
+    print(f"  shapely.relate (prebuilt)              {t_rel:8.3f}   ratio {t_rel / t_many:6.1f}x")
+    print(f"  shapely.intersects (prebuilt)          {t_int:8.3f}   ratio {t_int / t_many:6.1f}x")
+    print(f"  shapely.polygons x2 + relate           {t_build + t_rel:8.3f}   "
+          f"ratio {(t_build + t_rel) / t_many:6.1f}x")
+    many = pc.classify_many(arr_a, arr_b).states[:3000]
+    rel = shapely.relate(poly_a[:3000], poly_b[:3000])
+    inter = shapely.intersects(poly_a[:3000], poly_b[:3000])
+    oracle = np.where([m[0] == "2" for m in rel], 2, np.where(inter, 1, 0))
+    print(f"  states equal to Shapely's (first 3000 pairs): {np.mean(many == oracle):.4f}"
+          " (contact pairs are touching only within the tolerance)")
+
+    print("\ngrowth: classify vs Shapely construction + relate (us per pair)")
+    print(f"{'vertices':>8} {'classify':>10} {'relate':>10} {'ratio':>7} {'classify/n':>11}")
+    for n in (8, 16, 32, 64, 128, 256, 512, 1024):
+        pairs = make_pairs(rng, n, 150 if n <= 256 else 60)
+        t_ours = per_call(ours, pairs, repeats)
+        t_rel = per_call(shapely_relate, pairs, repeats)
+        print(f"{n:>8} {t_ours:>10.2f} {t_rel:>10.2f} {t_rel / t_ours:>7.1f} "
+              f"{1000 * t_ours / n:>9.1f}ns")
+
+    print(f"\nimport polycontact: {import_time():.3f} s (cumulative, -X importtime, median of 5)")
+
+
+if __name__ == "__main__":
+    main()
