@@ -162,6 +162,19 @@ def test_curve_sweep_is_not_the_filled_sweep():
         shapely.MultiLineString([[(0, 0), (11, 0)], [(11, 10), (0, 10)]]))
 
 
+def test_no_pinhole_where_many_components_meet():
+    # Regression: the snapped union of A with itself had a hole 1.4e-14 wide where
+    # several components meet; its corners, taken as outline points, lie 0.21 inside E.
+    a = pc.Shape([(0.03807015713455442, 2.000049816043191),
+                  (0.29077141391611083, 3.6706055138781286),
+                  (-1.2566393287113387, 2.892965327746735),
+                  (-1.2488407611933097, 1.5389124590139875),
+                  (-0.5230174431123771, 1.610559239058842)])
+    union = pc.entrance_block(a, a, method="pairs").to_shapely()
+    assert union.geom_type == "Polygon" and len(union.interiors) == 0
+    _same_region(union, _minkowski_reference(a, a, a.centroid))
+
+
 def test_bad_input_is_refused():
     a = pc.Shape(SQUARE)
     with pytest.raises(ValueError, match="method must be one of 'swept', 'pairs', got 'fast'"):
