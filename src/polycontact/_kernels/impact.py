@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import boundary_distance, relate_state
+from .relation import relate_state
 
 NO_HIT = 0
 HIT = 1
@@ -30,7 +30,8 @@ _PENETRATING = 2
 
 @njit(cache=True, nogil=True)
 def place(r, c0, m, t, out):
-    """Write the vertices of the body at time t into ``out`` (same shape as ``r``)."""
+    """Write the vertices of the body at time t into ``out`` (same shape as ``r``);
+    return the centroid ``(cx, cy)`` at t."""
     th = m[4] * t + 0.5 * m[5] * t * t
     cs = np.cos(th)
     sn = np.sin(th)
@@ -41,6 +42,7 @@ def place(r, c0, m, t, out):
         y = r[i, 1]
         out[i, 0] = cx + cs * x - sn * y
         out[i, 1] = cy + sn * x + cs * y
+    return cx, cy
 
 
 @njit(cache=True, nogil=True)
@@ -57,14 +59,60 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     return lin + wa * la + wb * lb
 
 
-#: Largest m·n for which :func:`pair_step` (all vertex–edge pairs, no allocation) is
-#: used; above it the sweep of ``boundary_distance`` is cheaper per iteration.
-PAIR_STEP_MAX = 1024
+#: Largest m·n for which :func:`pair_step` visits every vertex–edge pair; above it the
+#: edges of the other body are sorted by their smallest x once per step and each vertex
+#: visits only those within its reach.
+PAIR_SCAN_MAX = 256
+
+#: After a step h shorter than its window, the next window is this many times h: the
+#: directional bounds tighten as the window (the angle turned in it) shrinks.
+WINDOW_GROWTH = 2.0
 
 
 @njit(cache=True, nogil=True)
-def _point_segment2(px, py, ax, ay, bx, by):
-    """Squared distance from p to the segment ab."""
+def _bilinear_max(w0, w1, f0, f1):
+    """Largest w·f for w between w0 and w1 and f between f0 and f1 (at a corner)."""
+    return max(max(w0 * f0, w0 * f1), max(w1 * f0, w1 * f1))
+
+
+@njit(cache=True, nogil=True)
+def _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ex0, ey0, ex1, ey1, cex, cey, re, mw):
+    """Upper bound of the closing rate of vertex p and edge e along their fixed normal.
+
+    n = (p − q)/d, q the point of e nearest p. The edge lies in the half-plane
+    {x : (x − q)·n <= 0}, so sep(t) = p(t)·n − max over material points x of e of
+    x(t)·n equals d now and never exceeds dist(p(t), e(t)): the pair cannot touch while
+    sep > 0. A material point moves along n at v(t)·n + ω(t) f(t) with
+    f = (J R(θ) r)·n, and the max of moving points grows no faster than the fastest of
+    them, so −sep' <= −Δv(t)·n − ω_v(t) f_p(t) + max over x of ω_e(t) f_x(t), with
+    Δv = v_v − v_e. Δv·n and ω are affine in t: their extremes over the window are at its
+    ends. f is a sinusoid of amplitude |r| in θ, so while the body turns by at most Θ it
+    stays within |r| Θ of its current value (and within ±|r|); along the edge the
+    current value is affine in x and |r_x| convex, so the ends bound it. Each product
+    ω f is then bounded at a corner of its box (:func:`_bilinear_max`). A negative
+    result means the pair is separating throughout the window.
+
+    ``mw`` is a tuple holding, for the vertex body v and the edge body e: Δv at the
+    window ends (4), ω_v at the ends, ω_e at the ends, Θ_v, Θ_e (a tuple, not an array:
+    no reference counting per call).
+    """
+    inv = 1.0 / d
+    nx = (px - qx) * inv
+    ny = (py - qy) * inv
+    lin = -min(mw[0] * nx + mw[1] * ny, mw[2] * nx + mw[3] * ny)
+    fv = (px - cvx) * ny - (py - cvy) * nx
+    sv = rv * mw[8]
+    rot_v = _bilinear_max(mw[4], mw[5], -min(rv, fv + sv), -max(-rv, fv - sv))
+    fa = (ex0 - cex) * ny - (ey0 - cey) * nx
+    fb = (ex1 - cex) * ny - (ey1 - cey) * nx
+    se = re * mw[9]
+    rot_e = _bilinear_max(mw[6], mw[7], max(-re, min(fa, fb) - se), min(re, max(fa, fb) + se))
+    return lin + rot_v + rot_e
+
+
+@njit(cache=True, nogil=True)
+def _nearest_on_segment(px, py, ax, ay, bx, by):
+    """``(qx, qy, d2)``: the point of segment ab nearest p and its squared distance."""
     dx = bx - ax
     dy = by - ay
     den = dx * dx + dy * dy
@@ -72,48 +120,138 @@ def _point_segment2(px, py, ax, ay, bx, by):
     if den > 0.0:
         u = ((px - ax) * dx + (py - ay) * dy) / den
         u = min(1.0, max(0.0, u))
-    ex = ax + u * dx - px
-    ey = ay + u * dy - py
-    return ex * ex + ey * ey
+    qx = ax + u * dx
+    qy = ay + u * dy
+    return qx, qy, (px - qx) * (px - qx) + (py - qy) * (py - qy)
 
 
 @njit(cache=True, nogil=True)
-def _one_way_step(xa, ra_len, sa, xb, sb, rb_len, lin, wa, wb, dmin2, step):
-    for k in range(sb.shape[0] - 1):
-        s = sb[k]
-        e = sb[k + 1]
-        for j in range(s, e):
-            j1 = j + 1 if j + 1 < e else s
-            reach_b = wb * max(rb_len[j], rb_len[j1])
-            for i in range(xa.shape[0]):
-                d2 = _point_segment2(xa[i, 0], xa[i, 1], xb[j, 0], xb[j, 1], xb[j1, 0],
-                                     xb[j1, 1])
+def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, lam, step):
+    """The step after pair (p, edge ab) is charged, for a pair nearer than ``lam`` plus
+    ``step`` times its plain speed bound ``speed``: the time it needs to come within
+    ``lam`` at its directional rate (:func:`_pair_rate`), or at ``speed`` when it is
+    already within ``lam`` (no reliable normal; the step is then 0)."""
+    qx, qy, d2 = _nearest_on_segment(px, py, ax, ay, bx, by)
+    d = np.sqrt(d2)
+    if d <= lam:
+        return 0.0
+    rate = min(speed, _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ax, ay, bx, by, cex, cey,
+                                 re, mw))
+    if d - lam < step * rate:
+        return (d - lam) / rate
+    return step
+
+
+@njit(cache=True, nogil=True)
+def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, mw, lin, wv, we, lam, dmin2, step,
+                  scan_all):
+    """Vertices of one body against the edges of the other (``wv``, ``we``: the bounds
+    of |ω| over the window; ``nxt``, ``re_max`` from :func:`edge_table`)."""
+    ne = xe.shape[0]
+    if scan_all:
+        for i in range(xv.shape[0]):
+            base = lin + wv * rv_len[i]
+            px = xv[i, 0]
+            py = xv[i, 1]
+            for j in range(ne):
+                j1 = nxt[j]
+                d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
                 dmin2 = min(dmin2, d2)
-                speed = lin + wa * ra_len[i] + reach_b
-                reach = step * speed
-                if d2 < reach * reach:   # this pair closes sooner than the best so far
-                    step = np.sqrt(d2) / speed
+                speed = base + we * re_max[j]
+                if d2 < (step * speed + lam) ** 2:     # else it cannot shorten the step
+                    step = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
+                                      xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
+                                      lam, step)
+        return dmin2, step
+    xmin = np.empty(ne)
+    maxw = 0.0
+    lmax = 0.0
+    for j in range(ne):
+        xmin[j] = min(xe[j, 0], xe[nxt[j], 0])
+        maxw = max(maxw, abs(xe[j, 0] - xe[nxt[j], 0]))
+        lmax = max(lmax, re_max[j])
+    order = np.argsort(xmin)
+    sorted_x = xmin[order]
+    for i in range(xv.shape[0]):
+        px = xv[i, 0]
+        py = xv[i, 1]
+        base = lin + wv * rv_len[i]
+        # a pair farther than this cannot shorten the step
+        reach = step * (base + we * lmax) + lam
+        o = np.searchsorted(sorted_x, px - reach - maxw)
+        while o < ne and sorted_x[o] <= px + reach:
+            j = order[o]
+            o += 1
+            j1 = nxt[j]
+            if max(xe[j, 0], xe[j1, 0]) < px - reach:
+                continue
+            if min(xe[j, 1], xe[j1, 1]) > py + reach or max(xe[j, 1], xe[j1, 1]) < py - reach:
+                continue
+            d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
+            dmin2 = min(dmin2, d2)
+            speed = base + we * re_max[j]
+            if d2 < (step * speed + lam) ** 2:
+                step = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
+                                  xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
+                                  lam, step)
     return dmin2, step
 
 
 @njit(cache=True, nogil=True)
-def pair_step(xa, sa, ra_len, xb, sb, rb_len, lin, wa, wb):
-    """``(distance, step)``: the boundary distance, and a time step that no vertex–edge
-    pair can close.
+def edge_table(starts, r_len):
+    """``(nxt, r_max)``: the vertex after each vertex in its loop, and the largest
+    centroid distance of each edge's two ends."""
+    n = r_len.shape[0]
+    nxt = np.empty(n, np.int64)
+    r_max = np.empty(n)
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        for j in range(s, e):
+            j1 = j + 1 if j + 1 < e else s
+            nxt[j] = j1
+            r_max[j] = max(r_len[j], r_len[j1])
+    return nxt, r_max
 
-    ``ra_len[i]`` is the distance of vertex i of A from A's centroid (likewise B);
-    ``lin``, ``wa``, ``wb`` bound |Δv + Δa t|, |ω_A + α_A t|, |ω_B + α_B t| over the
-    window. A point q of edge e of B moves relative to a vertex p of A at most at
-    ``lin + wa |r_p| + wb max(|r_e0|, |r_e1|)`` (|r| is convex along the edge), so the
-    distance from p to e cannot close before distance / speed. Boundaries that do not
-    cross are at the distance of their nearest vertex–edge pair, and they cannot begin
-    to meet without some vertex reaching an edge, so the smallest such time over all
-    pairs (both ways) is a step without contact. Per pair, a vertex near its centroid
-    is not charged the speed of the farthest one: the step is never shorter than
-    distance / :func:`speed_bound`.
+
+@njit(cache=True, nogil=True)
+def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam):
+    """``(distance, step)``: the gap, and a time step in [0, t1 − t0] that no
+    vertex–edge pair can close.
+
+    ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ra_len[i]`` the
+    distance of vertex i from it, ``ea`` its :func:`edge_table` (likewise B); ``ma``,
+    ``mb`` the motion vectors. Each
+    pair p (vertex of one body), e (edge of the other) is charged the closing rate of
+    :func:`_pair_rate` along its own normal, and never more than the plain speed bound
+    ``|Δv| + |ω_v| |r_p| + |ω_e| max |r_e|`` (|r| is convex along the edge); within
+    ``lam`` of touching (no reliable normal) the plain bound alone. Boundaries that do
+    not cross are at the distance of their nearest vertex–edge pair, and they cannot
+    begin to meet without some vertex reaching an edge, so the smallest pair time (both
+    ways) is a step without contact.
+
+    ``distance`` is exact when it is below ``lam`` or below the step times the speed
+    bound; farther pairs are skipped and it may then be larger than the true gap.
     """
-    dmin2, step = _one_way_step(xa, ra_len, sa, xb, sb, rb_len, lin, wa, wb, np.inf, np.inf)
-    dmin2, step = _one_way_step(xb, rb_len, sb, xa, sa, ra_len, lin, wb, wa, dmin2, step)
+    h = t1 - t0
+    dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
+    dv0y = ma[1] - mb[1] + (ma[3] - mb[3]) * t0
+    dv1x = ma[0] - mb[0] + (ma[2] - mb[2]) * t1
+    dv1y = ma[1] - mb[1] + (ma[3] - mb[3]) * t1
+    lin = max(np.hypot(dv0x, dv0y), np.hypot(dv1x, dv1y))
+    wa0 = ma[4] + ma[5] * t0
+    wa1 = ma[4] + ma[5] * t1
+    wb0 = mb[4] + mb[5] * t0
+    wb1 = mb[4] + mb[5] * t1
+    wa = max(abs(wa0), abs(wa1))
+    wb = max(abs(wb0), abs(wb1))
+    scan_all = xa.shape[0] * xb.shape[0] <= PAIR_SCAN_MAX
+    mw = (dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h)
+    dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], mw, lin, wa, wb, lam,
+                                np.inf, h, scan_all)
+    mw = (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h)
+    dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], mw, lin, wb, wa, lam,
+                                dmin2, step, scan_all)
     return np.sqrt(dmin2), step
 
 
@@ -151,11 +289,10 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     :func:`polycontact.time_of_impact` for the argument). From a non-penetrating time
     t with boundary distance d and speed bound S over a window [t, t + H]:
 
-    - ``d / S`` is a step during which the boundaries cannot meet (the distance is
-      S-Lipschitz), so no penetration can start; for small bodies (m·n <=
-      ``PAIR_STEP_MAX``) the longer step of :func:`pair_step` (each vertex–edge pair
-      charged its own speed) is used. If the step is at least the probe length
-      ``tau = min(time_tol / 2, lam / S)`` it is taken;
+    - :func:`pair_step` gives a step h <= H during which no vertex–edge pair can
+      meet (each pair charged its closing rate along its own normal), so the
+      boundaries cannot meet and no penetration can start. If h is at least the probe
+      length ``tau = min(time_tol / 2, lam / S)`` it is taken;
     - otherwise the step is ``tau``: a penetration that begins and ends inside it lasts
       less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
       other body; any other penetration is still penetrating at ``t + tau``.
@@ -170,7 +307,10 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     rb_len = np.empty(rb.shape[0])
     for i in range(rb.shape[0]):
         rb_len[i] = np.hypot(rb[i, 0], rb[i, 1])
-    small = ra.shape[0] * rb.shape[0] <= PAIR_STEP_MAX
+    pa = np.empty(2)
+    pb = np.empty(2)
+    ea = edge_table(sa, ra_len)
+    eb = edge_table(sb, rb_len)
     first_contact = -1.0
     it = 0
     t = 0.0
@@ -178,8 +318,8 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
         t1 = intervals[k, 0]
         t2 = intervals[k, 1]
         t = t1
-        place(ra, ca, ma, t, xa)
-        place(rb, cb, mb, t, xb)
+        pa[0], pa[1] = place(ra, ca, ma, t, xa)
+        pb[0], pb[1] = place(rb, cb, mb, t, xb)
         # after t = 0 an interval opens with the bounding circles just touching: apart
         if t == 0.0 and relate_state(xa, sa, xb, sb, eps) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
@@ -189,13 +329,8 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
             if it > max_iter:
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
             t_end = min(t2, t + window)
-            lin, wa, wb = _window_rates(ma, mb, t, t_end)
-            s = lin + wa * la + wb * lb
-            if small:
-                d, h = pair_step(xa, sa, ra_len, xb, sb, rb_len, lin, wa, wb)
-            else:
-                d = boundary_distance(xa, sa, xb, sb)
-                h = d / s if s > 0.0 else np.inf
+            s = speed_bound(ma, la, mb, lb, t, t_end)
+            d, h = pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end, lam)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
@@ -205,7 +340,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
                 h = t_end - t
                 window = 2.0 * window
             else:
-                window = max(4.0 * h, 4.0 * tau)
+                window = max(WINDOW_GROWTH * h, 4.0 * tau)
             probe = h < tau
             if probe:
                 h = tau
@@ -216,11 +351,12 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
                 # a conservative step: the boundaries have not met before t_new, so
                 # the interiors do not overlap at t_new (overlap is preceded by touch)
                 t = t_new
-                place(ra, ca, ma, t, xa)
-                place(rb, cb, mb, t, xb)
+                pa[0], pa[1] = place(ra, ca, ma, t, xa)
+                pb[0], pb[1] = place(rb, cb, mb, t, xb)
                 continue
-            st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new, eps)
-            if st == _PENETRATING:
+            pa[0], pa[1] = place(ra, ca, ma, t_new, xa)
+            pb[0], pb[1] = place(rb, cb, mb, t_new, xb)
+            if relate_state(xa, sa, xb, sb, eps) == _PENETRATING:
                 lo = t
                 hi = t_new
                 goal = 0.1 * tau
