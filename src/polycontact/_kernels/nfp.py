@@ -284,7 +284,8 @@ def edge_cover(xy, starts, bb, fr, eps):
     Returns ``(outline, loose)``, both (M, 4) segments x0, y0, x1, y1:
     ``outline`` are the parts in no other sum's interior and on no seam, each kept once:
     the boundary of the union, oriented with the union on its left; ``loose`` are the
-    parts in no other open sum shrunk by eps, where exact fits and slides lie.
+    parts in no other open sum shrunk by eps, where exact fits and slides lie, less
+    those lying within a longer outline part.
     """
     k = starts.shape[0] - 1
     cap = 2 * k + 4
@@ -298,6 +299,7 @@ def edge_cover(xy, starts, bb, fr, eps):
     no = 0
     nl = 0
     hint = -1
+    by_x = np.argsort(bb[:, 0])
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
@@ -320,7 +322,9 @@ def edge_cover(xy, starts, bb, fr, eps):
             # The sum that swallowed the previous edge whole is tried first: an edge
             # inside the union is then usually done after one test.
             for qi in range(-1, k):
-                q = hint if qi < 0 else qi
+                q = hint if qi < 0 else by_x[qi]
+                if qi >= 0 and bb[q, 0] > x1:
+                    break  # sums sorted by their smallest x: none further can meet the edge
                 if q < 0 or (qi >= 0 and q == hint):
                     continue
                 if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
@@ -343,7 +347,19 @@ def edge_cover(xy, starts, bb, fr, eps):
                 outline[no, 2] = ax + hi0[r] * dx
                 outline[no, 3] = ay + hi0[r] * dy
                 no += 1
+            # A loose part within a long outline part of the same edge lies on the
+            # outline: no exact fit or slide there (those parts are seams or points).
+            length = np.hypot(dx, dy)
+            dt = 64.0 * eps / length
             for r in range(n1):
+                on_outline = False
+                for u in range(n0):
+                    if ((hi0[u] - lo0[u]) * length > 128.0 * eps and lo0[u] - dt <= lo1[r]
+                            and hi1[r] <= hi0[u] + dt):
+                        on_outline = True
+                        break
+                if on_outline:
+                    continue
                 if nl == loose.shape[0]:
                     loose = _grow(loose)
                 loose[nl, 0] = ax + lo1[r] * dx
