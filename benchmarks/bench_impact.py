@@ -30,7 +30,6 @@ import shapely
 import polycontact as pc
 from polycontact import Motion, Shape
 from polycontact._kernels import impact as ki
-from polycontact._kernels.broad_phase import overlap_intervals
 from polycontact.broad_phase import BROAD_PHASE_INFLATION
 from polycontact.impact import CONTACT_RESOLUTION
 
@@ -92,7 +91,8 @@ def median_time(fn, repeat: int) -> float:
 
 
 def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
-    """What a query costs without building the result: broad phase + search kernel."""
+    """What a query costs without building the result: broad phase + search, one kernel
+    call (``_kernels.impact.query``) for either method."""
     ra = a.packed[0] - a.centroid
     rb = b.packed[0] - b.centroid
     ca = np.asarray(a.centroid)
@@ -104,13 +104,9 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
     la, lb = a.bounding_radius, b.bounding_radius
 
     def run():
-        iv = overlap_intervals(ca, va, la, cb, vb, lb, t_max, BROAD_PHASE_INFLATION)
-        if method == "exact":
-            return ki.exact_search(ra, a.packed[1], ca, va, a.bounding_radius, rb,
-                                   b.packed[1], cb, vb, b.bounding_radius, iv, TOL, eps, lam,
-                                   1_000_000)
-        return ki.sampled_search(ra, a.packed[1], ca, va, rb, b.packed[1], cb, vb, iv, TOL,
-                                 samples, eps)
+        return ki.query(ra, a.packed[1], ca, va, la, rb, b.packed[1], cb, vb, lb, t_max,
+                        BROAD_PHASE_INFLATION, method == "exact", TOL, eps, lam, 1_000_000,
+                        samples)
 
     return run
 

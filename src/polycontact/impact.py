@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .broad_phase import check_motion, check_t_max, intervals_array
+from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_t_max
 from .motion import Motion
 from .relation import Feature, State, classify
 from .shape import Shape, as_shape
@@ -186,8 +186,9 @@ def _positive(value: Any, what: str) -> float:
 
 def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
     """Largest |coordinate| the body can reach in [0, t_max] (for the tolerance)."""
+    cx, cy = shape.centroid
     reach = (
-        float(np.max(np.abs(shape.centroid)))
+        max(abs(float(cx)), abs(float(cy)))
         + math.hypot(*motion.velocity) * t_max
         + 0.5 * math.hypot(*motion.acceleration) * t_max * t_max
         + shape.bounding_radius
@@ -323,25 +324,16 @@ def time_of_impact(
 
     from ._kernels import impact as ki
 
-    intervals = intervals_array(a, ma, b, mb, t_max)
     eps = RELATIVE_TOLERANCE * max(_path_scale(a, ma, t_max), _path_scale(b, mb, t_max))
-    ra = a.packed[0] - a.centroid
-    rb = b.packed[0] - b.centroid
+    (xa, sa), (xb, sb) = a.packed, b.packed
     ca = np.asarray(a.centroid, dtype=np.float64)
     cb = np.asarray(b.centroid, dtype=np.float64)
-    if method == "exact":
-        lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
-        code, t_hi, t_lo, t_contact, iters, reached = ki.exact_search(
-            ra, a.packed[1], ca, ma.array, a.bounding_radius,
-            rb, b.packed[1], cb, mb.array, b.bounding_radius,
-            intervals, tol, eps, lam, int(max_iterations),
-        )
-    else:
-        code, t_hi, t_lo, t_contact, iters = ki.sampled_search(
-            ra, a.packed[1], ca, ma.array, rb, b.packed[1], cb, mb.array,
-            intervals, tol, int(samples), eps,
-        )
-        reached = t_hi if code == ki.HIT else t_max
+    la, lb = a.bounding_radius, b.bounding_radius
+    intervals, code, t_hi, t_lo, t_contact, iters, reached = ki.query(
+        xa - ca, sa, ca, ma.array, la, xb - cb, sb, cb, mb.array, lb, t_max,
+        BROAD_PHASE_INFLATION, method == "exact", tol, eps, CONTACT_RESOLUTION * (la + lb),
+        int(max_iterations), int(samples),
+    )
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps)
 
@@ -367,7 +359,7 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         state=state,
         status=status,
         method=method,
-        broad_phase=tuple((float(s), float(e)) for s, e in intervals),
+        broad_phase=tuple(map(tuple, intervals.tolist())),
         time_bracket=bracket,
         iterations=iters,
         searched_to=reached,

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .broad_phase import overlap_intervals
 from .relation import relate_state
 
 NO_HIT = 0
@@ -419,3 +420,23 @@ def sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps)
         if found:
             return HIT, hi, lo, first_contact, evals
     return NO_HIT, -1.0, -1.0, first_contact, evals
+
+
+@njit(cache=True, nogil=True)
+def query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, exact, time_tol, eps, lam,
+          max_iter, samples):
+    """Broad phase and search in one call (one dispatch from Python).
+
+    Returns ``(intervals, status, t_hi, t_lo, first_contact, iterations, t_reached)``:
+    :func:`exact_search` when ``exact``, else :func:`sampled_search` with ``samples``
+    points (``t_reached`` is then t_hi on a hit, else t_max).
+    """
+    iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
+    if exact:
+        code, hi, lo, contact, its, reached = exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb,
+                                                           lb, iv, time_tol, eps, lam,
+                                                           max_iter)
+        return iv, code, hi, lo, contact, its, reached
+    code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, iv, time_tol,
+                                                samples, eps)
+    return iv, code, hi, lo, contact, its, hi if code == HIT else t_max
