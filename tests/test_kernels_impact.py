@@ -159,7 +159,7 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
     d, step = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
                            b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, 0.0, 1.0, 0.0)
+                           ma.array, mb.array, 0.0, 1.0, 0.0, np.full(3, -1))
     assert math.isclose(d, boundary_distance(*a.packed, *b.packed), rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -194,7 +194,7 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     lam = 1e-3
     d, step = ki.pair_step(pa.packed[0], np.array(pa.centroid), la, ki.edge_table(a.packed[1], la),
                            pb.packed[0], np.array(pb.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, t0, t0 + window, lam)
+                           ma.array, mb.array, t0, t0 + window, lam, np.full(3, -1))
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)

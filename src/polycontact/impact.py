@@ -266,8 +266,9 @@ def time_of_impact(
     to matter are skipped by a sweep over x. Near contact the step
     shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
     λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and classifies
-    the end. A penetrating end is bisected back to the non-penetrating start, which
-    gives ``time`` within τ ≤ ``time_tolerance``/2 after the first penetration. Not
+    the end. A penetrating end is the hit, with the non-penetrating start of the
+    probe as ``time_bracket[0]``: ``time`` is within τ ≤ ``time_tolerance``/2 after the
+    first penetration. Not
     penetrating at the end means either no penetration began in the step, or one began
     and ended inside it — lasting under ``time_tolerance``/2 with no point moving more
     than λ relative to the other body: a penetration shallower than the contact
