@@ -94,8 +94,8 @@ def _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ex0, ey0, ex1, ey1, cex, cey, re
     result means the pair is separating throughout the window.
 
     ``mw`` is a tuple holding, for the vertex body v and the edge body e: Δv at the
-    window ends (4), ω_v at the ends, ω_e at the ends, Θ_v, Θ_e (a tuple, not an array:
-    no reference counting per call).
+    window ends (4), ω_v at the ends, ω_e at the ends, Θ_v, Θ_e, max |Δv|, the window
+    length (a tuple, not an array: no reference counting per call).
     """
     inv = 1.0 / d
     nx = (px - qx) * inv
@@ -127,20 +127,61 @@ def _nearest_on_segment(px, py, ax, ay, bx, by):
 
 
 @njit(cache=True, nogil=True)
+def _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw):
+    """Upper bound of the closing rate of vertex p towards the line of an edge of the
+    other body, the line turning with that body (``n``: the edge's outward normal now).
+
+    The signed distance s = (p − x)·n(t), x a point of the line, changes at
+    (ṗ − ẋ_p)·n(t) with ẋ_p = v_e + ω_e J (p − c_e), the velocity of the other body's
+    point under p. So −s' = −Δv·n(t) − ω_v (J (p − c_v))·n(t) + ω_e (J (p − c_e))·n(t).
+    While n turns by at most Θ_e: Δv·n(t) is within |Δv| Θ_e of Δv·n(now) (affine in
+    t: extremes at the window ends); (J R_v r_p)·n is within |r_p| (Θ_v + Θ_e) of its
+    current value; p − c_e moves by at most δ = h (|Δv| + |ω_v| |r_p|), so
+    (J (p − c_e))·n is within δ + (|p − c_e| + δ) Θ_e of its current value. The
+    products with ω are bounded at a corner (:func:`_bilinear_max`). The distance from
+    p to the edge is at least s, so the pair stays apart while s > 0.
+    """
+    lin = mw[10]
+    t1 = -min(mw[0] * nx + mw[1] * ny, mw[2] * nx + mw[3] * ny) + lin * mw[9]
+    gv = (px - cvx) * ny - (py - cvy) * nx
+    sv = rv * (mw[8] + mw[9])
+    t2 = _bilinear_max(mw[4], mw[5], -min(rv, gv + sv), -max(-rv, gv - sv))
+    ux = px - cex
+    uy = py - cey
+    delta = lin * mw[11] + rv * mw[8]
+    ru = np.sqrt(ux * ux + uy * uy) + delta
+    ge = ux * ny - uy * nx
+    se = delta + ru * mw[9]
+    t3 = _bilinear_max(mw[6], mw[7], max(-ru, ge - se), min(ru, ge + se))
+    return t1 + t2 + t3
+
+
+@njit(cache=True, nogil=True)
 def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, lam, step):
     """The step after pair (p, edge ab) is charged, for a pair nearer than ``lam`` plus
-    ``step`` times its plain speed bound ``speed``: the time it needs to come within
-    ``lam`` at its directional rate (:func:`_pair_rate`), or at ``speed`` when it is
-    already within ``lam`` (no reliable normal; the step is then 0)."""
+    ``step`` times its plain speed bound ``speed``: the longer of the times it needs to
+    come within ``lam`` at its fixed-normal rate (:func:`_pair_rate`, never above
+    ``speed``) and, when p is outside the edge's line by more than ``lam``, at its rate
+    towards the turning line (:func:`_line_rate`); both are lower bounds of the same
+    time. 0 when it is already within ``lam`` (no reliable normal)."""
     qx, qy, d2 = _nearest_on_segment(px, py, ax, ay, bx, by)
     d = np.sqrt(d2)
     if d <= lam:
         return 0.0
     rate = min(speed, _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ax, ay, bx, by, cex, cey,
                                  re, mw))
-    if d - lam < step * rate:
-        return (d - lam) / rate
-    return step
+    best = (d - lam) / rate if rate > 0.0 else np.inf
+    ex = bx - ax
+    ey = by - ay
+    ln = np.sqrt(ex * ex + ey * ey)
+    if ln > 0.0 and best < step:
+        nx = ey / ln                    # interior on the left: outward on the right
+        ny = -ex / ln
+        s0 = (px - ax) * nx + (py - ay) * ny
+        if s0 > lam:
+            rl = _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw)
+            best = max(best, (s0 - lam) / rl if rl > 0.0 else np.inf)
+    return min(step, best)
 
 
 @njit(cache=True, nogil=True)
@@ -257,8 +298,8 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit)
     wa = max(abs(wa0), abs(wa1))
     wb = max(abs(wb0), abs(wb1))
     scan_all = xa.shape[0] * xb.shape[0] <= PAIR_SCAN_MAX
-    mwa = (dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h)
-    mwb = (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h)
+    mwa = (dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h, lin, h)
+    mwb = (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h, lin, h)
     step = h
     if crit[0] >= 0:
         i = crit[1]
