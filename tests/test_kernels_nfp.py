@@ -142,3 +142,24 @@ def test_ear_triangles_tile_a_simple_polygon(poly):
     assert all(t.area > 0 for t in tris)
     assert abs(sum(t.area for t in tris) - poly.area) < 1e-9  # no overlaps
     assert shapely.symmetric_difference(shapely.union_all(tris), poly).area < 1e-9
+
+
+def test_snap_to_vertices_and_crossings():
+    # sums: a unit square and a square shifted right by 1 and up by 0.5
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy, starts = _packed([sq, sq + [1, 0.5]])
+    e = 1e-13
+    pts = np.array([[1 + e, 1 - e],      # near a vertex
+                    [1 + e, 0.5 + e],    # near (1, 0.5): a vertex of the second square
+                    [0.5, 1 + e],        # on the top edge, sliding along x: no crossing
+                    [1 + e, 0.25],       # on x = 1, sliding along y: no crossing near
+                    [5.0, 5.0]])         # far from everything: unchanged
+    along = np.array([[0, 0], [0, 0], [1, 0], [0, 1], [0, 0]], float)
+    out = kn.snap(pts, along, xy, starts, 1e-10)
+    assert out[0].tolist() == [1.0, 1.0]
+    assert out[1].tolist() == [1.0, 0.5]
+    assert out[2].tolist() == pts[2].tolist() and out[3].tolist() == pts[3].tolist()
+    assert out[4].tolist() == [5.0, 5.0]
+    # a slide's end near the crossing of x = 0.5 + t with the square's top edge y = 1
+    cross = kn.snap(np.array([[0.7, 1 + e]]), np.array([[1.0, 2.0]]), xy, starts, 1e-10)
+    assert cross[0, 1] == 1.0 and abs(cross[0, 0] - 0.7) < 1e-12

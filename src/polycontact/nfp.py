@@ -409,50 +409,6 @@ def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
     return check
 
 
-def _edges(xy: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end points of every edge of packed loops."""
-    nxt = np.arange(1, len(xy) + 1)
-    nxt[starts[1:] - 1] = starts[:-1]
-    return xy, xy[nxt]
-
-
-def _snap(p: np.ndarray, along: np.ndarray | None, edges: tuple, tol: float) -> np.ndarray:
-    """A candidate position made exact: the nearest vertex of the sums within ``tol``;
-    else the crossing, nearest to ``p``, of the line through ``p`` along ``along`` (a
-    slide's end) or of the sum edge nearest to ``p`` (an exact fit) with another sum
-    edge passing within ``tol``; else ``p`` itself."""
-    e0, e1 = edges
-    d = np.hypot(e0[:, 0] - p[0], e0[:, 1] - p[1])
-    i = int(np.argmin(d))
-    if d[i] <= tol:
-        return e0[i].copy()
-    u = e1 - e0
-    ln = np.hypot(u[:, 0], u[:, 1])
-    t = np.clip(((p - e0) * u).sum(axis=1) / np.where(ln > 0, ln * ln, 1.0), 0.0, 1.0)
-    dist = np.hypot(*(e0 + t[:, None] * u - p).T)
-    close = np.flatnonzero((dist <= tol) & (ln > 0))
-    if len(close) == 0:
-        return p
-    if along is None:
-        k = close[np.argmin(dist[close])]
-        base, direction = e0[k], u[k] / ln[k]
-    else:
-        base, direction = p, along / np.hypot(*along)
-    best = p
-    best_d = np.inf
-    for k in close:
-        w = u[k] / ln[k]
-        den = direction[0] * w[1] - direction[1] * w[0]
-        if abs(den) < 1e-6:
-            continue
-        s_ = ((e0[k, 0] - base[0]) * w[1] - (e0[k, 1] - base[1]) * w[0]) / den
-        q = base + s_ * direction
-        dq = np.hypot(*(q - p))
-        if dq < best_d:
-            best, best_d = q, dq
-    return best if best_d <= tol else p
-
-
 def _clean_degenerate(
     pts: np.ndarray, segs: np.ndarray, pieces: tuple, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -469,13 +425,13 @@ def _clean_degenerate(
     if len(pts) == 0 and len(segs) == 0:
         return np.empty((0, 2)), slides
     check = make_check()
-    edges = _edges(*_kernels().nfp.convex_sums(*pieces))
+    kn = _kernels().nfp
+    sums, starts = kn.convex_sums(*pieces)
+    pts = kn.snap(pts, np.zeros_like(pts), sums, starts, snap)
     if len(segs):
-        ends = segs.reshape(-1, 2, 2).copy()
-        for k in range(len(ends)):
-            along = ends[k, 1] - ends[k, 0]
-            ends[k, 0] = _snap(ends[k, 0], along, edges, snap)
-            ends[k, 1] = _snap(ends[k, 1], along, edges, snap)
+        flat = segs.reshape(-1, 2)
+        along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
+        ends = kn.snap(flat, along, sums, starts, snap).reshape(-1, 2, 2)
         ends = ends[np.hypot(*(ends[:, 1] - ends[:, 0]).T) > near]
         lines = shapely.line_merge(shapely.union_all(shapely.linestrings(ends)), directed=False)
         merged = [
@@ -492,7 +448,6 @@ def _clean_degenerate(
             slides = slides[np.lexsort((slides[:, 0, 1], slides[:, 0, 0]))]
     fits: list[np.ndarray] = []
     for p in pts:
-        p = _snap(p, None, edges, snap)
         if any(np.hypot(*(p - q)) <= near for q in fits):
             continue
         if len(slides) and shapely.distance(

@@ -631,3 +631,89 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     meta[1] = 1.0 if ok else 0.0
     meta[2] = pts.shape[0]
     return ring_xy, ring_starts, np.column_stack((area, length)), cand, meta
+
+
+@njit(cache=True, nogil=True)
+def snap(points, along, xy, starts, tol):
+    """Candidate positions made exact (a copy of ``points`` (P, 2) is returned).
+
+    Each point goes to the nearest vertex of the sums within ``tol``; else to the
+    nearest crossing within ``tol`` of a line through it with a sum edge passing within
+    ``tol``: the line along ``along[k]`` (a slide's direction) or, where that is zero
+    (an exact fit), the line of the nearest such edge. Points with neither stay.
+    """
+    out = points.copy()
+    nv = xy.shape[0]
+    nxt = np.empty(nv, np.int64)
+    for k in range(starts.shape[0] - 1):
+        for i in range(starts[k], starts[k + 1]):
+            nxt[i] = i + 1 if i + 1 < starts[k + 1] else starts[k]
+    for k in range(points.shape[0]):
+        px = points[k, 0]
+        py = points[k, 1]
+        best = tol
+        bi = -1
+        for i in range(nv):
+            d = np.hypot(xy[i, 0] - px, xy[i, 1] - py)
+            if d <= best:
+                best = d
+                bi = i
+        if bi >= 0:
+            out[k, 0] = xy[bi, 0]
+            out[k, 1] = xy[bi, 1]
+            continue
+        # the edge nearest to p, among those within tol
+        near_e = -1
+        near_d = tol
+        for i in range(nv):
+            j = nxt[i]
+            ux = xy[j, 0] - xy[i, 0]
+            uy = xy[j, 1] - xy[i, 1]
+            ln2 = ux * ux + uy * uy
+            if ln2 == 0.0:
+                continue
+            t = min(1.0, max(0.0, ((px - xy[i, 0]) * ux + (py - xy[i, 1]) * uy) / ln2))
+            d = np.hypot(xy[i, 0] + t * ux - px, xy[i, 1] + t * uy - py)
+            if d <= near_d:
+                near_d = d
+                near_e = i
+        ax_ = along[k, 0]
+        ay_ = along[k, 1]
+        if ax_ == 0.0 and ay_ == 0.0:
+            if near_e < 0:
+                continue
+            bx_ = xy[near_e, 0]
+            by_ = xy[near_e, 1]
+            ax_ = xy[nxt[near_e], 0] - bx_
+            ay_ = xy[nxt[near_e], 1] - by_
+        else:
+            bx_ = px
+            by_ = py
+        la = np.hypot(ax_, ay_)
+        ax_ /= la
+        ay_ /= la
+        best = tol
+        for i in range(nv):
+            j = nxt[i]
+            ux = xy[j, 0] - xy[i, 0]
+            uy = xy[j, 1] - xy[i, 1]
+            ln = np.hypot(ux, uy)
+            if ln == 0.0:
+                continue
+            t = min(1.0, max(0.0, ((px - xy[i, 0]) * ux + (py - xy[i, 1]) * uy) / (ln * ln)))
+            if np.hypot(xy[i, 0] + t * ux - px, xy[i, 1] + t * uy - py) > tol:
+                continue
+            wx = ux / ln
+            wy = uy / ln
+            den = ax_ * wy - ay_ * wx
+            if abs(den) < 1e-6:
+                continue
+            s = ((xy[i, 0] - bx_) * wy - (xy[i, 1] - by_) * wx) / den
+            qx = bx_ + s * ax_
+            qy = by_ + s * ay_
+            d = np.hypot(qx - px, qy - py)
+            if d <= best:
+                best = d
+                out[k, 0] = qx
+                out[k, 1] = qy
+    return out
