@@ -115,7 +115,8 @@ def lattice_polygons(draw):
 def test_convex_pieces_tile_the_polygon(poly):
     tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
-    xy, starts = decompose.convex_pieces(np.ascontiguousarray(coords), 1e-12)
+    vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
+    xy, starts = decompose.convex_pieces(vxy, idx.reshape(-1, 3), 1e-12)
     pieces = [shapely.Polygon(p) for p in _split(xy, starts)]
     assert len(pieces) <= len(tris)
     for p, ring in zip(pieces, _split(xy, starts)):
@@ -138,10 +139,14 @@ def test_ear_triangles_tile_a_simple_polygon(poly):
     ring = np.asarray(poly.exterior.coords)[:-1]
     ok, tri = decompose.ear_triangles(np.ascontiguousarray(ring))
     assert ok
-    tris = [shapely.Polygon(t) for t in tri]
+    tris = [shapely.Polygon(ring[t]) for t in tri]
     assert all(t.area > 0 for t in tris)
     assert abs(sum(t.area for t in tris) - poly.area) < 1e-9  # no overlaps
     assert shapely.symmetric_difference(shapely.union_all(tris), poly).area < 1e-9
+    xy, starts = decompose.convex_pieces(ring, tri, 1e-12)
+    pieces = [shapely.Polygon(p) for p in _split(xy, starts)]
+    assert all(decompose.is_convex(p) for p in _split(xy, starts))
+    assert abs(sum(p.area for p in pieces) - poly.area) < 1e-9
 
 
 def test_snap_to_vertices_and_crossings():

@@ -44,7 +44,7 @@ import shapely.affinity
 
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE, default_tolerance
+from .tolerances import RELATIVE_TOLERANCE
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]
 
@@ -295,7 +295,7 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     elif len(starts) == 2 and len(xy) <= _EAR_CLIPPING_MAX:
         ok, tri = dec.ear_triangles(xy)
         if ok:
-            pieces = dec.convex_pieces(tri, default_tolerance(xy))
+            pieces = dec.convex_pieces(xy, tri, RELATIVE_TOLERANCE)
     if not ok:
         # (shapely.Polygon is slow with an empty hole list)
         geom = (shapely.Polygon(shape.exterior, shape.holes) if shape.holes
@@ -311,8 +311,9 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     """Convex pieces of a shapely (Multi)Polygon: GEOS triangulation, then merging."""
     tris = shapely.get_parts(shapely.constrained_delaunay_triangles(geom))
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
-    eps = default_tolerance(coords.reshape(-1, 2))
-    return _kernels().decompose.convex_pieces(np.ascontiguousarray(coords), eps)
+    # GEOS adds no vertex: triangles share exact coordinates, hence vertex indices
+    vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
+    return _kernels().decompose.convex_pieces(vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE)
 
 
 def _entrance(

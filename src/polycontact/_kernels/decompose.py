@@ -9,11 +9,7 @@ four times the minimum number of convex pieces, and in practice close to it.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
-from numba.typed import Dict
-
-_POINT = types.UniTuple(types.float64, 2)
-_INT = types.int64
+from numba import njit
 
 
 @njit(cache=True, nogil=True)
@@ -22,63 +18,58 @@ def _orient(ax, ay, bx, by, cx, cy):
 
 
 @njit(cache=True, nogil=True)
-def convex_pieces(tri, eps):
-    """Convex pieces covering the union of triangles ``tri`` (float64, shape (T, 3, 2)).
+def convex_pieces(vxy, tri, rel_tol):
+    """Convex pieces covering the union of triangles.
 
-    Triangles of either orientation are accepted; triangles whose doubled area is at most
-    ``eps`` times their longest edge are dropped (zero area). Returns ``(xy, starts)``:
-    the pieces packed like a shape's loops, each counter-clockwise, piece ``k`` in rows
-    ``starts[k]:starts[k + 1]``. Vertices where two merged edges continue straight are
+    ``vxy`` (V, 2) float64 holds the vertices and ``tri`` (T, 3) int64 the triangles as
+    vertex indices (either orientation). Two triangles are neighbours when they share
+    an edge, i.e. two vertex indices. Triangles whose doubled area is at most ``eps``
+    times their longest edge are dropped (zero area), with
+    ``eps = rel_tol * max(1, largest |coordinate|)``. Returns ``(xy, starts)``: the
+    pieces packed like a shape's loops, each counter-clockwise, piece ``k`` in rows
+    ``starts[k]:starts[k + 1]``. Vertices where two merged edges go straight on are
     removed.
     """
     n_tri = tri.shape[0]
-    # Vertex ids by exact coordinates (the triangulation reuses the input coordinates).
-    ids = Dict.empty(key_type=_POINT, value_type=_INT)
-    vx = np.empty(3 * n_tri)
-    vy = np.empty(3 * n_tri)
+    nv = vxy.shape[0]
+    vx = vxy[:, 0]
+    vy = vxy[:, 1]
+    eps = rel_tol * max(1.0, np.abs(vxy).max())
     org = np.empty(3 * n_tri, np.int64)
     nxt = np.empty(3 * n_tri, np.int64)
     prv = np.empty(3 * n_tri, np.int64)
     alive = np.zeros(3 * n_tri, np.bool_)
-    nv = 0
     nh = 0
     for t in range(n_tri):
-        ax, ay = tri[t, 0, 0], tri[t, 0, 1]
-        bx, by = tri[t, 1, 0], tri[t, 1, 1]
-        cx, cy = tri[t, 2, 0], tri[t, 2, 1]
-        o = _orient(ax, ay, bx, by, cx, cy)
-        longest = max(np.hypot(bx - ax, by - ay), np.hypot(cx - bx, cy - by),
-                      np.hypot(ax - cx, ay - cy))
+        a = tri[t, 0]
+        b = tri[t, 1]
+        c = tri[t, 2]
+        o = _orient(vx[a], vy[a], vx[b], vy[b], vx[c], vy[c])
+        longest = max(np.hypot(vx[b] - vx[a], vy[b] - vy[a]),
+                      np.hypot(vx[c] - vx[b], vy[c] - vy[b]),
+                      np.hypot(vx[a] - vx[c], vy[a] - vy[c]))
         if abs(o) <= eps * longest:
             continue
-        order = (0, 1, 2) if o > 0.0 else (0, 2, 1)
+        org[nh] = a
+        org[nh + 1] = b if o > 0.0 else c
+        org[nh + 2] = c if o > 0.0 else b
         for k in range(3):
-            key = (tri[t, order[k], 0], tri[t, order[k], 1])
-            if key in ids:
-                org[nh + k] = ids[key]
-            else:
-                ids[key] = nv
-                vx[nv] = key[0]
-                vy[nv] = key[1]
-                org[nh + k] = nv
-                nv += 1
             nxt[nh + k] = nh + (k + 1) % 3
             prv[nh + k] = nh + (k + 2) % 3
             alive[nh + k] = True
         nh += 3
-    # Twins: half-edge u->v of one piece and v->u of the neighbour.
-    edge = Dict.empty(key_type=_INT, value_type=_INT)
+    # Twins: half-edge u->v of one triangle and v->u of its neighbour (sorted keys).
+    keys = np.empty(nh, np.int64)
+    for h in range(nh):
+        keys[h] = org[h] * nv + org[nxt[h]]
+    order = np.argsort(keys)
+    sorted_keys = keys[order]
     twin = np.full(nh, -1, np.int64)
     for h in range(nh):
-        u = org[h]
-        v = org[nxt[h]]
-        back = v * nv + u
-        if back in edge:
-            g = edge[back]
-            twin[h] = g
-            twin[g] = h
-        else:
-            edge[u * nv + v] = h
+        back = org[nxt[h]] * nv + org[h]
+        r = np.searchsorted(sorted_keys, back)
+        if r < nh and sorted_keys[r] == back:
+            twin[h] = order[r]
     # Union-find over pieces (one per triangle at first) to skip diagonals inside a piece.
     parent = np.arange(nh // 3)
     for h in range(nh):
@@ -183,9 +174,9 @@ def ear_triangles(xy):
 
     Vertices where the ring goes straight on are skipped first. Clipping the fattest
     ear each time gives triangles close to a Delaunay triangulation, which merge into
-    fewer convex pieces than a fan. Returns ``(ok, tri)`` with ``tri`` of shape
-    (T, 3, 2); ``ok`` is False when no ear is left (only possible through rounding in a
-    near-degenerate ring).
+    fewer convex pieces than a fan. Returns ``(ok, tri)`` with ``tri`` (T, 3) int64,
+    the triangles as indices into ``xy``; ``ok`` is False when no ear is left (only
+    possible through rounding in a near-degenerate ring).
     """
     n = xy.shape[0]
     nxt = np.empty(n, np.int64)
@@ -215,7 +206,7 @@ def ear_triangles(xy):
     for i in range(n):
         if alive[i]:
             quality[i] = _ear_quality(xy, prv[i], i, nxt[i], nxt)
-    tri = np.empty((max(left - 2, 1), 3, 2))
+    tri = np.empty((max(left - 2, 1), 3), np.int64)
     nt = 0
     while left > 3:
         best = -1
@@ -226,9 +217,9 @@ def ear_triangles(xy):
             return False, tri[:0]
         p = prv[best]
         q = nxt[best]
-        tri[nt, 0] = xy[p]
-        tri[nt, 1] = xy[best]
-        tri[nt, 2] = xy[q]
+        tri[nt, 0] = p
+        tri[nt, 1] = best
+        tri[nt, 2] = q
         nt += 1
         nxt[p] = q
         prv[q] = p
@@ -238,9 +229,9 @@ def ear_triangles(xy):
         quality[q] = _ear_quality(xy, p, q, nxt[q], nxt)
     for i in range(n):
         if alive[i]:
-            tri[nt, 0] = xy[prv[i]]
-            tri[nt, 1] = xy[i]
-            tri[nt, 2] = xy[nxt[i]]
+            tri[nt, 0] = prv[i]
+            tri[nt, 1] = i
+            tri[nt, 2] = nxt[i]
             nt += 1
             break
     return True, tri[:nt].copy()
