@@ -185,10 +185,11 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
 
 
 @njit(cache=True, nogil=True)
-def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, mw, lin, wv, we, lam, dmin2, step,
-                  scan_all, crit, way):
+def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, lam, dmin2,
+                  step, scan_all, crit, way):
     """Vertices of one body against the edges of the other (``wv``, ``we``: the bounds
-    of |ω| over the window; ``nxt``, ``re_max`` from :func:`edge_table`). The pair that
+    of |ω| over the window; ``nxt``, ``re_max``, ``order`` from :func:`edge_table`;
+    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that
     sets the step is written to ``crit`` as ``(way, vertex, edge)``."""
     ne = xe.shape[0]
     if scan_all:
@@ -212,11 +213,27 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, mw, lin, wv, we, lam, dmi
     xmin = np.empty(ne)
     maxw = 0.0
     lmax = 0.0
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
     for j in range(ne):
         xmin[j] = min(xe[j, 0], xe[nxt[j], 0])
         maxw = max(maxw, abs(xe[j, 0] - xe[nxt[j], 0]))
         lmax = max(lmax, re_max[j])
-    order = np.argsort(xmin)
+        x0 = min(x0, xe[j, 0])
+        x1 = max(x1, xe[j, 0])
+        y0 = min(y0, xe[j, 1])
+        y1 = max(y1, xe[j, 1])
+    # the previous step's order is nearly right: insertion sort finishes it in ~O(n)
+    for k in range(1, ne):
+        cur = order[k]
+        key = xmin[cur]
+        m = k
+        while m > 0 and xmin[order[m - 1]] > key:
+            order[m] = order[m - 1]
+            m -= 1
+        order[m] = cur
     sorted_x = xmin[order]
     for i in range(xv.shape[0]):
         px = xv[i, 0]
@@ -224,6 +241,8 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, mw, lin, wv, we, lam, dmi
         base = lin + wv * rv_len[i]
         # a pair farther than this cannot shorten the step
         reach = step * (base + we * lmax) + lam
+        if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
+            continue
         o = np.searchsorted(sorted_x, px - reach - maxw)
         while o < ne and sorted_x[o] <= px + reach:
             j = order[o]
@@ -248,8 +267,9 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, mw, lin, wv, we, lam, dmi
 
 @njit(cache=True, nogil=True)
 def edge_table(starts, r_len):
-    """``(nxt, r_max)``: the vertex after each vertex in its loop, and the largest
-    centroid distance of each edge's two ends."""
+    """``(nxt, r_max, order)``: the vertex after each vertex in its loop, the largest
+    centroid distance of each edge's two ends, and an edge order that the sweep keeps
+    sorted by smallest x (starts as 0, 1, ...)."""
     n = r_len.shape[0]
     nxt = np.empty(n, np.int64)
     r_max = np.empty(n)
@@ -260,7 +280,7 @@ def edge_table(starts, r_len):
             j1 = j + 1 if j + 1 < e else s
             nxt[j] = j1
             r_max[j] = max(r_len[j], r_len[j1])
-    return nxt, r_max
+    return nxt, r_max, np.arange(n)
 
 
 @njit(cache=True, nogil=True)
@@ -313,10 +333,10 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit)
         j1 = e[0][j]
         step = _pair_time(xv[i, 0], xv[i, 1], cv[0], cv[1], rv, xe[j, 0], xe[j, 1], xe[j1, 0],
                           xe[j1, 1], ce[0], ce[1], e[1][j], mw, speed, lam, step)
-    dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], mwa, lin, wa, wb, lam,
-                                np.inf, step, scan_all, crit, 0)
-    dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], mwb, lin, wb, wa, lam,
-                                dmin2, step, scan_all, crit, 1)
+    dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], eb[2], mwa, lin, wa, wb,
+                                lam, np.inf, step, scan_all, crit, 0)
+    dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], ea[2], mwb, lin, wb, wa,
+                                lam, dmin2, step, scan_all, crit, 1)
     return np.sqrt(dmin2), step
 
 
