@@ -160,7 +160,14 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     d, step = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
                            b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
                            ma.array, mb.array, 0.0, 1.0, 0.0, np.full(3, -1))
-    assert math.isclose(d, boundary_distance(*a.packed, *b.packed), rel_tol=1e-12)
+    # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
+    # it is never below the gap, and with lam just above the gap it is the gap
+    gap = boundary_distance(*a.packed, *b.packed)
+    assert d >= gap * (1 - 1e-12)
+    d_lam, _ = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
+                            b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
+                            ma.array, mb.array, 0.0, 1.0, 1.01 * gap, np.full(3, -1))
+    assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
     if speed > 0:

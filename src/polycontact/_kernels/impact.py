@@ -192,11 +192,27 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
     ``order`` is kept sorted by the edges' smallest x from step to step). The pair that
     sets the step is written to ``crit`` as ``(way, vertex, edge)``."""
     ne = xe.shape[0]
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
+    lmax = 0.0
+    for j in range(ne):
+        x0 = min(x0, xe[j, 0])
+        x1 = max(x1, xe[j, 0])
+        y0 = min(y0, xe[j, 1])
+        y1 = max(y1, xe[j, 1])
+        lmax = max(lmax, re_max[j])
     if scan_all:
         for i in range(xv.shape[0]):
             base = lin + wv * rv_len[i]
             px = xv[i, 0]
             py = xv[i, 1]
+            # no pair farther than this can shorten the step: skip a vertex that far
+            # from the other body's box
+            reach = step * (base + we * lmax) + lam
+            if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
+                continue
             for j in range(ne):
                 j1 = nxt[j]
                 d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
@@ -212,19 +228,9 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
         return dmin2, step
     xmin = np.empty(ne)
     maxw = 0.0
-    lmax = 0.0
-    x0 = np.inf
-    x1 = -np.inf
-    y0 = np.inf
-    y1 = -np.inf
     for j in range(ne):
         xmin[j] = min(xe[j, 0], xe[nxt[j], 0])
         maxw = max(maxw, abs(xe[j, 0] - xe[nxt[j], 0]))
-        lmax = max(lmax, re_max[j])
-        x0 = min(x0, xe[j, 0])
-        x1 = max(x1, xe[j, 0])
-        y0 = min(y0, xe[j, 1])
-        y1 = max(y1, xe[j, 1])
     # the previous step's order is nearly right: insertion sort finishes it in ~O(n)
     for k in range(1, ne):
         cur = order[k]
