@@ -151,13 +151,14 @@ def main() -> int:
     # compile every kernel before timing (the slot gives a slide, the frame an exact fit)
     square = [(0, 0), (1, 0), (1, 1), (0, 1)]
     pc.no_fit_polygon(square, [(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)])
-    pc.no_fit_polygon([(0, 0), (2, 0), (2, 2), (0, 2)],
-                      pc.Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]]))
+    frame = pc.Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]])
+    pc.no_fit_polygon([(0, 0), (2, 0), (2, 2), (0, 2)], frame)
     head = (f"{'instance':10} {'NFPs':>6} {'pc cold s':>9} {'pc warm s':>9} {'pyclipper s':>11} "
             f"{'pysfcgal s':>10} {'clip/cold':>9} {'sfcgal/cold':>11} {'clip/warm':>9} "
             f"{'sfcgal/warm':>11}")
     if args.check:
-        head += f" {'wrong pc':>8} {'wrong clip':>10} {'false holes clip':>16} {'wrong sfcgal':>12} {'fits+slides':>11}"
+        head += (f" {'wrong pc':>8} {'wrong clip':>10} {'false holes clip':>16}"
+                 f" {'wrong sfcgal':>12} {'fits+slides':>11}")
     print(head)
     total = {"pc_cold": 0.0, "pc_warm": 0.0, "pyclipper": 0.0, "pysfcgal": 0.0, "nfps": 0}
     for path in paths:

@@ -55,7 +55,8 @@ def reference_region(a: shapely.Geometry, b: shapely.Geometry, a0) -> shapely.Ge
             coords.append(pts)
             ids.append(np.full(len(pts), k))
             k += 1
-    hulls = shapely.convex_hull(shapely.multipoints(np.concatenate(coords), indices=np.concatenate(ids)))
+    points = shapely.multipoints(np.concatenate(coords), indices=np.concatenate(ids))
+    hulls = shapely.convex_hull(points)
     region = shapely.union_all(hulls)
     scale = max(1.0, float(np.abs(shapely.get_coordinates(region)).max()))
     return _without_seams(region, 1e-9 * scale)

@@ -345,11 +345,11 @@ def _entrance(
 def _polygon_from_rings(
     xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float
 ) -> Any:
-    """(Multi)Polygon from CCW shells and CW holes; rings thinner than width dropped."""
+    """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
     if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
-        ring = np.concatenate([xy, xy[:1]])
-        return shapely.from_wkb(_WKB_POLYGON.pack(1, 3, 1, len(ring)) + ring.astype("<f8").tobytes())
+        header = _WKB_POLYGON.pack(1, 3, 1, len(xy))
+        return shapely.from_wkb(header + xy.astype("<f8", copy=False).tobytes())
     shells = []
     holes = []
     for k in range(len(starts) - 1):

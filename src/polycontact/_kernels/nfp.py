@@ -605,7 +605,7 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
     ``a0 − A``. ``eps <= 0`` means ``rel_tol * max(1, largest |coordinate| of the sums)``.
     Returns ``(ring_xy, ring_starts, ring_stats, candidates, meta)``: the outline's
-    rings; their signed area and length (R, 2); candidate exact fits then candidate
+    rings, closed (each ends with its first point); their signed area and length (R, 2); candidate exact fits then candidate
     slides as segments (C, 4), an exact fit as a zero-length segment; ``meta`` =
     ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
     did not link into rings (the caller then unions the sums another way).
@@ -617,7 +617,8 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     if starts.shape[0] == 2:
         rs = np.array([0, sums.shape[0]], np.int64)
         area, length = _ring_stats(sums, rs)
-        return sums, rs, np.column_stack((area, length)), np.empty((0, 4)), meta
+        ring_xy, ring_starts = _closed(sums, rs)
+        return ring_xy, ring_starts, np.column_stack((area, length)), np.empty((0, 4)), meta
     bb = _bboxes(sums, starts)
     fr = _frames(sums, starts)
     outline, loose = edge_cover(sums, starts, bb, fr, eps)
@@ -630,7 +631,26 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     cand[pts.shape[0]:] = segs
     meta[1] = 1.0 if ok else 0.0
     meta[2] = pts.shape[0]
+    ring_xy, ring_starts = _closed(ring_xy, ring_starts)
     return ring_xy, ring_starts, np.column_stack((area, length)), cand, meta
+
+
+@njit(cache=True, nogil=True)
+def _closed(xy, starts):
+    """The packed loops with each loop's first point repeated at its end."""
+    n = starts.shape[0] - 1
+    out = np.empty((xy.shape[0] + n, 2))
+    st = np.empty(n + 1, np.int64)
+    st[0] = 0
+    w = 0
+    for k in range(n):
+        for i in range(starts[k], starts[k + 1]):
+            out[w] = xy[i]
+            w += 1
+        out[w] = xy[starts[k]]
+        w += 1
+        st[k + 1] = w
+    return out, st
 
 
 @njit(cache=True, nogil=True)
