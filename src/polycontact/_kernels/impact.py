@@ -291,25 +291,28 @@ def edge_table(starts, r_len):
 
 @njit(cache=True, nogil=True)
 def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit):
-    """``(distance, step)``: the gap, and a time step in [0, t1 − t0] that no
-    vertex–edge pair can close.
+    """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
+    vertex comes within ``lam`` of an edge of the other body.
 
     ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ra_len[i]`` the
     distance of vertex i from it, ``ea`` its :func:`edge_table` (likewise B); ``ma``,
     ``mb`` the motion vectors. ``crit`` (int64, 3) names the pair that set the last
     step, ``(way, vertex, edge)`` (way 0: vertex of A; −1: none); it is charged first,
     so that the step is near its final value early and the rest of the pairs are
-    mostly skipped, and it is updated. Each
-    pair p (vertex of one body), e (edge of the other) is charged the closing rate of
-    :func:`_pair_rate` along its own normal, and never more than the plain speed bound
-    ``|Δv| + |ω_v| |r_p| + |ω_e| max |r_e|`` (|r| is convex along the edge); within
-    ``lam`` of touching (no reliable normal) the plain bound alone. Boundaries that do
+    mostly skipped, and it is updated.
+
+    Each pair p (vertex of one body), e (edge of the other) gets the time of
+    :func:`_pair_time`: the longer of two safe bounds, along the pair's fixed normal
+    (:func:`_pair_rate`, never above the plain speed bound
+    ``|Δv| + |ω_v| |r_p| + |ω_e| max |r_e|``; |r| is convex along the edge) and towards
+    the edge's turning line (:func:`_line_rate`); 0 within ``lam``. Boundaries that do
     not cross are at the distance of their nearest vertex–edge pair, and they cannot
     begin to meet without some vertex reaching an edge, so the smallest pair time (both
-    ways) is a step without contact.
+    ways) is a step without contact. A pair farther than ``lam`` plus the current step
+    times its plain speed bound cannot shorten the step and is skipped (whole vertices
+    by the other body's box, edges by the sweep over x for large bodies).
 
-    ``distance`` is exact when it is below ``lam`` or below the step times the speed
-    bound; farther pairs are skipped and it may then be larger than the true gap.
+    ``distance`` is exact when it is at most ``lam``; otherwise it is at least the gap.
     """
     h = t1 - t0
     dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
