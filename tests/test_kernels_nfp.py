@@ -168,3 +168,16 @@ def test_snap_to_vertices_and_crossings():
     # a slide's end near the crossing of x = 0.5 + t with the square's top edge y = 1
     cross = kn.snap(np.array([[0.7, 1 + e]]), np.array([[1.0, 2.0]]), xy, starts, 1e-10)
     assert cross[0, 1] == 1.0 and abs(cross[0, 0] - 0.7) < 1e-12
+
+
+def test_merge_collinear():
+    segs = np.array([
+        [0, 0, 1, 0], [2, 0, 1, 0],       # meet end to end (one reversed)
+        [1.5, 0, 3, 0],                   # overlaps
+        [0, 1, 0, 2], [0, 3, 0, 4],       # same line, apart: stay two
+        [5, 5, 5, 5 + 1e-13],             # shorter than tol: dropped
+        [0, 0, 1, 1],                     # meets the first at an angle: stays
+    ], float)
+    out = kn.merge_collinear(segs, 1e-10)
+    out = out[np.lexsort(out.T[::-1])]
+    assert out.tolist() == [[0, 0, 1, 1], [0, 0, 3, 0], [0, 1, 0, 2], [0, 3, 0, 4]]

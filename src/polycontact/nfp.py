@@ -410,6 +410,14 @@ def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
     return check
 
 
+def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> float:
+    """Distance from p to the nearest of the segments (S, 2, 2)."""
+    a = segs[:, 0]
+    u = segs[:, 1] - a
+    t = np.clip(((p - a) * u).sum(axis=1) / (u * u).sum(axis=1), 0.0, 1.0)
+    return float(np.min(np.hypot(*(a + t[:, None] * u - p).T)))
+
+
 def _clean_degenerate(
     pts: np.ndarray, segs: np.ndarray, pieces: tuple, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -433,27 +441,16 @@ def _clean_degenerate(
         flat = segs.reshape(-1, 2)
         along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
         ends = kn.snap(flat, along, sums, starts, snap).reshape(-1, 2, 2)
-        ends = ends[np.hypot(*(ends[:, 1] - ends[:, 0]).T) > near]
-        lines = shapely.line_merge(shapely.union_all(shapely.linestrings(ends)), directed=False)
-        merged = [
-            seg
-            for g in shapely.get_parts(shapely.simplify(lines, near))
-            for seg in np.lib.stride_tricks.sliding_window_view(
-                np.asarray(g.coords), (2, 2)
-            ).reshape(-1, 2, 2)
-        ]
+        merged = kn.merge_collinear(ends.reshape(-1, 4), near)
+        merged = merged[np.lexsort(merged.T[::-1])].reshape(-1, 2, 2)  # sorted
         kept = [s for s in merged if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
         if kept:
-            # each slide from its lexicographically smaller end; slides sorted
-            slides = np.array([s if tuple(s[0]) <= tuple(s[1]) else s[::-1] for s in kept])
-            slides = slides[np.lexsort((slides[:, 0, 1], slides[:, 0, 0]))]
+            slides = np.array(kept)
     fits: list[np.ndarray] = []
     for p in pts:
         if any(np.hypot(*(p - q)) <= near for q in fits):
             continue
-        if len(slides) and shapely.distance(
-            shapely.Point(p), shapely.linestrings(slides)
-        ).min() <= near:
+        if len(slides) and _distance_to_segments(p, slides) <= near:
             continue
         if check(p):
             fits.append(p)

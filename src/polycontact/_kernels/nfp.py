@@ -737,3 +737,59 @@ def snap(points, along, xy, starts, tol):
                 out[k, 0] = qx
                 out[k, 1] = qy
     return out
+
+
+@njit(cache=True, nogil=True)
+def merge_collinear(segs, tol):
+    """Segments (S, 4) merged where they lie on one line and overlap or meet (within tol).
+
+    Each result runs from its lexicographically smaller end. Segments shorter than
+    ``tol`` are dropped.
+    """
+    n = segs.shape[0]
+    s = segs.copy()
+    for r in range(n):
+        if (s[r, 2], s[r, 3]) < (s[r, 0], s[r, 1]):
+            s[r, 0], s[r, 1], s[r, 2], s[r, 3] = s[r, 2], s[r, 3], s[r, 0], s[r, 1]
+    keep = np.ones(n, np.bool_)
+    for r in range(n):
+        if np.hypot(s[r, 2] - s[r, 0], s[r, 3] - s[r, 1]) <= tol:
+            keep[r] = False
+    changed = True
+    while changed:
+        changed = False
+        for r in range(n):
+            if not keep[r]:
+                continue
+            ln = np.hypot(s[r, 2] - s[r, 0], s[r, 3] - s[r, 1])
+            ux = (s[r, 2] - s[r, 0]) / ln
+            uy = (s[r, 3] - s[r, 1]) / ln
+            for q in range(n):
+                if q == r or not keep[q]:
+                    continue
+                # both ends of q on r's line?
+                d0 = ux * (s[q, 1] - s[r, 1]) - uy * (s[q, 0] - s[r, 0])
+                d1 = ux * (s[q, 3] - s[r, 1]) - uy * (s[q, 2] - s[r, 0])
+                if abs(d0) > tol or abs(d1) > tol:
+                    continue
+                t0 = ux * (s[q, 0] - s[r, 0]) + uy * (s[q, 1] - s[r, 1])
+                t1 = ux * (s[q, 2] - s[r, 0]) + uy * (s[q, 3] - s[r, 1])
+                lo = min(t0, t1)
+                hi = max(t0, t1)
+                if hi < -tol or lo > ln + tol:
+                    continue
+                # merge q into r: the extreme ends along r's direction
+                if lo < 0.0:
+                    if t0 <= t1:
+                        s[r, 0], s[r, 1] = s[q, 0], s[q, 1]
+                    else:
+                        s[r, 0], s[r, 1] = s[q, 2], s[q, 3]
+                if hi > ln:
+                    if t1 >= t0:
+                        s[r, 2], s[r, 3] = s[q, 2], s[q, 3]
+                    else:
+                        s[r, 2], s[r, 3] = s[q, 0], s[q, 1]
+                keep[q] = False
+                changed = True
+                ln = np.hypot(s[r, 2] - s[r, 0], s[r, 3] - s[r, 1])
+    return s[keep].copy()
