@@ -47,7 +47,7 @@ def touching(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> np.ndarr
     """A moved along a random direction until it just touches B (bisection on the state)."""
     u = rng.normal(size=2)
     u /= np.hypot(*u)
-    lo, hi = 0.0, 6.0  # A + lo u overlaps B, A + hi u is clear of it
+    lo, hi = 0.0, 8.0  # A + lo u overlaps B, A + hi u is clear of it
     for _ in range(80):
         mid = 0.5 * (lo + hi)
         state = pc.classify(a + mid * u, b).state
@@ -67,7 +67,7 @@ def make_pairs(rng: np.random.Generator, n: int, count: int) -> list[tuple[np.nd
     while len(out) < count:
         kind = want[len(out) % 3]
         a = star(rng, n)
-        b = star(rng, n) + rng.uniform(-1.2, 1.2, 2)
+        b = star(rng, n) + rng.uniform(-2.6, 2.6, 2)
         state = pc.classify(a, b).state
         if kind == "separate" and state is pc.State.SEPARATE:
             out.append((a, b))

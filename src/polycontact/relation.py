@@ -19,7 +19,9 @@ Examples
 from __future__ import annotations
 
 import enum
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -377,6 +379,17 @@ class RelationBatch:
         return km.many_distances(*self._packed, self.states, self.tolerances)
 
 
+def _split(count: int, fn: Any) -> list[Any]:
+    """Run ``fn(p0, p1)`` over chunks of range(count) on threads (the kernels release
+    the GIL), one chunk per CPU; returns the results in order."""
+    workers = min(os.cpu_count() or 1, max(1, count // 2048))
+    if workers == 1:
+        return [fn(0, count)]
+    bounds = np.linspace(0, count, workers + 1).astype(int)
+    with ThreadPoolExecutor(workers) as pool:
+        return list(pool.map(fn, bounds[:-1], bounds[1:]))
+
+
 def _pack_array(arr: np.ndarray, what: str) -> tuple | None:
     """Pack a (P, N, 2) array of raw rings; None if some ring needs ``Shape``."""
     from ._kernels import relation_many as km
@@ -384,7 +397,12 @@ def _pack_array(arr: np.ndarray, what: str) -> tuple | None:
     p_count, n = arr.shape[0], arr.shape[1]
     xy = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1, 2)
     lo = np.arange(p_count, dtype=np.int64) * n
-    used, sign = km.check_rings(xy, lo, np.full(p_count, n, dtype=np.int64), RELATIVE_TOLERANCE)
+    counts = np.full(p_count, n, dtype=np.int64)
+    parts = _split(
+        p_count, lambda p0, p1: km.check_rings(xy, lo[p0:p1], counts[p0:p1], RELATIVE_TOLERANCE)
+    )
+    used = np.concatenate([u for u, _ in parts])
+    sign = np.concatenate([s for _, s in parts])
     if (used < 0).any():
         return None
     ls = np.empty(2 * p_count, dtype=np.int64)
@@ -458,7 +476,10 @@ def _pack(items: Any, what: str) -> tuple:
 def classify_many(
     shapes_a: Any, shapes_b: Any, *, tolerance: float | None = None
 ) -> RelationBatch:
-    """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one parallel call.
+    """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.
+
+    The pairs are split over one thread per CPU (the compiled kernels release the GIL);
+    the signed distances, on first access, run in parallel too.
 
     Parameters
     ----------
@@ -491,7 +512,18 @@ def classify_many(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"
         )
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
-    states, eps = km.many_states(*pa, *pb, tol, RELATIVE_TOLERANCE)
+    xa, lsa, bsa, fa = pa
+    xb, lsb, bsb, fb = pb
+
+    def chunk(p0: int, p1: int) -> tuple[np.ndarray, np.ndarray]:
+        return km.many_states(
+            xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
+            RELATIVE_TOLERANCE,
+        )
+
+    parts = _split(len(fa), chunk)
+    states = np.concatenate([st for st, _ in parts])
+    eps = np.concatenate([e for _, e in parts])
     return RelationBatch(states, eps, (*pa, *pb))
 
 
