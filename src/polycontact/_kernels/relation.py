@@ -130,7 +130,7 @@ def _sort_by_xmin(box, cnt):
     for i in range(cnt):
         lo = min(lo, box[i, 0])
         hi = max(hi, box[i, 0])
-    if cnt > 16 and hi > lo:
+    if cnt > 32 and hi > lo:
         scale = (cnt - 1) / (hi - lo)
         start = np.zeros(cnt + 1, np.int64)
         for i in range(cnt):
