@@ -181,3 +181,15 @@ def test_merge_collinear():
     out = kn.merge_collinear(segs, 1e-10)
     out = out[np.lexsort(out.T[::-1])]
     assert out.tolist() == [[0, 0, 1, 1], [0, 0, 3, 0], [0, 1, 0, 2], [0, 3, 0, 4]]
+
+
+def test_ring_pieces_convex_small_and_too_big():
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    ok, xy, starts = decompose.ring_pieces(sq, 1e-12, 64)
+    assert ok and xy.tolist() == sq.tolist() and starts.tolist() == [0, 4]
+    ell = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
+    ok, xy, starts = decompose.ring_pieces(ell, 1e-12, 64)
+    assert ok and len(starts) == 3
+    assert sum(shapely.Polygon(p).area for p in _split(xy, starts)) == 3.0
+    ok, _, _ = decompose.ring_pieces(ell, 1e-12, 5)  # too many vertices for ear clipping
+    assert not ok

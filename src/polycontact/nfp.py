@@ -287,15 +287,10 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     hit = _PIECES_CACHE.get(key)
     if hit is not None:
         return hit
-    dec = _kernels().decompose
     ok = False
-    if len(starts) == 2 and dec.is_convex(xy):
-        pieces = (np.ascontiguousarray(xy), np.array([0, len(xy)], dtype=np.int64))
-        ok = True
-    elif len(starts) == 2 and len(xy) <= _EAR_CLIPPING_MAX:
-        ok, tri = dec.ear_triangles(xy)
-        if ok:
-            pieces = dec.convex_pieces(xy, tri, RELATIVE_TOLERANCE)
+    if len(starts) == 2:
+        ok, pxy, pst = _kernels().decompose.ring_pieces(xy, RELATIVE_TOLERANCE, _EAR_CLIPPING_MAX)
+        pieces = (pxy, pst)
     if not ok:
         # (shapely.Polygon is slow with an empty hole list)
         geom = (shapely.Polygon(shape.exterior, shape.holes) if shape.holes

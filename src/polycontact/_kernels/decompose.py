@@ -235,3 +235,21 @@ def ear_triangles(xy):
             nt += 1
             break
     return True, tri[:nt].copy()
+
+
+@njit(cache=True, nogil=True)
+def ring_pieces(xy, rel_tol, max_ear):
+    """Convex pieces of a simple CCW ring in one call: ``(ok, xy, starts)``.
+
+    The ring itself when it is convex; else best-ear triangles merged by
+    :func:`convex_pieces` when it has at most ``max_ear`` vertices. ``ok`` is False
+    when neither applies (the caller triangulates another way).
+    """
+    if is_convex(xy):
+        return True, xy.copy(), np.array([0, xy.shape[0]], np.int64)
+    if xy.shape[0] <= max_ear:
+        ok, tri = ear_triangles(xy)
+        if ok:
+            pxy, st = convex_pieces(xy, tri, rel_tol)
+            return True, pxy, st
+    return False, np.empty((0, 2)), np.zeros(1, np.int64)

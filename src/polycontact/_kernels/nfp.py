@@ -605,8 +605,9 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
     ``a0 − A``. ``eps <= 0`` means ``rel_tol * max(1, largest |coordinate| of the sums)``.
     Returns ``(ring_xy, ring_starts, ring_stats, candidates, meta)``: the outline's
-    rings, closed (each ends with its first point); their signed area and length (R, 2); candidate exact fits then candidate
-    slides as segments (C, 4), an exact fit as a zero-length segment; ``meta`` =
+    rings, closed (each ends with its first point); their signed area and length
+    (R, 2); candidate exact fits then candidate slides as segments (C, 4), an exact
+    fit as a zero-length segment; ``meta`` =
     ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
     did not link into rings (the caller then unions the sums another way).
     """
