@@ -572,15 +572,25 @@ def _ring_is_simple(xy, n, eps):
         box[i, 2] = min(xy[i, 1], xy[j, 1])
         box[i, 3] = max(xy[i, 1], xy[j, 1])
     order = _sort_by_xmin(box, n)
+    sb = np.empty((n, 4))  # boxes in sweep order, for contiguous scans
+    for oi in range(n):
+        i = order[oi]
+        sb[oi, 0] = box[i, 0]
+        sb[oi, 1] = box[i, 1]
+        sb[oi, 2] = box[i, 2]
+        sb[oi, 3] = box[i, 3]
     for oi in range(n):
         i = order[oi]
         i1 = i + 1 if i + 1 < n else 0
+        x1 = sb[oi, 1] + eps
+        y0 = sb[oi, 2] - eps
+        y1 = sb[oi, 3] + eps
         for oj in range(oi + 1, n):
-            j = order[oj]
-            if box[j, 0] > box[i, 1] + eps:
+            if sb[oj, 0] > x1:
                 break
-            if box[j, 2] > box[i, 3] + eps or box[j, 3] < box[i, 2] - eps:
+            if sb[oj, 2] > y1 or sb[oj, 3] < y0:
                 continue
+            j = order[oj]
             j1 = j + 1 if j + 1 < n else 0
             if j == i1 or i == j1:
                 continue
