@@ -81,7 +81,7 @@ def test_separate_point_and_distance():
 
 def test_repr_and_shapes():
     r = classify(SQ, SQ + 0.5)
-    assert repr(r).startswith("Relation(state='penetrating', distance=-0.5")
+    assert repr(r) == "Relation(state='penetrating', tolerance=1.5e-12)"
     a, b = r.shapes
     assert isinstance(a, Shape) and a.area == 1.0
 

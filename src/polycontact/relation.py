@@ -108,8 +108,10 @@ class Relation:
         otherwise the first vertex inside, otherwise a touching vertex. Separate: the
         midpoint of the closest pair of boundary points.
     normal : ndarray of shape (2,) or None
-        Unit vector from A towards B. Contact: the normal of the touched edge (when a
-        vertex sits on a vertex, the edge on which it lies most squarely). Penetrating:
+        Unit vector from A towards B. Contact: the normal of a touched edge, one that
+        keeps the touching vertex's own edges on its side (so at a vertex-on-vertex
+        touch of flush edges it is the flush edge's normal), preferring the touch
+        farthest from the edge's ends. Penetrating:
         the direction opposite the smallest separating translation of A. Separate: None.
     escape : ndarray of shape (2,) or None
         Penetrating only: the smallest translation of A that ends the overlap.
@@ -120,10 +122,8 @@ class Relation:
     _pair: tuple = field(repr=False)
 
     def __repr__(self) -> str:
-        return (
-            f"Relation(state={self.state.value!r}, distance={self.distance:.6g}, "
-            f"features={len(self.features)}, tolerance={self.tolerance:g})"
-        )
+        # Only what is already decided: the lazy parts (a depth can be costly) stay lazy.
+        return f"Relation(state={self.state.value!r}, tolerance={self.tolerance:g})"
 
     @cached_property
     def shapes(self) -> tuple[Shape, Shape]:
