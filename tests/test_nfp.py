@@ -232,7 +232,7 @@ def grid_shapes(draw, size=4):
         assume(False)
 
 
-@settings(max_examples=60)
+@settings(max_examples=150)
 @given(star_shapes(), star_shapes())
 def test_random_concave_with_holes_against_reference(a, b):
     nfp = pc.no_fit_polygon(a, b)
@@ -240,7 +240,7 @@ def test_random_concave_with_holes_against_reference(a, b):
     assert same_region(nfp.region, ref) is None
 
 
-@settings(max_examples=60)
+@settings(max_examples=200)
 @given(grid_shapes(), grid_shapes())
 def test_grid_shapes_against_reference_and_lattice(a, b):
     nfp = pc.no_fit_polygon(a, b, reference="origin")
@@ -311,7 +311,7 @@ def test_inner_fit_rectangle_in_bin():
     assert pc.inner_fit_polygon([(0, 0), (11, 0), (11, 1)], bin_).is_empty
 
 
-@settings(max_examples=40)
+@settings(max_examples=80)
 @given(grid_shapes(size=3), grid_shapes(size=5))
 def test_inner_fit_against_brute_force(a, container):
     ifp = pc.inner_fit_polygon(a, container, reference="origin")
