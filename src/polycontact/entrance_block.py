@@ -157,7 +157,9 @@ class EntranceBlock:
         """The entrance block as one shapely (Multi)Polygon: the union of the components.
 
         Zero-width components are left out: each lies in the union of the others (an
-        edge sliding along a parallel edge has an end vertex on the other edge).
+        edge sliding along a parallel edge has an end vertex on the other edge). Holes
+        and pieces no wider than the tolerance, which rounding can leave where many
+        components meet, are dropped. Computed once, on first use.
         """
         return self._union
 
