@@ -11,7 +11,7 @@ Timed, in the same run and on the same prepared inputs:
   nesting code calling it repeatedly on the same pieces does;
 - ``pyclipper.MinkowskiSum2`` on integer coordinates scaled by a power of two so the
   largest reaches 2**50 (Clipper needs integers);
-- ``pysfcgal`` ``Polygon.minkowski_sum`` (CGAL; it ignores B's holes, none here).
+- ``pysfcgal`` ``Polygon.minkowski_sum`` (CGAL, exact arithmetic; ESICUP has no holes).
 
 With ``--check`` every result is compared with the independent reference of
 ``tests/nfp_reference.py``: a region is wrong when the symmetric difference exceeds 1e-9
