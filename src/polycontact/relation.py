@@ -253,9 +253,10 @@ def _local(starts: np.ndarray, g: int) -> tuple[int, int]:
 def _to_shape(src: Any) -> Shape:
     if isinstance(src, Shape):
         return src
-    arr, n, sign = src
+    raw, n, sign = src  # the bytes of a C-contiguous float64 (N, 2) ring, copied at call
+    arr = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
     ring = arr[:n] if sign > 0 else arr[:n][::-1]
-    return Shape._trusted([np.ascontiguousarray(ring, dtype=np.float64)])
+    return Shape._trusted([np.array(ring, dtype=np.float64)])
 
 
 def _check_tolerance(tolerance: Any) -> float:
@@ -269,6 +270,7 @@ def _check_tolerance(tolerance: Any) -> float:
 
 
 _F64 = np.dtype(np.float64)
+_ND = np.ndarray
 _KERNELS: list[Any] = []
 
 
@@ -279,6 +281,9 @@ def _kr() -> Any:
 
         _KERNELS.append(relation)
     return _KERNELS[0]
+
+
+_RAW: list[Any] = []  # [classify_raw], bound on first use
 
 
 def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
@@ -317,8 +322,8 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     """
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     if (
-        type(a) is np.ndarray
-        and type(b) is np.ndarray
+        type(a) is _ND
+        and type(b) is _ND
         and a.dtype is _F64
         and b.dtype is _F64
         and a.ndim == 2
@@ -326,12 +331,16 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
         and a.flags.c_contiguous
         and b.flags.c_contiguous
     ):
-        code, eps, na, fa, nb, fb = _kr().classify_raw(a, b, tol, RELATIVE_TOLERANCE)
+        if not _RAW:
+            _RAW.append(_kr().classify_raw)
+        code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, RELATIVE_TOLERANCE)
         if code >= 0:
+            # The lean path: the bytes are the copy the lazy parts are computed from.
             obj = object.__new__(Relation)
-            obj.__dict__.update(
-                state=_STATES[code], tolerance=eps, _pair=((a.copy(), na, fa), (b.copy(), nb, fb))
-            )
+            d = obj.__dict__
+            d["state"] = _STATES[code]
+            d["tolerance"] = eps
+            d["_pair"] = ((a.tobytes(), na, fa), (b.tobytes(), nb, fb))
             return obj
     sa = as_shape(a, "a")
     sb = as_shape(b, "b")

@@ -116,15 +116,23 @@ def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, box, ids, cnt):
 
 @njit(cache=True, nogil=True)
 def _sort_by_xmin(box, cnt):
-    """Order of the first cnt rows of box by xmin.
-
-    A bucket pass (one bucket per row over the range of xmin) followed by an insertion
-    pass: O(cnt) for spread-out keys. If the insertion pass does too much work (keys
-    bunched in a few buckets) it falls back to ``np.argsort``.
-    """
+    """Order of the first cnt rows of box by xmin (see :func:`_sort_into`)."""
     order = np.empty(cnt, np.int64)
+    _sort_into(box, cnt, order, np.empty(cnt + 1, np.int64))
+    return order
+
+
+@njit(cache=True, nogil=True)
+def _sort_into(box, cnt, order, start):
+    """Write into ``order[:cnt]`` the order of the first cnt rows of box by xmin.
+
+    A bucket pass (one bucket per row over the range of xmin; ``start`` is scratch of
+    at least cnt + 1 entries) followed by an insertion pass: O(cnt) for spread-out keys.
+    If the insertion pass does too much work (keys bunched in a few buckets) it falls
+    back to ``np.argsort``.
+    """
     if cnt == 0:
-        return order
+        return
     lo = np.inf
     hi = -np.inf
     for i in range(cnt):
@@ -132,7 +140,8 @@ def _sort_by_xmin(box, cnt):
         hi = max(hi, box[i, 0])
     if cnt > 32 and hi > lo:
         scale = (cnt - 1) / (hi - lo)
-        start = np.zeros(cnt + 1, np.int64)
+        for k in range(cnt + 1):
+            start[k] = 0
         for i in range(cnt):
             start[int((box[i, 0] - lo) * scale) + 1] += 1
         for k in range(cnt):
@@ -155,8 +164,8 @@ def _sort_by_xmin(box, cnt):
             budget -= 1
         order[j] = cur
         if budget < 0:
-            return np.argsort(box[:cnt, 0])
-    return order
+            order[:cnt] = np.argsort(box[:cnt, 0])
+            return
 
 
 @njit(cache=True, nogil=True)
@@ -282,6 +291,20 @@ def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
 @njit(cache=True, nogil=True)
 def _state(xa, sa, fa, xb, sb, fb, eps):
     """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right)."""
+    box, ids, touch = _scratch(sa[sa.shape[0] - 1] + sb[sb.shape[0] - 1])
+    return _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch)
+
+
+@njit(cache=True, nogil=True)
+def _scratch(size):
+    """Scratch buffers for :func:`_state_in` for up to ``size`` vertices in all."""
+    return np.empty((size + 1, 4)), np.empty((size + 1, 4), np.int64), np.empty(size + 1, np.bool_)
+
+
+@njit(cache=True, nogil=True)
+def _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch):
+    """:func:`_state` with scratch buffers (from :func:`_scratch`; grown if too small),
+    so a loop over many pairs allocates nothing per pair."""
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
     ax0, ax1, ay0, ay1 = _bbox(xa, na)
@@ -293,12 +316,14 @@ def _state(xa, sa, fa, xb, sb, fb, eps):
     wy0 = max(ay0, by0) - eps
     wy1 = min(ay1, by1) + eps
     tot = na + nb
-    box = np.empty((tot, 4))
-    ids = np.empty((tot, 2), np.int64)
+    if box.shape[0] <= tot:
+        box, ids, touch = _scratch(tot)
     cnt = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, box, ids, 0)
     cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, box, ids, cnt)
-    order = _sort_by_xmin(box, cnt)
-    touch = np.zeros(tot, np.bool_)
+    # ids columns: 0, 1 the edge's vertices; 2 the sweep order; 3 scratch of the sort
+    order = ids[:, 2]
+    _sort_into(box, cnt, order, ids[:, 3])
+    touch[:tot] = False
     any_touch = False
     maxw = 0.0
     for oi in range(cnt):
@@ -554,6 +579,32 @@ def _meet(px, py, qx, qy, rx, ry, sx, sy, eps):
     return segment_meet(px, py, qx, qy, rx, ry, sx, sy, eps)[0]
 
 
+#: Rings with at most this many vertices are checked pair by pair (no sort, no
+#: allocation); above it the edges are swept in order of their smallest x.
+_SMALL_RING = 24
+
+
+@njit(cache=True, nogil=True)
+def _small_ring_is_simple(xy, n, eps):
+    """All pairs of non-adjacent edges, each rejected by its boxes first."""
+    for i in range(n - 2):
+        px, py = xy[i, 0], xy[i, 1]
+        qx, qy = xy[i + 1, 0], xy[i + 1, 1]
+        x0 = min(px, qx) - eps
+        x1 = max(px, qx) + eps
+        y0 = min(py, qy) - eps
+        y1 = max(py, qy) + eps
+        for j in range(i + 2, n if i > 0 else n - 1):
+            j1 = j + 1 if j + 1 < n else 0
+            rx, ry = xy[j, 0], xy[j, 1]
+            sx, sy = xy[j1, 0], xy[j1, 1]
+            if max(rx, sx) < x0 or min(rx, sx) > x1 or max(ry, sy) < y0 or min(ry, sy) > y1:
+                continue
+            if _meet(px, py, qx, qy, rx, ry, sx, sy, eps):
+                return False
+    return True
+
+
 @njit(cache=True, nogil=True)
 def _ring_is_simple(xy, n, eps):
     """No two edges of the ring meet except consecutive ones at their shared vertex,
@@ -564,6 +615,8 @@ def _ring_is_simple(xy, n, eps):
         j = i + 1 if i + 1 < n else 0
         if _folds(xy[h, 0], xy[h, 1], xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], eps):
             return False
+    if n <= _SMALL_RING:
+        return _small_ring_is_simple(xy, n, eps)
     box = np.empty((n, 4))
     for i in range(n):
         j = i + 1 if i + 1 < n else 0
@@ -616,20 +669,28 @@ def _raw_ring(xy, rel):
         n -= 1
     if n < 3:
         return -1, 1.0, 1.0
-    scale = 1.0
+    # One pass: finiteness, scale, bounding box and twice the signed area.
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
+    a2 = 0.0
+    jx = xy[n - 1, 0]
+    jy = xy[n - 1, 1]
     for i in range(n):
         x = xy[i, 0]
         y = xy[i, 1]
-        if not (np.isfinite(x) and np.isfinite(y)):
+        if not (abs(x) < np.inf and abs(y) < np.inf):
             return -1, 1.0, 1.0
-        scale = max(scale, abs(x), abs(y))
+        x0 = min(x0, x)
+        x1 = max(x1, x)
+        y0 = min(y0, y)
+        y1 = max(y1, y)
+        a2 += jx * y - x * jy
+        jx = x
+        jy = y
+    scale = max(1.0, -x0, x1, -y0, y1)
     eps = rel * scale
-    x0, x1, y0, y1 = _bbox(xy, n)
-    a2 = 0.0
-    j = n - 1
-    for i in range(n):
-        a2 += xy[j, 0] * xy[i, 1] - xy[i, 0] * xy[j, 1]
-        j = i
     if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
         return -1, 1.0, 1.0
     if not _ring_is_simple(xy, n, eps):
