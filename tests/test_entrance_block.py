@@ -9,7 +9,7 @@ from hypothesis import given, note, settings
 from hypothesis import strategies as st
 
 import polycontact as pc
-from polycontact.entrance_block import Element
+from polycontact.entrance import Element
 
 SQUARE = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
 ELL = [(0.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)]
@@ -134,7 +134,7 @@ def test_reference_point_moves_the_block():
 
 def test_swept_uses_the_splice_and_the_edge_union_alike():
     # a convex loop (spliced) and a concave one (edge by edge) along the same edge
-    from polycontact.entrance_block import _splice, _swept_loop
+    from polycontact.entrance import _splice, _swept_loop
 
     v = np.array([0.7, 0.2])
     square = np.array(SQUARE)
@@ -153,7 +153,7 @@ def test_swept_uses_the_splice_and_the_edge_union_alike():
 def test_curve_sweep_is_not_the_filled_sweep():
     # a long square sliding a little: the boundary sweeps two thin strips, not the square
     big = np.array([(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)])
-    from polycontact.entrance_block import _swept_loop
+    from polycontact.entrance import _swept_loop
 
     area, lines = _swept_loop(big, np.array([1.0, 0.0]), 1e-12)
     _same_region(area, shapely.box(0, 0, 1, 10).union(shapely.box(10, 0, 11, 10)))

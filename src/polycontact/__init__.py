@@ -36,9 +36,9 @@ _LAZY = {
     "RelationBatch": "relation",
     "warmup": "relation",
     # entrance block
-    "EntranceBlock": "entrance_block",
-    "Component": "entrance_block",
-    "entrance_block": "entrance_block",
+    "EntranceBlock": "entrance",
+    "Component": "entrance",
+    "entrance_block": "entrance",
     # motion and time of impact
     "Motion": "motion",
     "broad_phase_intervals": "broad_phase",

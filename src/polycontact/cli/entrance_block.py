@@ -75,7 +75,7 @@ def _text(rep: dict, a: str, b: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..entrance_block import entrance_block
+    from ..entrance import entrance_block
 
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)

@@ -29,8 +29,6 @@ tolerance grid (``grid_size``), which is robust where floating-point overlay is 
 
 from __future__ import annotations
 
-import sys
-import types
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, NamedTuple
@@ -525,19 +523,3 @@ def _outline(geom: Any) -> Any:
     if geom.geom_type in ("LineString", "MultiLineString"):
         return geom
     return shapely.union_all([_outline(g) for g in shapely.get_parts(geom)])
-
-
-class _CallableModule(types.ModuleType):
-    """This module, callable as :func:`entrance_block`.
-
-    ``polycontact.entrance_block`` names both the function (re-exported by the package)
-    and this module; importing the module (``from polycontact.entrance_block import
-    Component``) makes the package attribute the module, so the module forwards calls.
-    """
-
-    def __call__(self, *args: Any, **kwargs: Any) -> EntranceBlock:
-        return entrance_block(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
-
