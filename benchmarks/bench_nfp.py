@@ -7,8 +7,10 @@ reference point at the origin (nesting convention: E = B ⊕ (−A)).
 
 Timed, in the same run and on the same prepared inputs:
 - ``polycontact.no_fit_polygon`` (region, exact fits and slides); "cold" clears the
-  convex-decomposition cache before each NFP, "warm" reuses it across pairs, as a
-  nesting code calling it repeatedly on the same pieces does;
+  convex-decomposition cache before each NFP (every NFP decomposes both its pieces);
+  "warm" clears it once at the start of each build of the instance, so each piece at
+  each orientation is decomposed once and reused across its pairs, as a nesting code
+  building all NFPs of an instance does (the decompositions are inside the timing);
 - ``pyclipper.MinkowskiSum2`` on integer coordinates scaled by a power of two so the
   largest reaches 2**50 (Clipper needs integers);
 - ``pysfcgal`` ``Polygon.minkowski_sum`` (CGAL, exact arithmetic; ESICUP has no holes).
@@ -92,6 +94,7 @@ def run(path: Path, repeat: int, check: bool) -> dict:
     pairs = [(i, j) for i in range(len(rings)) for j in range(len(rings))]
 
     def t_pc_warm():
+        nfp_module._PIECES_CACHE.clear()
         return [pc.no_fit_polygon(shapes[i], shapes[j], "origin") for i, j in pairs]
 
     def t_pc_cold():
