@@ -44,3 +44,27 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
         return Shape.from_wkt(text, repair=repair)
     except InvalidShapeError as exc:
         raise CommandError(f"{path}: {exc}") from None
+
+
+def _number_option(text: str, *, zero_allowed: bool) -> float:
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value) or value < 0 or (value == 0 and not zero_allowed):
+        bound = ">= 0" if zero_allowed else "> 0"
+        raise argparse.ArgumentTypeError(f"expected a number {bound}, got {text!r}")
+    return value
+
+
+def positive_number(text: str) -> float:
+    """argparse type: a finite number > 0 (a time tolerance, a length tolerance)."""
+    return _number_option(text, zero_allowed=False)
+
+
+def non_negative_number(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    return _number_option(text, zero_allowed=True)

@@ -4,21 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from typing import Any
 
-from ._io import read_shape
-
-
-def _tolerance(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
-    return value
+from ._io import non_negative_number, read_shape
 
 
 def add_parser(subparsers: Any) -> None:
@@ -31,7 +20,7 @@ def add_parser(subparsers: Any) -> None:
     )
     p.add_argument("a", metavar="A.json", help="first body (A)")
     p.add_argument("b", metavar="B.json", help="second body (B)")
-    p.add_argument("--tolerance", type=_tolerance, default=None, metavar="T",
+    p.add_argument("--tolerance", type=non_negative_number, default=None, metavar="T",
                    help="absolute distance that counts as touching "
                    "(default 1e-12 × the largest coordinate, at least 1e-12)")
     p.add_argument("--repair", action="store_true",

@@ -4,21 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from typing import Any
 
-from ._io import CommandError
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
-    return value
+from ._io import CommandError, positive_number
 
 
 def _samples(text: str) -> int:
@@ -43,7 +32,7 @@ def add_parser(subparsers: Any) -> None:
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
     p.add_argument("--samples", type=_samples, default=10,
                    help="time points per round of the sampled method (default 10)")
-    p.add_argument("--time-tolerance", type=_positive_float, default=None,
+    p.add_argument("--time-tolerance", type=positive_number, default=None,
                    help="accuracy of the time (default: the scene's, else 1e-4)")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")

@@ -7,7 +7,7 @@ import json
 import math
 from typing import Any
 
-from ._io import CommandError, read_shape
+from ._io import CommandError, positive_number, read_shape
 
 
 def _reference(text: str) -> Any:
@@ -22,16 +22,6 @@ def _reference(text: str) -> Any:
     if not (math.isfinite(x) and math.isfinite(y)):
         raise argparse.ArgumentTypeError(f"expected finite numbers, got {text!r}")
     return (x, y)
-
-
-def _tolerance(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
-    return value
 
 
 def add_parser(subparsers: Any) -> None:
@@ -51,7 +41,7 @@ def add_parser(subparsers: Any) -> None:
                    "translations of A's coordinates, as nesting codes use)")
     p.add_argument("--inner", action="store_true",
                    help="the inner-fit polygon instead: where A lies inside B")
-    p.add_argument("--tolerance", type=_tolerance, default=None, metavar="T",
+    p.add_argument("--tolerance", type=positive_number, default=None, metavar="T",
                    help="absolute distance tolerance (default 1e-12 × the largest "
                    "coordinate, at least 1e-12)")
     p.add_argument("--repair", action="store_true",
