@@ -128,6 +128,33 @@ def test_sort_by_xmin(keys):
     assert np.all(np.diff(box[order, 0]) >= 0)
 
 
+@given(
+    st.lists(st.integers(1, 6), min_size=25, max_size=48),
+    st.integers(0, 3),
+    st.tuples(st.integers(0, 47), st.integers(0, 47)),
+)
+def test_long_ring_sweep_agrees_with_all_pairs(radii, snap, swap):
+    # Star rings on a coarse grid, some with two vertices swapped: many touch or cross
+    # themselves (and bunched keys exercise the sort's fallback); the sweep must agree
+    # with the all-pairs check.
+    t = np.linspace(0.0, 2.0 * np.pi, len(radii), endpoint=False)
+    ring = np.c_[np.cos(t), np.sin(t)] * np.array(radii, dtype=float)[:, None]
+    if snap:
+        ring = np.round(ring * snap) / snap
+    i, j = swap[0] % len(ring), swap[1] % len(ring)
+    ring[[i, j]] = ring[[j, i]]
+    n = len(ring)
+    eps = 1e-12 * max(1.0, np.abs(ring).max())
+    folds = any(
+        kr._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n)
+    )
+    expected = not folds and kr._small_ring_is_simple(ring, n, eps)
+    assert kr._ring_is_simple(ring, n, eps) == expected
+    rows = kr._sorted_edge_boxes(ring, n)
+    assert sorted(rows[:, 4].astype(int).tolist()) == list(range(n))
+    assert np.all(np.diff(rows[:, 0]) >= 0)
+
+
 @given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
 def test_raw_ring_agrees_with_shape(points):
     ring = np.array(points, dtype=float)

@@ -617,33 +617,19 @@ def _ring_is_simple(xy, n, eps):
             return False
     if n <= _SMALL_RING:
         return _small_ring_is_simple(xy, n, eps)
-    box = np.empty((n, 4))
-    for i in range(n):
-        j = i + 1 if i + 1 < n else 0
-        box[i, 0] = min(xy[i, 0], xy[j, 0])
-        box[i, 1] = max(xy[i, 0], xy[j, 0])
-        box[i, 2] = min(xy[i, 1], xy[j, 1])
-        box[i, 3] = max(xy[i, 1], xy[j, 1])
-    order = _sort_by_xmin(box, n)
-    sb = np.empty((n, 4))  # boxes in sweep order, for contiguous scans
+    eb = _sorted_edge_boxes(xy, n)
     for oi in range(n):
-        i = order[oi]
-        sb[oi, 0] = box[i, 0]
-        sb[oi, 1] = box[i, 1]
-        sb[oi, 2] = box[i, 2]
-        sb[oi, 3] = box[i, 3]
-    for oi in range(n):
-        i = order[oi]
+        i = int(eb[oi, 4])
         i1 = i + 1 if i + 1 < n else 0
-        x1 = sb[oi, 1] + eps
-        y0 = sb[oi, 2] - eps
-        y1 = sb[oi, 3] + eps
+        x1 = eb[oi, 1] + eps
+        y0 = eb[oi, 2] - eps
+        y1 = eb[oi, 3] + eps
         for oj in range(oi + 1, n):
-            if sb[oj, 0] > x1:
+            if eb[oj, 0] > x1:
                 break
-            if sb[oj, 2] > y1 or sb[oj, 3] < y0:
+            if eb[oj, 2] > y1 or eb[oj, 3] < y0:
                 continue
-            j = order[oj]
+            j = int(eb[oj, 4])
             j1 = j + 1 if j + 1 < n else 0
             if j == i1 or i == j1:
                 continue
@@ -651,6 +637,66 @@ def _ring_is_simple(xy, n, eps):
                      xy[j, 0], xy[j, 1], xy[j1, 0], xy[j1, 1], eps):
                 return False
     return True
+
+
+@njit(cache=True, nogil=True)
+def _sorted_edge_boxes(xy, n):
+    """Rows ``(xmin, xmax, ymin, ymax, edge)`` of a ring's n edges, ordered by xmin.
+
+    The rows are placed by a bucket pass (one bucket per edge over the range of xmin)
+    and finished by an insertion pass on the rows themselves, so the sweep that follows
+    reads them contiguously; O(n) for spread-out keys. If the insertion pass does too
+    much work (keys bunched in a few buckets) it falls back to ``np.argsort``.
+    """
+    key = np.empty(n)
+    lo = np.inf
+    hi = -np.inf
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        k = min(xy[i, 0], xy[j, 0])
+        key[i] = k
+        lo = min(lo, k)
+        hi = max(hi, k)
+    scale = (n - 1) / (hi - lo) if hi > lo else 0.0
+    start = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        start[int((key[i] - lo) * scale) + 1] += 1
+    for k in range(n):
+        start[k + 1] += start[k]
+    eb = np.empty((n, 5))
+    for i in range(n):
+        b = int((key[i] - lo) * scale)
+        r = start[b]
+        start[b] = r + 1
+        j = i + 1 if i + 1 < n else 0
+        eb[r, 0] = key[i]
+        eb[r, 1] = max(xy[i, 0], xy[j, 0])
+        eb[r, 2] = min(xy[i, 1], xy[j, 1])
+        eb[r, 3] = max(xy[i, 1], xy[j, 1])
+        eb[r, 4] = i
+    budget = 8 * n + 64
+    for r in range(1, n):
+        k = eb[r, 0]
+        if eb[r - 1, 0] <= k:
+            continue
+        c1 = eb[r, 1]
+        c2 = eb[r, 2]
+        c3 = eb[r, 3]
+        c4 = eb[r, 4]
+        s = r
+        while s > 0 and eb[s - 1, 0] > k:
+            for c in range(5):
+                eb[s, c] = eb[s - 1, c]
+            s -= 1
+        budget -= r - s
+        eb[s, 0] = k
+        eb[s, 1] = c1
+        eb[s, 2] = c2
+        eb[s, 3] = c3
+        eb[s, 4] = c4
+        if budget < 0:
+            return eb[np.argsort(eb[:, 0])]
+    return eb
 
 
 @njit(cache=True, nogil=True)
