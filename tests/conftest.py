@@ -6,13 +6,22 @@ from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-# "default" for local runs; "ci" is selected by .ci/run; "nojit" for the pure-Python
-# run of the kernels (NUMBA_DISABLE_JIT=1), which is slower, so it draws fewer examples.
+# "default" for local runs (fresh random examples each run); "ci" is selected by .ci/run
+# and is derandomized, so a CI verdict can be reproduced exactly; "deep" draws many more
+# examples for a search before a release; "nojit" for the pure-Python run of the kernels
+# (NUMBA_DISABLE_JIT=1), which is slower, so it draws fewer examples.
 settings.register_profile(
     "default", max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 settings.register_profile(
-    "ci", max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+    "ci",
+    max_examples=300,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile(
+    "deep", max_examples=3000, deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 settings.register_profile(
     "nojit", max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow]

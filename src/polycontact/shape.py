@@ -27,8 +27,9 @@ ArrayLike = Any
 
 
 def _signed_area(ring: np.ndarray) -> float:
-    x = ring[:, 0]
-    y = ring[:, 1]
+    # Relative to the first vertex: small rings far from the origin keep their digits.
+    x = ring[:, 0] - ring[0, 0]
+    y = ring[:, 1] - ring[0, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
@@ -136,9 +137,11 @@ class Shape:
         self._starts = starts
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
-        # contribute negative area, which removes them.
-        x = xy[:, 0]
-        y = xy[:, 1]
+        # contribute negative area, which removes them. Coordinates are taken relative to
+        # the first vertex so that a small shape far from the origin keeps its digits.
+        origin = xy[0]
+        x = xy[:, 0] - origin[0]
+        y = xy[:, 1] - origin[1]
         nxt = np.empty(len(xy), dtype=np.int64)
         for k in range(len(loops)):
             s, e = starts[k], starts[k + 1]
@@ -147,11 +150,13 @@ class Shape:
         a2 = float(cross.sum())
         self._area = 0.5 * a2
         self._centroid = np.array(
-            [float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
-             float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
+            [origin[0] + float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
+             origin[1] + float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
         )
         self._centroid.flags.writeable = False
-        self._radius = float(np.max(np.hypot(x - self._centroid[0], y - self._centroid[1])))
+        self._radius = float(
+            np.max(np.hypot(xy[:, 0] - self._centroid[0], xy[:, 1] - self._centroid[1]))
+        )
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
