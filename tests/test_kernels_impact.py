@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import shapely
-from hypothesis import assume, given
+from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
 from polycontact import Motion, Shape
@@ -149,6 +149,7 @@ def test_sampled_search_follows_the_paper_steps():
 
 
 @given(vec, st.floats(-4, 4), vec, st.floats(-4, 4), st.floats(-1, 1), st.floats(0, 1))
+@example((0.0, 0.0), 0.0, (-1.0, 0.0), 0.0, 0.0, 0.9999999999999999)
 def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     from polycontact._kernels.relation import boundary_distance
 
@@ -174,7 +175,10 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
         assert step >= min(1.0, d / speed * (1 - 1e-12))
     t = min(step, 1.0) * frac
     moved = boundary_distance(*a.at(ma, t).packed, *b.at(mb, t).packed)
-    assert moved > 0 or frac == 1
+    # Short of the step the bodies are still apart, unless the gap left, (1 - frac) d,
+    # is below the rounding of the placed coordinates (frac = 1 - 1e-16 on a head-on
+    # approach leaves a gap of 1e-16).
+    assert moved > 0 or (1 - frac) * d < 1e-12
 
 
 def _star(n, r0, r1, phase):

@@ -176,7 +176,9 @@ def _pt(g, xa, xb, na):
 
 
 @njit(cache=True, nogil=True)
-def _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
+def _cones_overlap(
+    px, py, xa, fa, xb, fb, na, box, ids, order, cnt, swept, maxw, eps, rays, rord
+):
     """Whether the open interior cones of A and B at the touch point p overlap.
 
     Every edge of either body within eps of p gives rays leaving p: along the edge from
@@ -184,36 +186,32 @@ def _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
     counter-clockwise of it is "opening"; sorted by angle, the interior of a body in a
     direction d is decided by the body's nearest ray clockwise of d (rays of one body
     alternate opening/closing around p, so holes touching the outer loop work too).
+    If ``swept``, the edge rows are ordered by ``order`` (xmin ascending; ``maxw`` the
+    widest edge) and only the rows near p are read; otherwise every row is read.
+    ``rays`` (at least 2 cnt rows of 6) and ``rord`` (as many ints) are scratch: rows
+    ``(pseudo-angle, edge length, opening, of A, unit direction)``, and their order.
     """
     lo = 0
-    hi = cnt
-    xlo = px - eps - maxw
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if box[order[mid], 0] < xlo:
-            lo = mid + 1
-        else:
-            hi = mid
-    cap = 0
-    for oi in range(lo, cnt):
-        i = order[oi]
-        if box[i, 0] > px + eps:
-            break
-        if box[i, 2] <= py + eps and box[i, 3] >= py - eps:
-            cap += 2
-    ang = np.empty(cap)
-    length = np.empty(cap)
-    opening = np.empty(cap, np.bool_)
-    is_a = np.empty(cap, np.bool_)
+    if swept:
+        hi = cnt
+        xlo = px - eps - maxw
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if box[order[mid], 0] < xlo:
+                lo = mid + 1
+            else:
+                hi = mid
     r = 0
     for oi in range(lo, cnt):
-        i = order[oi]
+        i = order[oi] if swept else oi
         if box[i, 0] > px + eps:
-            break
-        if box[i, 2] > py + eps or box[i, 3] < py - eps:
+            if swept:
+                break
             continue
-        body_a = ids[i, 0] < na
-        flip = fa if body_a else fb
+        if box[i, 1] < px - eps or box[i, 2] > py + eps or box[i, 3] < py - eps:
+            continue
+        a_side = 1.0 if ids[i, 0] < na else 0.0
+        flip = fa if a_side > 0.0 else fb
         ux, uy = _pt(ids[i, 0], xa, xb, na)
         wx, wy = _pt(ids[i, 1], xa, xb, na)
         if _point_segment_distance(px, py, ux, uy, wx, wy) > eps:
@@ -221,57 +219,89 @@ def _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
         du = _norm(px - ux, py - uy)
         dw = _norm(px - wx, py - wy)
         le = _norm(wx - ux, wy - uy)
+        if le == 0.0:
+            continue
+        ex = (wx - ux) / le
+        ey = (wy - uy) / le
         if du > eps or dw <= eps:  # ray from p (or from w) back along the edge
             if not (du <= eps and dw <= eps):
-                ang[r] = np.arctan2(uy - wy, ux - wx)
-                length[r] = le
-                opening[r] = flip < 0.0
-                is_a[r] = body_a
+                _put_ray(rays, r, -ex, -ey, le, flip < 0.0, a_side)
                 r += 1
         if dw > eps:  # ray from p (or from u) forward along the edge
-            ang[r] = np.arctan2(wy - uy, wx - ux)
-            length[r] = le
-            opening[r] = flip > 0.0
-            is_a[r] = body_a
+            _put_ray(rays, r, ex, ey, le, flip > 0.0, a_side)
             r += 1
     if r == 0:
         return False
-    ordr = np.argsort(ang[:r])
+    # Order by angle: insertion sort (a touch point has a handful of rays).
     for q in range(r):
-        i1 = ordr[q]
-        i2 = ordr[(q + 1) % r]
-        gap = ang[i2] - ang[i1]
+        key = rays[q, 0]
+        m = q
+        while m > 0 and rays[rord[m - 1], 0] > key:
+            rord[m] = rord[m - 1]
+            m -= 1
+        rord[m] = q
+    for q in range(r):
+        i1 = rord[q]
+        i2 = rord[(q + 1) % r]
+        gap = rays[i2, 0] - rays[i1, 0]  # in pseudo-angle units (a full turn is 4)
         if q == r - 1:
-            gap += 2.0 * np.pi
-        if gap * min(length[i1], length[i2]) <= eps and gap < 1.0:
-            continue
-        mid = ang[i1] + 0.5 * gap
-        if mid > np.pi:
-            mid -= 2.0 * np.pi
-        if _interior_at(mid, ang, opening, is_a, r, True) and _interior_at(
-            mid, ang, opening, is_a, r, False
-        ):
+            gap += 4.0
+        if gap < 2.0:
+            # Less than half a turn: skip a sliver whose rays end within eps of each
+            # other (true angle below 1 radian and angle x shorter length <= eps).
+            sin_gap = rays[i1, 4] * rays[i2, 5] - rays[i1, 5] * rays[i2, 4]
+            cos_gap = rays[i1, 4] * rays[i2, 4] + rays[i1, 5] * rays[i2, 5]
+            if cos_gap > _COS_ONE_RADIAN and (
+                np.arcsin(min(1.0, max(0.0, sin_gap))) * min(rays[i1, 1], rays[i2, 1]) <= eps
+            ):
+                continue
+        mid = rays[i1, 0] + 0.5 * gap
+        if mid > 2.0:
+            mid -= 4.0
+        if _interior_at(mid, rays, r, 1.0) and _interior_at(mid, rays, r, 0.0):
             return True
     return False
 
 
+_COS_ONE_RADIAN = np.cos(1.0)
+
+
 @njit(cache=True, nogil=True)
-def _interior_at(theta, ang, opening, is_a, r, body_a):
-    """Interior flag of one body in direction theta: its nearest ray clockwise."""
+def _pseudo_angle(dx, dy):
+    """A number in (-2, 2] that increases with ``atan2(dy, dx)`` (no trigonometry)."""
+    p = dx / (abs(dx) + abs(dy))
+    return 1.0 - p if dy >= 0.0 else p - 1.0
+
+
+@njit(cache=True, nogil=True)
+def _put_ray(rays, r, ux, uy, length, opening, a_side):
+    """Row r of the ray table: pseudo-angle, edge length, opening, of A, unit direction."""
+    rays[r, 0] = _pseudo_angle(ux, uy)
+    rays[r, 1] = length
+    rays[r, 2] = 1.0 if opening else 0.0
+    rays[r, 3] = a_side
+    rays[r, 4] = ux
+    rays[r, 5] = uy
+
+
+@njit(cache=True, nogil=True)
+def _interior_at(theta, rays, r, a_side):
+    """Interior flag of one body (``a_side`` 1.0 for A) in pseudo-angle direction
+    theta: its nearest ray clockwise."""
     best = -1
     best_gap = np.inf
     for i in range(r):
-        if is_a[i] != body_a:
+        if rays[i, 3] != a_side:
             continue
-        gap = theta - ang[i]
+        gap = theta - rays[i, 0]
         if gap < 0.0:
-            gap += 2.0 * np.pi
+            gap += 4.0
         if gap < best_gap:
             best_gap = gap
             best = i
     if best < 0:
         return False
-    return opening[best]
+    return rays[best, 2] > 0.0
 
 
 @njit(cache=True, nogil=True)
@@ -289,20 +319,98 @@ def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
 
 
 @njit(cache=True, nogil=True)
+def _point_segment_distance2(px, py, ax, ay, bx, by):
+    """Squared distance from p to the closed segment ab."""
+    dx = bx - ax
+    dy = by - ay
+    wx = px - ax
+    wy = py - ay
+    t = wx * dx + wy * dy
+    if t <= 0.0:
+        return wx * wx + wy * wy
+    den = dx * dx + dy * dy
+    if t >= den:
+        ex = px - bx
+        ey = py - by
+        return ex * ex + ey * ey
+    t /= den
+    ex = wx - t * dx
+    ey = wy - t * dy
+    return ex * ex + ey * ey
+
+
+#: Pairs with at most this many (A edge, B edge) combinations in the common window are
+#: tested all against all; above it the edges are sorted and swept in x.
+_ALL_PAIRS = 256
+
+
+@njit(cache=True, nogil=True)
+def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
+    """Edge ga->a1 of A against edge gb->b1 of B (B's rows offset by na).
+
+    Marks in ``touch`` every end vertex within eps of the other edge; returns 1 if some
+    did, 2 if the edges cross properly (and no end is within eps), 0 otherwise.
+    """
+    px, py = xa[ga, 0], xa[ga, 1]
+    qx, qy = xa[a1, 0], xa[a1, 1]
+    rx, ry = xb[gb - na, 0], xb[gb - na, 1]
+    sx, sy = xb[b1 - na, 0], xb[b1 - na, 1]
+    # An end is "beyond eps" of a line when its orientation exceeds eps x the edge
+    # length; compared squared, so no square root is taken.
+    o1 = _orient(px, py, qx, qy, rx, ry)
+    o2 = _orient(px, py, qx, qy, sx, sy)
+    if o1 * o2 > 0.0:
+        ta2 = eps * eps * ((qx - px) * (qx - px) + (qy - py) * (qy - py))
+        if o1 * o1 > ta2 and o2 * o2 > ta2:
+            return 0  # B's edge strictly on one side of A's edge line
+    o3 = _orient(rx, ry, sx, sy, px, py)
+    o4 = _orient(rx, ry, sx, sy, qx, qy)
+    if o3 * o4 > 0.0:
+        tb2 = eps * eps * ((sx - rx) * (sx - rx) + (sy - ry) * (sy - ry))
+        if o3 * o3 > tb2 and o4 * o4 > tb2:
+            return 0
+    e2 = eps * eps
+    near = 0
+    if _point_segment_distance2(px, py, rx, ry, sx, sy) <= e2:
+        touch[ga] = True
+        near = 1
+    if _point_segment_distance2(qx, qy, rx, ry, sx, sy) <= e2:
+        touch[a1] = True
+        near = 1
+    if _point_segment_distance2(rx, ry, px, py, qx, qy) <= e2:
+        touch[gb] = True
+        near = 1
+    if _point_segment_distance2(sx, sy, px, py, qx, qy) <= e2:
+        touch[b1] = True
+        near = 1
+    if near:
+        return 1
+    if ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
+        return 2
+    return 0
+
+
+@njit(cache=True, nogil=True)
 def _state(xa, sa, fa, xb, sb, fb, eps):
     """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right)."""
-    box, ids, touch = _scratch(sa[sa.shape[0] - 1] + sb[sb.shape[0] - 1])
-    return _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch)
+    return _state_in(xa, sa, fa, xb, sb, fb, eps, _scratch(sa[-1] + sb[-1]))
 
 
 @njit(cache=True, nogil=True)
 def _scratch(size):
-    """Scratch buffers for :func:`_state_in` for up to ``size`` vertices in all."""
-    return np.empty((size + 1, 4)), np.empty((size + 1, 4), np.int64), np.empty(size + 1, np.bool_)
+    """Scratch buffers for :func:`_state_in` for up to ``size`` vertices in all: edge
+    boxes, edge ids, touch flags, and the rays at one touch point with their order."""
+    return (
+        np.empty((size + 1, 4)),
+        np.empty((size + 1, 4), np.int64),
+        np.empty(size + 1, np.bool_),
+        np.empty((2 * size + 2, 6)),
+        np.empty(2 * size + 2, np.int64),
+    )
 
 
 @njit(cache=True, nogil=True)
-def _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch):
+def _state_in(xa, sa, fa, xb, sb, fb, eps, scratch):
     """:func:`_state` with scratch buffers (from :func:`_scratch`; grown if too small),
     so a loop over many pairs allocates nothing per pair."""
     na = sa[sa.shape[0] - 1]
@@ -316,72 +424,65 @@ def _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch):
     wy0 = max(ay0, by0) - eps
     wy1 = min(ay1, by1) + eps
     tot = na + nb
-    if box.shape[0] <= tot:
-        box, ids, touch = _scratch(tot)
-    cnt = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, box, ids, 0)
-    cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, box, ids, cnt)
-    # ids columns: 0, 1 the edge's vertices; 2 the sweep order; 3 scratch of the sort
-    order = ids[:, 2]
-    _sort_into(box, cnt, order, ids[:, 3])
+    if scratch[0].shape[0] <= tot:
+        scratch = _scratch(tot)
+    box, ids, touch, rays, rord = scratch
+    cnt_a = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, box, ids, 0)  # rows of A's edges
+    cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, box, ids, cnt_a)
     touch[:tot] = False
     any_touch = False
     maxw = 0.0
-    for oi in range(cnt):
-        i = order[oi]
-        xi1 = box[i, 1] + eps
-        yi0 = box[i, 2] - eps
-        yi1 = box[i, 3] + eps
-        maxw = max(maxw, box[i, 1] - box[i, 0])
-        i_in_a = ids[i, 0] < na
-        for oj in range(oi + 1, cnt):
-            j = order[oj]
-            if box[j, 0] > xi1:
-                break
-            if (ids[j, 0] < na) == i_in_a or box[j, 2] > yi1 or box[j, 3] < yi0:
-                continue
-            ea = i if i_in_a else j
-            eb = j if i_in_a else i
-            ga = ids[ea, 0]
-            a1 = ids[ea, 1]
-            gb = ids[eb, 0]
-            b1 = ids[eb, 1]
-            px, py = xa[ga, 0], xa[ga, 1]
-            qx, qy = xa[a1, 0], xa[a1, 1]
-            rx, ry = xb[gb - na, 0], xb[gb - na, 1]
-            sx, sy = xb[b1 - na, 0], xb[b1 - na, 1]
-            o1 = _orient(px, py, qx, qy, rx, ry)
-            o2 = _orient(px, py, qx, qy, sx, sy)
-            ta = eps * _norm(qx - px, qy - py)
-            if (o1 > ta and o2 > ta) or (o1 < -ta and o2 < -ta):
-                continue  # B's edge strictly on one side of A's edge line
-            o3 = _orient(rx, ry, sx, sy, px, py)
-            o4 = _orient(rx, ry, sx, sy, qx, qy)
-            tb = eps * _norm(sx - rx, sy - ry)
-            if (o3 > tb and o4 > tb) or (o3 < -tb and o4 < -tb):
-                continue
-            near = False
-            if _point_segment_distance(px, py, rx, ry, sx, sy) <= eps:
-                touch[ga] = True
-                near = True
-            if _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps:
-                touch[a1] = True
-                near = True
-            if _point_segment_distance(rx, ry, px, py, qx, qy) <= eps:
-                touch[gb] = True
-                near = True
-            if _point_segment_distance(sx, sy, px, py, qx, qy) <= eps:
-                touch[b1] = True
-                near = True
-            if near:
-                any_touch = True
-            elif ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
-                return PENETRATING
+    # ids columns: 0, 1 the edge's vertices; 2 the sweep order; 3 scratch of the sort
+    order = ids[:, 2]
+    swept = cnt_a * (cnt - cnt_a) > _ALL_PAIRS
+    if not swept:
+        # Few edges in the window: every A edge against every B edge, no sort.
+        for i in range(cnt_a):
+            x0 = box[i, 0] - eps
+            x1 = box[i, 1] + eps
+            y0 = box[i, 2] - eps
+            y1 = box[i, 3] + eps
+            for j in range(cnt_a, cnt):
+                if box[j, 0] > x1 or box[j, 1] < x0 or box[j, 2] > y1 or box[j, 3] < y0:
+                    continue
+                met = _edge_pair(xa, xb, na, ids[i, 0], ids[i, 1], ids[j, 0], ids[j, 1], eps, touch)
+                if met == 2:
+                    return PENETRATING
+                if met == 1:
+                    any_touch = True
+    else:
+        _sort_into(box, cnt, order, ids[:, 3])
+        for oi in range(cnt):
+            i = order[oi]
+            xi1 = box[i, 1] + eps
+            yi0 = box[i, 2] - eps
+            yi1 = box[i, 3] + eps
+            maxw = max(maxw, box[i, 1] - box[i, 0])
+            i_in_a = i < cnt_a
+            for oj in range(oi + 1, cnt):
+                j = order[oj]
+                if box[j, 0] > xi1:
+                    break
+                if (j < cnt_a) == i_in_a or box[j, 2] > yi1 or box[j, 3] < yi0:
+                    continue
+                ea = i if i_in_a else j
+                eb = j if i_in_a else i
+                met = _edge_pair(
+                    xa, xb, na, ids[ea, 0], ids[ea, 1], ids[eb, 0], ids[eb, 1], eps, touch
+                )
+                if met == 2:
+                    return PENETRATING
+                if met == 1:
+                    any_touch = True
     # (3) cones at the touch points
     if any_touch:
         for g in range(tot):
             if touch[g]:
                 px, py = _pt(g, xa, xb, na)
-                if _cones_overlap(px, py, xa, fa, xb, fb, na, box, ids, order, cnt, maxw, eps):
+                if _cones_overlap(
+                    px, py, xa, fa, xb, fb, na, box, ids, order, cnt, swept, maxw, eps, rays,
+                    rord,
+                ):
                     return PENETRATING
     # (2) one untouched vertex per loop, strictly inside the other body
     if _untouched_inside(xa, sa, touch, 0, xb, sb, bx0, bx1, by0, by1):

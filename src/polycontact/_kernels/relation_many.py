@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .relation import CONTACT, SEPARATE, _raw_ring, _state, closest_pair, penetration
+from .relation import CONTACT, SEPARATE, _raw_ring, _scratch, _state_in, closest_pair, penetration
 
 
 @njit(cache=True, nogil=True)
@@ -41,6 +41,27 @@ def _body(xy, ls, bs, p):
 
 
 @njit(cache=True, nogil=True)
+def _body_into(xy, ls, bs, p, buf):
+    """:func:`_body` with the loop starts written into ``buf`` (no allocation)."""
+    first = ls[bs[p]]
+    m = bs[p + 1] - bs[p]
+    for k in range(m):
+        buf[k] = ls[bs[p] + k] - first
+    return xy[first : ls[bs[p + 1] - 1]], buf[:m]
+
+
+@njit(cache=True, nogil=True)
+def _largest(ls, bs):
+    """Most vertices and most loop starts of one body in a packed batch."""
+    v = 0
+    m = 0
+    for p in range(bs.shape[0] - 1):
+        v = max(v, ls[bs[p + 1] - 1] - ls[bs[p]])
+        m = max(m, bs[p + 1] - bs[p])
+    return v, m
+
+
+@njit(cache=True, nogil=True)
 def _scale(xy):
     s = 1.0
     for i in range(xy.shape[0]):
@@ -57,12 +78,17 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
     p_count = bsa.shape[0] - 1
     states = np.empty(p_count, np.int8)
     eps = np.empty(p_count)
+    va, ma = _largest(lsa, bsa)
+    vb, mb = _largest(lsb, bsb)
+    scratch = _scratch(va + vb)
+    buf_a = np.empty(ma, np.int64)
+    buf_b = np.empty(mb, np.int64)
     for p in range(p_count):
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
+        ya, sa = _body_into(xa, lsa, bsa, p, buf_a)
+        yb, sb = _body_into(xb, lsb, bsb, p, buf_b)
         e = tol if tol >= 0.0 else rel * max(_scale(ya), _scale(yb))
         eps[p] = e
-        states[p] = _state(ya, sa, fa[p], yb, sb, fb[p], e)
+        states[p] = _state_in(ya, sa, fa[p], yb, sb, fb[p], e, scratch)
     return states, eps
 
 
