@@ -208,3 +208,42 @@ def test_many_kernels_match_single(many):
             assert d == 0.0
         else:
             assert -d == pytest.approx(kr.penetration(*a.packed, *b.packed, _eps(a, b))[0])
+
+
+@given(st.lists(pairs(n_max=6, holes=False), min_size=1, max_size=5), st.data())
+def test_raw_states_matches_single_pairs(many, data):
+    """The fused validate-and-classify kernel of (P, N, 2) arrays against classify_raw."""
+    n = max(max(len(a.exterior), len(b.exterior)) for a, b, _ in many)
+
+    def raw(shape):
+        # n rows: a ring of n - 1 vertices gets its closing point (dropped by the kernel);
+        # either orientation, as the data says.
+        ring = shape.exterior
+        if data.draw(st.booleans()):
+            ring = ring[::-1]
+        if len(ring) == n - 1:
+            ring = np.vstack([ring, ring[:1]])
+        return ring if len(ring) == n else None
+
+    rows = [(raw(a), raw(b)) for a, b, _ in many]
+    rows = [(ra, rb) for ra, rb in rows if ra is not None and rb is not None]
+    if not rows:
+        return
+    xa = np.stack([ra for ra, _ in rows])
+    xb = np.stack([rb for _, rb in rows])
+    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0, RELATIVE_TOLERANCE)
+    for p, (ra, rb) in enumerate(rows):
+        state, e, na, fa, nb, fb = kr.classify_raw(ra, rb, -1.0, RELATIVE_TOLERANCE)
+        assert (states[p], eps[p], used_a[p], sign_a[p], used_b[p], sign_b[p]) == (
+            state, e, na, fa, nb, fb
+        )
+
+
+def test_raw_states_flags_invalid_rings():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
+    states, _, used_a, _, used_b, _ = km.raw_states(
+        np.stack([sq, bow, sq]), np.stack([sq + 0.5, sq, bow]), -1.0, RELATIVE_TOLERANCE
+    )
+    assert states.tolist() == [2, -1, -1]
+    assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]

@@ -158,3 +158,13 @@ def test_inputs_are_not_modified():
     np.testing.assert_array_equal(a, keep[0])
     np.testing.assert_array_equal(b, keep[1])
     assert UNIT.exterior.flags.writeable is False  # Shapes stay frozen too
+
+
+def test_classify_many_array_path_names_the_bad_ring():
+    bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
+    a = np.stack([SQ, SQ, SQ])
+    b = np.stack([SQ, SQ, bow])
+    keep = b.copy()
+    with pytest.raises(InvalidShapeError, match=r"^shapes_b\[2\]: .*self-intersect"):
+        classify_many(a, b)
+    np.testing.assert_array_equal(b, keep)

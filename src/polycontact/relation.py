@@ -399,25 +399,45 @@ def _split(count: int, fn: Any) -> list[Any]:
         return list(pool.map(fn, bounds[:-1], bounds[1:]))
 
 
-def _pack_array(arr: np.ndarray, what: str) -> tuple | None:
-    """Pack a (P, N, 2) array of raw rings; None if some ring needs ``Shape``."""
-    from ._kernels import relation_many as km
-
-    p_count, n = arr.shape[0], arr.shape[1]
-    xy = np.ascontiguousarray(arr, dtype=np.float64).reshape(-1, 2)
-    lo = np.arange(p_count, dtype=np.int64) * n
-    counts = np.full(p_count, n, dtype=np.int64)
-    parts = _split(
-        p_count, lambda p0, p1: km.check_rings(xy, lo[p0:p1], counts[p0:p1], RELATIVE_TOLERANCE)
-    )
-    used = np.concatenate([u for u, _ in parts])
-    sign = np.concatenate([s for _, s in parts])
-    if (used < 0).any():
+def _raw_array(arr: Any) -> np.ndarray | None:
+    """``arr`` as a C-contiguous float64 (P, N, 2) array of rings, or None if it is not
+    one (no copy when it already is)."""
+    if not (isinstance(arr, np.ndarray) and arr.ndim == 3 and arr.shape[2] == 2):
         return None
+    if arr.dtype.kind not in "fiu":
+        return None
+    return np.ascontiguousarray(arr, dtype=np.float64)
+
+
+def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple:
+    """Packed batch form of P validated rings ``arr`` (P, N, 2), ``used[p]`` vertices each."""
+    p_count, n = arr.shape[0], arr.shape[1]
+    lo = np.arange(p_count, dtype=np.int64) * n
     ls = np.empty(2 * p_count, dtype=np.int64)
     ls[0::2] = lo
     ls[1::2] = lo + used
-    return xy, ls, np.arange(0, 2 * p_count + 1, 2, dtype=np.int64), sign
+    return arr.reshape(-1, 2), ls, np.arange(0, 2 * p_count + 1, 2, dtype=np.int64), sign
+
+
+def _classify_arrays(
+    arr_a: np.ndarray, arr_b: np.ndarray, tol: float
+) -> RelationBatch | None:
+    """:func:`classify_many` of two (P, N, 2) ring arrays in one kernel pass per thread;
+    None if some ring is not valid as given (the caller then explains through ``Shape``)."""
+    from ._kernels import relation_many as km
+
+    parts = _split(
+        arr_a.shape[0],
+        lambda p0, p1: km.raw_states(arr_a[p0:p1], arr_b[p0:p1], tol, RELATIVE_TOLERANCE),
+    )
+    states, eps, used_a, sign_a, used_b, sign_b = (
+        np.concatenate([part[k] for part in parts]) for k in range(6)
+    )
+    if (states < 0).any():
+        return None
+    return RelationBatch(
+        states, eps, (*_ring_pack(arr_a, used_a, sign_a), *_ring_pack(arr_b, used_b, sign_b))
+    )
 
 
 def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
@@ -469,10 +489,7 @@ def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
 
 
 def _pack(items: Any, what: str) -> tuple:
-    if isinstance(items, np.ndarray) and items.ndim == 3 and items.shape[2] == 2:
-        packed = _pack_array(items, what)
-        if packed is not None:
-            return packed
+    if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
         raise InvalidShapeError(
@@ -514,13 +531,19 @@ def classify_many(
     """
     from ._kernels import relation_many as km
 
+    tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
+    arr_a = _raw_array(shapes_a)
+    arr_b = _raw_array(shapes_b)
+    if arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
+        batch = _classify_arrays(arr_a, arr_b, tol)
+        if batch is not None:
+            return batch
     pa = _pack(shapes_a, "shapes_a")
     pb = _pack(shapes_b, "shapes_b")
     if len(pa[3]) != len(pb[3]):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"
         )
-    tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     xa, lsa, bsa, fa = pa
     xb, lsb, bsb, fb = pb
 

@@ -34,6 +34,45 @@ def check_rings(xy, lo, n, rel):
 
 
 @njit(cache=True, nogil=True)
+def raw_states(xa, xb, tol, rel):
+    """Validate and classify P pairs of raw outer rings, ``xa`` (P, N, 2) against
+    ``xb`` (P, M, 2), in one pass over the pairs.
+
+    Returns ``(states, eps, used_a, sign_a, used_b, sign_b)``: per pair the state
+    (int8; -1 when either ring is not valid as given), the tolerance, and per ring
+    the vertices used (a repeated closing point dropped; -1 if invalid) and the
+    orientation sign (see :func:`polycontact._kernels.relation._raw_ring`).
+    ``tol`` < 0 means per pair ``rel`` × the largest absolute coordinate of the pair.
+    """
+    p_count = xa.shape[0]
+    states = np.empty(p_count, np.int8)
+    eps = np.zeros(p_count)
+    used_a = np.empty(p_count, np.int64)
+    used_b = np.empty(p_count, np.int64)
+    sign_a = np.empty(p_count)
+    sign_b = np.empty(p_count)
+    scratch = _scratch(xa.shape[1] + xb.shape[1])
+    sa = np.zeros(2, np.int64)
+    sb = np.zeros(2, np.int64)
+    for p in range(p_count):
+        na, fa, sca = _raw_ring(xa[p], rel)
+        nb, fb, scb = _raw_ring(xb[p], rel)
+        used_a[p] = na
+        used_b[p] = nb
+        sign_a[p] = fa
+        sign_b[p] = fb
+        if na < 0 or nb < 0:
+            states[p] = -1
+            continue
+        e = tol if tol >= 0.0 else rel * max(sca, scb)
+        eps[p] = e
+        sa[1] = na
+        sb[1] = nb
+        states[p] = _state_in(xa[p][:na], sa, fa, xb[p][:nb], sb, fb, e, scratch)
+    return states, eps, used_a, sign_a, used_b, sign_b
+
+
+@njit(cache=True, nogil=True)
 def _body(xy, ls, bs, p):
     first = ls[bs[p]]
     starts = ls[bs[p] : bs[p + 1]] - first
