@@ -158,7 +158,7 @@ def test_long_ring_sweep_agrees_with_all_pairs(radii, snap, swap):
 @given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
 def test_raw_ring_agrees_with_shape(points):
     ring = np.array(points, dtype=float)
-    n, sign, scale = kr._raw_ring(ring, RELATIVE_TOLERANCE)
+    n, sign, scale, box = kr._raw_ring(ring, RELATIVE_TOLERANCE)
     try:
         shape = Shape(ring)
     except InvalidShapeError:
@@ -169,6 +169,7 @@ def test_raw_ring_agrees_with_shape(points):
         assert n == len(ring)
         assert sign == (1.0 if np.array_equal(shape.exterior, ring) else -1.0)
         assert scale == max(1.0, np.abs(ring).max())
+        assert box == (ring[:, 0].min(), ring[:, 0].max(), ring[:, 1].min(), ring[:, 1].max())
 
 
 def test_classify_raw_orientation_and_codes():

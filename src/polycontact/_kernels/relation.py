@@ -393,7 +393,8 @@ def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
 @njit(cache=True, nogil=True)
 def _state(xa, sa, fa, xb, sb, fb, eps):
     """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right)."""
-    return _state_in(xa, sa, fa, xb, sb, fb, eps, _scratch(sa[-1] + sb[-1]))
+    box, ids, touch, rays, rord = _scratch(sa[-1] + sb[-1])
+    return _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch, rays, rord)
 
 
 @njit(cache=True, nogil=True)
@@ -410,9 +411,9 @@ def _scratch(size):
 
 
 @njit(cache=True, nogil=True)
-def _state_in(xa, sa, fa, xb, sb, fb, eps, scratch):
-    """:func:`_state` with scratch buffers (from :func:`_scratch`; grown if too small),
-    so a loop over many pairs allocates nothing per pair."""
+def _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch, rays, rord):
+    """:func:`_state` with the scratch buffers of :func:`_scratch` (sized for at least
+    the vertices of both bodies), so a loop over many pairs allocates nothing per pair."""
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
     ax0, ax1, ay0, ay1 = _bbox(xa, na)
@@ -424,9 +425,6 @@ def _state_in(xa, sa, fa, xb, sb, fb, eps, scratch):
     wy0 = max(ay0, by0) - eps
     wy1 = min(ay1, by1) + eps
     tot = na + nb
-    if scratch[0].shape[0] <= tot:
-        scratch = _scratch(tot)
-    box, ids, touch, rays, rord = scratch
     cnt_a = _edge_table(xa, sa, 0, wx0, wx1, wy0, wy1, box, ids, 0)  # rows of A's edges
     cnt = _edge_table(xb, sb, na, wx0, wx1, wy0, wy1, box, ids, cnt_a)
     touch[:tot] = False
@@ -802,20 +800,21 @@ def _sorted_edge_boxes(xy, n):
 
 @njit(cache=True, nogil=True)
 def _raw_ring(xy, rel):
-    """Check one raw (N, 2) ring; returns ``(n, sign, scale)``.
+    """Check one raw (N, 2) ring; returns ``(n, sign, scale, box)``.
 
     ``n`` is the number of vertices used (a repeated closing point dropped), or -1 when
     the ring is not a valid simple polygon as given (the caller then lets
     :class:`polycontact.Shape` explain or repair); ``sign`` is +1.0 counter-clockwise,
-    -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1).
+    -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1); ``box`` the
+    bounding box ``(xmin, xmax, ymin, ymax)``.
     """
     n = xy.shape[0]
     if xy.shape[1] != 2:
-        return -1, 1.0, 1.0
+        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
     if n >= 2 and xy[n - 1, 0] == xy[0, 0] and xy[n - 1, 1] == xy[0, 1]:
         n -= 1
     if n < 3:
-        return -1, 1.0, 1.0
+        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
     # One pass: finiteness, scale, bounding box and twice the signed area.
     x0 = np.inf
     x1 = -np.inf
@@ -828,7 +827,7 @@ def _raw_ring(xy, rel):
         x = xy[i, 0]
         y = xy[i, 1]
         if not (abs(x) < np.inf and abs(y) < np.inf):
-            return -1, 1.0, 1.0
+            return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
         x0 = min(x0, x)
         x1 = max(x1, x)
         y0 = min(y0, y)
@@ -839,10 +838,10 @@ def _raw_ring(xy, rel):
     scale = max(1.0, -x0, x1, -y0, y1)
     eps = rel * scale
     if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
-        return -1, 1.0, 1.0
+        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
     if not _ring_is_simple(xy, n, eps):
-        return -1, 1.0, 1.0
-    return n, (1.0 if a2 > 0.0 else -1.0), scale
+        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
+    return n, (1.0 if a2 > 0.0 else -1.0), scale, (x0, x1, y0, y1)
 
 
 @njit(cache=True, nogil=True)
@@ -853,10 +852,10 @@ def classify_raw(a, b, tol, rel):
     valid as given and -2 when ring B is not (the caller re-raises through ``Shape``).
     ``tol`` < 0 means the default tolerance ``rel`` × the largest coordinate.
     """
-    na, fa, sca = _raw_ring(a, rel)
+    na, fa, sca, _ = _raw_ring(a, rel)
     if na < 0:
         return -1, 0.0, na, fa, 0, 1.0
-    nb, fb, scb = _raw_ring(b, rel)
+    nb, fb, scb, _ = _raw_ring(b, rel)
     if nb < 0:
         return -2, 0.0, na, fa, nb, fb
     eps = tol if tol >= 0.0 else rel * max(sca, scb)

@@ -27,7 +27,7 @@ def check_rings(xy, lo, n, rel):
     used = np.empty(p_count, np.int64)
     sign = np.empty(p_count)
     for p in range(p_count):
-        u, s, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel)
+        u, s, _, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel)
         used[p] = u
         sign[p] = s
     return used, sign
@@ -51,12 +51,12 @@ def raw_states(xa, xb, tol, rel):
     used_b = np.empty(p_count, np.int64)
     sign_a = np.empty(p_count)
     sign_b = np.empty(p_count)
-    scratch = _scratch(xa.shape[1] + xb.shape[1])
+    box, ids, touch, rays, rord = _scratch(xa.shape[1] + xb.shape[1])
     sa = np.zeros(2, np.int64)
     sb = np.zeros(2, np.int64)
     for p in range(p_count):
-        na, fa, sca = _raw_ring(xa[p], rel)
-        nb, fb, scb = _raw_ring(xb[p], rel)
+        na, fa, sca, ba = _raw_ring(xa[p], rel)
+        nb, fb, scb, bb = _raw_ring(xb[p], rel)
         used_a[p] = na
         used_b[p] = nb
         sign_a[p] = fa
@@ -66,9 +66,14 @@ def raw_states(xa, xb, tol, rel):
             continue
         e = tol if tol >= 0.0 else rel * max(sca, scb)
         eps[p] = e
+        if ba[0] > bb[1] + e or bb[0] > ba[1] + e or ba[2] > bb[3] + e or bb[2] > ba[3] + e:
+            states[p] = SEPARATE  # boxes apart: no call into the state kernel
+            continue
         sa[1] = na
         sb[1] = nb
-        states[p] = _state_in(xa[p][:na], sa, fa, xb[p][:nb], sb, fb, e, scratch)
+        states[p] = _state_in(
+            xa[p][:na], sa, fa, xb[p][:nb], sb, fb, e, box, ids, touch, rays, rord
+        )
     return states, eps, used_a, sign_a, used_b, sign_b
 
 
@@ -119,7 +124,7 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
     eps = np.empty(p_count)
     va, ma = _largest(lsa, bsa)
     vb, mb = _largest(lsb, bsb)
-    scratch = _scratch(va + vb)
+    box, ids, touch, rays, rord = _scratch(va + vb)
     buf_a = np.empty(ma, np.int64)
     buf_b = np.empty(mb, np.int64)
     for p in range(p_count):
@@ -127,7 +132,7 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
         yb, sb = _body_into(xb, lsb, bsb, p, buf_b)
         e = tol if tol >= 0.0 else rel * max(_scale(ya), _scale(yb))
         eps[p] = e
-        states[p] = _state_in(ya, sa, fa[p], yb, sb, fb[p], e, scratch)
+        states[p] = _state_in(ya, sa, fa[p], yb, sb, fb[p], e, box, ids, touch, rays, rord)
     return states, eps
 
 
