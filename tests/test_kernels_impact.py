@@ -160,14 +160,14 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
     d, step = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
                            b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, 0.0, 1.0, 0.0, np.full(3, -1))
+                           ma.array, mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1))
     # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
     # it is never below the gap, and with lam just above the gap it is the gap
     gap = boundary_distance(*a.packed, *b.packed)
     assert d >= gap * (1 - 1e-12)
     d_lam, _ = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
                             b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
-                            ma.array, mb.array, 0.0, 1.0, 1.01 * gap, np.full(3, -1))
+                            ma.array, mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1))
     assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -203,11 +203,12 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
     lam = 1e-3
+    lam_pair = ki.PAIR_GAP * lam
     d, step = ki.pair_step(pa.packed[0], np.array(pa.centroid), la, ki.edge_table(a.packed[1], la),
                            pb.packed[0], np.array(pb.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, t0, t0 + window, lam, np.full(3, -1))
+                           ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1))
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)
     for t in np.linspace(t0, t0 + step, 7):
-        assert boundary_distance(*a.at(ma, t).packed, *b.at(mb, t).packed) >= lam * (1 - 1e-9)
+        assert boundary_distance(*a.at(ma, t).packed, *b.at(mb, t).packed) >= lam_pair * (1 - 1e-9)

@@ -253,8 +253,9 @@ def time_of_impact(
     without the boundaries meeting (at the first overlap the boundaries touch). So
     each step min(H, d/S) lands no later than the first contact. The step actually
     taken is longer and has the same guarantee: boundaries meet first where a vertex
-    reaches an edge, so it is enough that no vertex p comes within λ of any edge e of
-    the other body. Each such pair is held apart along its own fixed normal n (from
+    reaches an edge, so it is enough that no vertex p comes within λ' of any edge e of
+    the other body (λ' = λ until the first contact is found, λ/64 after it, so that
+    fewer probes remain before the hit). Each such pair is held apart along its own fixed normal n (from
     the nearest point q of e to p): the edge lies in the half-plane behind q, so
     sep(t) = p(t)·n − max over points x of e of x(t)·n starts at dist(p, e) and never
     exceeds it. A point moves along n at v·n + ω (J R r)·n, and (J R(θ) r)·n stays
@@ -262,8 +263,9 @@ def time_of_impact(
     −Δv·n − ω_p f_p + max_x ω_e f_x evaluated over boxes that hold these quantities on
     the window (extremes at its ends or corners; see ``_kernels.impact._pair_rate``),
     and never faster than the plain bound above with |r_p| and max |r_e| for L. The
-    step is the least, over pairs and both ways, of (dist − λ) / rate; pairs too far
-    to matter are skipped by a sweep over x. Near contact the step
+    step is the least, over pairs and both ways, of (dist − λ') / rate; pairs too far
+    to matter are skipped by boxes (and a sweep over x for large bodies). Near contact
+    the step
     shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
     λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and classifies
     the end. A penetrating end is the hit, with the non-penetrating start of the

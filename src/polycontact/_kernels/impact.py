@@ -60,14 +60,22 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     return lin + wa * la + wb * lb
 
 
-#: Largest m·n for which :func:`pair_step` visits every vertex–edge pair; above it the
-#: edges of the other body are sorted by their smallest x once per step and each vertex
-#: visits only those within its reach.
+#: When a body's vertices times the other body's edges are at most
+#: :data:`PAIR_SCAN_MAX`, each vertex within reach of the other body's box meets every
+#: edge; otherwise, when at most :data:`FEW_VERTICES` are within reach, they meet the
+#: edges within reach of their common box, and else a sweep over the edges sorted by
+#: smallest x finds each vertex's edges.
+FEW_VERTICES = 32
 PAIR_SCAN_MAX = 256
+
+#: The pair steps of :func:`pair_step` stop this fraction of the contact resolution
+#: short of contact: the probes that follow (each a classification) then cover a gap
+#: of lam / 64 instead of lam.
+PAIR_GAP = 1.0 / 64.0
 
 #: After a step h shorter than its window, the next window is this many times h: the
 #: directional bounds tighten as the window (the angle turned in it) shrinks.
-WINDOW_GROWTH = 2.0
+WINDOW_GROWTH = 1.5
 
 
 @njit(cache=True, nogil=True)
@@ -185,12 +193,17 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
 
 
 @njit(cache=True, nogil=True)
-def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, lam, dmin2,
-                  step, scan_all, crit, way):
+def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, lam, lam_pair,
+                  dmin2, step, crit, way):
     """Vertices of one body against the edges of the other (``wv``, ``we``: the bounds
     of |ω| over the window; ``nxt``, ``re_max``, ``order`` from :func:`edge_table`;
-    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that
-    sets the step is written to ``crit`` as ``(way, vertex, edge)``."""
+    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that sets the step is written to
+    ``crit`` as ``(way, vertex, edge)``.
+
+    Only vertices within reach of the edge body's box are visited; when they are few,
+    each meets the edges within reach of their common box, else a sweep over the edges
+    sorted by smallest x (``et[2]``, kept nearly sorted from step to step) finds them.
+    """
     ne = xe.shape[0]
     x0 = np.inf
     x1 = -np.inf
@@ -203,7 +216,7 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
         y0 = min(y0, xe[j, 1])
         y1 = max(y1, xe[j, 1])
         lmax = max(lmax, re_max[j])
-    if scan_all:
+    if xv.shape[0] * ne <= PAIR_SCAN_MAX:
         for i in range(xv.shape[0]):
             base = lin + wv * rv_len[i]
             px = xv[i, 0]
@@ -221,7 +234,59 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                 if d2 < (step * speed + lam) ** 2:     # else it cannot shorten the step
                     new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
                                      xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
-                                     lam, step)
+                                     lam_pair, step)
+                    if new < step:
+                        step = new
+                        crit[0], crit[1], crit[2] = way, i, j
+        return dmin2, step
+    # no pair farther than `reach` can shorten the step: skip a vertex that far from
+    # the other body's box
+    cand = np.empty(xv.shape[0], np.int64)
+    nc = 0
+    bx0 = np.inf
+    bx1 = -np.inf
+    by0 = np.inf
+    by1 = -np.inf
+    for i in range(xv.shape[0]):
+        px = xv[i, 0]
+        py = xv[i, 1]
+        reach = step * (lin + wv * rv_len[i] + we * lmax) + lam
+        if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
+            continue
+        cand[nc] = i
+        nc += 1
+        bx0 = min(bx0, px - reach)
+        bx1 = max(bx1, px + reach)
+        by0 = min(by0, py - reach)
+        by1 = max(by1, py + reach)
+    if nc == 0:
+        return dmin2, step
+    if nc <= FEW_VERTICES:
+        for j in range(ne):
+            j1 = nxt[j]
+            ax = xe[j, 0]
+            ay = xe[j, 1]
+            bx = xe[j1, 0]
+            by = xe[j1, 1]
+            ex0 = min(ax, bx)
+            ex1 = max(ax, bx)
+            ey0 = min(ay, by)
+            ey1 = max(ay, by)
+            if ex0 > bx1 or ex1 < bx0 or ey0 > by1 or ey1 < by0:
+                continue
+            for k in range(nc):
+                i = cand[k]
+                px = xv[i, 0]
+                py = xv[i, 1]
+                speed = lin + wv * rv_len[i] + we * re_max[j]
+                reach = step * speed + lam
+                if ex0 > px + reach or ex1 < px - reach or ey0 > py + reach or ey1 < py - reach:
+                    continue
+                d2 = _nearest_on_segment(px, py, ax, ay, bx, by)[2]
+                dmin2 = min(dmin2, d2)
+                if d2 < reach * reach:     # else it cannot shorten the step
+                    new = _pair_time(px, py, cv[0], cv[1], rv_len[i], ax, ay, bx, by, ce[0],
+                                     ce[1], re_max[j], mw, speed, lam_pair, step)
                     if new < step:
                         step = new
                         crit[0], crit[1], crit[2] = way, i, j
@@ -241,14 +306,11 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
             m -= 1
         order[m] = cur
     sorted_x = xmin[order]
-    for i in range(xv.shape[0]):
+    for k in range(nc):
+        i = cand[k]
         px = xv[i, 0]
         py = xv[i, 1]
-        base = lin + wv * rv_len[i]
-        # a pair farther than this cannot shorten the step
-        reach = step * (base + we * lmax) + lam
-        if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
-            continue
+        reach = step * (lin + wv * rv_len[i] + we * lmax) + lam
         o = np.searchsorted(sorted_x, px - reach - maxw)
         while o < ne and sorted_x[o] <= px + reach:
             j = order[o]
@@ -260,11 +322,11 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                 continue
             d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
             dmin2 = min(dmin2, d2)
-            speed = base + we * re_max[j]
+            speed = lin + wv * rv_len[i] + we * re_max[j]
             if d2 < (step * speed + lam) ** 2:
                 new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
                                  xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
-                                 lam, step)
+                                 lam_pair, step)
                 if new < step:
                     step = new
                     crit[0], crit[1], crit[2] = way, i, j
@@ -290,9 +352,17 @@ def edge_table(starts, r_len):
 
 
 @njit(cache=True, nogil=True)
-def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit):
+def _crit_time(xv, cv, rv, xe, ce, nxt, re_max, i, j, mw, speed, lam, step):
+    """:func:`_pair_time` of vertex i against edge j of the other body."""
+    j1 = nxt[j]
+    return _pair_time(xv[i, 0], xv[i, 1], cv[0], cv[1], rv, xe[j, 0], xe[j, 1], xe[j1, 0],
+                      xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed, lam, step)
+
+
+@njit(cache=True, nogil=True)
+def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, lam_pair, crit):
     """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
-    vertex comes within ``lam`` of an edge of the other body.
+    vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
 
     ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ra_len[i]`` the
     distance of vertex i from it, ``ea`` its :func:`edge_table` (likewise B); ``ma``,
@@ -305,12 +375,13 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit)
     :func:`_pair_time`: the longer of two safe bounds, along the pair's fixed normal
     (:func:`_pair_rate`, never above the plain speed bound
     ``|Δv| + |ω_v| |r_p| + |ω_e| max |r_e|``; |r| is convex along the edge) and towards
-    the edge's turning line (:func:`_line_rate`); 0 within ``lam``. Boundaries that do
-    not cross are at the distance of their nearest vertex–edge pair, and they cannot
+    the edge's turning line (:func:`_line_rate`); 0 within ``lam_pair``. Boundaries that
+    do not cross are at the distance of their nearest vertex–edge pair, and they cannot
     begin to meet without some vertex reaching an edge, so the smallest pair time (both
     ways) is a step without contact. A pair farther than ``lam`` plus the current step
     times its plain speed bound cannot shorten the step and is skipped (whole vertices
-    by the other body's box, edges by the sweep over x for large bodies).
+    by the other body's box; for large bodies, edges by the box of the few vertices
+    left or by a sweep over x).
 
     ``distance`` is exact when it is at most ``lam``; otherwise it is at least the gap.
     """
@@ -326,7 +397,6 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit)
     wb1 = mb[4] + mb[5] * t1
     wa = max(abs(wa0), abs(wa1))
     wb = max(abs(wb0), abs(wb1))
-    scan_all = xa.shape[0] * xb.shape[0] <= PAIR_SCAN_MAX
     mwa = (dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h, lin, h)
     mwb = (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h, lin, h)
     step = h
@@ -334,18 +404,15 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, crit)
         i = crit[1]
         j = crit[2]
         if crit[0] == 0:
-            xv, cv, rv, xe, ce, e, mw = xa, ca, ra_len[i], xb, cb, eb, mwa
-            speed = lin + wa * rv + wb * eb[1][j]
+            step = _crit_time(xa, ca, ra_len[i], xb, cb, eb[0], eb[1], i, j, mwa,
+                              lin + wa * ra_len[i] + wb * eb[1][j], lam_pair, step)
         else:
-            xv, cv, rv, xe, ce, e, mw = xb, cb, rb_len[i], xa, ca, ea, mwb
-            speed = lin + wb * rv + wa * ea[1][j]
-        j1 = e[0][j]
-        step = _pair_time(xv[i, 0], xv[i, 1], cv[0], cv[1], rv, xe[j, 0], xe[j, 1], xe[j1, 0],
-                          xe[j1, 1], ce[0], ce[1], e[1][j], mw, speed, lam, step)
+            step = _crit_time(xb, cb, rb_len[i], xa, ca, ea[0], ea[1], i, j, mwb,
+                              lin + wb * rb_len[i] + wa * ea[1][j], lam_pair, step)
     dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], eb[2], mwa, lin, wa, wb,
-                                lam, np.inf, step, scan_all, crit, 0)
+                                lam, lam_pair, np.inf, step, crit, 0)
     dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], ea[2], mwb, lin, wb, wa,
-                                lam, dmin2, step, scan_all, crit, 1)
+                                lam, lam_pair, dmin2, step, crit, 1)
     return np.sqrt(dmin2), step
 
 
@@ -386,7 +453,12 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     - :func:`pair_step` gives a step h <= H during which no vertex–edge pair can
       meet (each pair charged its closing rate along its own normal), so the
       boundaries cannot meet and no penetration can start. If h is at least the probe
-      length ``tau = min(time_tol / 2, lam / S)`` it is taken;
+      length ``tau = min(time_tol / 2, lam / S)`` it is taken. The pairs are held
+      ``lam`` apart until the first contact (so that the first time found within
+      ``lam`` is at most a probe late) and ``PAIR_GAP · lam`` apart after it, which
+      leaves fewer probes to the hit: where the step to ``lam`` is shorter than tau
+      before the first contact, the step to ``PAIR_GAP · lam`` (at most
+      ``time_tol / 2``) is taken instead;
     - otherwise the step is ``tau``: a penetration that begins and ends inside it lasts
       less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
       other body; any other penetration is still penetrating at ``t + tau``.
@@ -406,6 +478,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     ea = edge_table(sa, ra_len)
     eb = edge_table(sb, rb_len)
     crit = np.full(3, -1, np.int64)
+    lam_pair = PAIR_GAP * lam
     first_contact = -1.0
     it = 0
     t = 0.0
@@ -425,13 +498,20 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
             t_end = min(t2, t + window)
             s = speed_bound(ma, la, mb, lb, t, t_end)
+            # until the first contact the pairs are stepped to lam, so that the first
+            # time found within lam is at most a probe late; then closer
             d, h = pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end, lam,
-                             crit)
+                             lam if first_contact < 0.0 else lam_pair, crit)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
                 break  # at the end, or no relative motion: the state at t holds to t2
             tau = min(0.5 * time_tol, lam / s)
+            if h < tau and first_contact < 0.0:
+                # about to touch: step the pairs to lam_pair instead, at most
+                # time_tol / 2 at a time (so the first contact found is no later)
+                h = min(pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end,
+                                  lam, lam_pair, crit)[1], 0.5 * time_tol)
             if h >= t_end - t:
                 h = t_end - t
                 window = 2.0 * window
