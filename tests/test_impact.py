@@ -150,10 +150,50 @@ def test_slide_then_hit_a_step():
 
 
 def test_slide_runs_out_of_iterations_with_a_status_not_a_hang():
-    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), SQ.moved((3, 1)), Motion(), t_max=5,
+    # under the overhang no line separates the bodies (B's leg reaches below A's top):
+    # the slide is followed by probes, and a small budget ends it with a status
+    b = Shape([(3.0, 1.0), (3.3, 1.0), (3.3, 0.0), (3.6, 0.0), (3.6, 2.0), (3.0, 2.0)])
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=5,
                          max_iterations=1000)
     assert hit.status is ImpactStatus.OUT_OF_ITERATIONS
-    assert not hit.collides and 2.0 <= hit.searched_to < 5
+    assert not hit.collides and 2.0 <= hit.searched_to < 2.3
+
+
+def _no_overlap(a, ma, b, mb, ts, area=0.0):
+    return all(_place(a, ma, t).intersection(_place(b, mb, t)).area <= area for t in ts)
+
+
+def test_long_slide_ends_with_a_verdict():
+    # paper Fig. 16 over twenty body sizes: A slides under a long bar from t = 1 to 22
+    # and leaves it. Contact, not collision, found in a few steps: a line through the
+    # touching edges separates the bodies for the whole slide
+    bar = Shape([(2, 1), (22, 1), (22, 1.5), (2, 1.5)])
+    ma = Motion(velocity=(1, 0))
+    hit = time_of_impact(SQ, ma, bar, Motion(), t_max=30)
+    assert hit.status is ImpactStatus.NO_HIT and not hit.collides
+    assert hit.first_contact == pytest.approx(1.0, abs=TOL)
+    assert hit.state is State.CONTACT and hit.iterations < 100
+    ts = np.linspace(0, 30, 3001)
+    assert oracle_first_penetration(SQ, ma, bar, Motion(), 0, 30, 3001) is None
+    assert shapely.distance(_place(SQ, ma, 10.0), _place(bar, Motion(), 10.0)) == 0.0
+    assert _no_overlap(SQ, ma, bar, Motion(), ts)
+
+
+def test_tilted_slide_along_a_moving_bar():
+    # the same slide turned by 0.3 rad (no coordinate exact) with both bodies moving:
+    # A at (1, 0.05), the bar at (0, 0.05) in the turned frame
+    c, s = math.cos(0.3), math.sin(0.3)
+    rot = np.array([[c, -s], [s, c]])
+    a = Shape(SQ.exterior @ rot.T)
+    bar = Shape(np.array([(2.0, 1), (22, 1), (22, 1.5), (2, 1.5)]) @ rot.T)
+    ma = Motion(velocity=tuple(rot @ (1.0, 0.05)))
+    mb = Motion(velocity=tuple(rot @ (0.0, 0.05)))
+    hit = time_of_impact(a, ma, bar, mb, t_max=30)
+    assert hit.status is ImpactStatus.NO_HIT and not hit.collides
+    assert hit.first_contact == pytest.approx(1.0, abs=TOL) and hit.iterations < 1000
+    # the oracle: touching during the slide, never overlapping beyond rounding
+    assert shapely.distance(_place(a, ma, 10.0), _place(bar, mb, 10.0)) < 1e-9
+    assert _no_overlap(a, ma, bar, mb, np.linspace(0, 30, 3001), area=1e-9)
 
 
 def test_corner_graze_is_contact():

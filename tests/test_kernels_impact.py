@@ -112,11 +112,46 @@ def test_exact_search_on_flush_squares():
 
 def test_exact_search_reports_the_budget():
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    b = sq.moved((0.5, 1))                         # sliding contact from t = 0
+    # sliding contact from t = 0 under an overhang whose leg reaches below A's top:
+    # no separating line, so it is followed by probes
+    b = Shape([(0.5, 1), (1.8, 1), (1.8, 0), (2.1, 0), (2.1, 2), (0.5, 2)])
     ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
     out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
                           b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
     assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0
+
+
+def test_exact_search_follows_a_slide_in_few_steps():
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    b = Shape([(0.5, 1), (9, 1), (9, 2), (0.5, 2)])   # sliding contact from t = 0
+    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
+    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
+                          b.bounding_radius, np.array([[0.0, 12.0]]), 1e-4, 1e-12, 1e-3, 50)
+    assert out[0] == ki.NO_HIT and out[3] == 0.0 and out[4] < 50
+
+
+@given(vec, st.floats(-0.3, 0.3), vec, st.floats(-0.3, 0.3), st.floats(0.0, 1.0),
+       st.floats(0.0, 1.0))
+def test_slide_time_keeps_the_interiors_apart(va, wa, vb, wb, dx, frac):
+    """Whatever the motions, during the certified time a square resting on a bar
+    (flush, at an offset dx) does not come to overlap it (Shapely, beyond rounding)."""
+    a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)]).moved((dx, 0))
+    bar = Shape([(-1, -0.5), (3, -0.5), (3, 0), (-1, 0)])
+    ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
+    ra, rb = a.packed[0] - a.centroid, bar.packed[0] - bar.centroid
+    la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
+    na, nb = ki.edge_table(a.packed[1], la)[0], ki.edge_table(bar.packed[1], lb)[0]
+    mwa, _ = ki.motion_window(ma.array, mb.array, 0.0, 1.0)
+    # A's vertices against the line of the bar's top edge (edge 2: (3, 0) -> (-1, 0))
+    h = ki.slide_time(a.packed[0], np.array(a.centroid), la, na, bar.packed[0],
+                      np.array(bar.centroid), nb, bar.bounding_radius, 2, mwa, 1e-12, 1.0,
+                      0.0)
+    assert 0.0 <= h <= 1.0
+    if va == vb == (0.0, 0.0) and wa == wb == 0.0:
+        assert h == 1.0                 # nothing moves: the whole window
+    t = h * frac
+    overlap = a.at(ma, t).to_shapely().intersection(bar.at(mb, t).to_shapely()).area
+    assert overlap <= 1e-9
 
 
 def _paper_sampled(a, ma, b, mb, t1, t2, n, threshold):

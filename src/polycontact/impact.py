@@ -41,7 +41,8 @@ __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MA
 CONTACT_RESOLUTION = 1e-6
 
 #: Default iteration budget of the exact method (one iteration places both bodies and
-#: classifies them). Reached only by long sliding contacts; the result then says so.
+#: steps or classifies them). Reached only by long sliding contacts that no line through
+#: the touching edges separates; the result then says so.
 MAX_ITERATIONS = 1_000_000
 
 _METHODS = ("exact", "sampled")
@@ -255,8 +256,9 @@ def time_of_impact(
     taken is longer and has the same guarantee: boundaries meet first where a vertex
     reaches an edge, so it is enough that no vertex p comes within λ' of any edge e of
     the other body (λ' = λ until the first contact is found, λ/64 after it, so that
-    fewer probes remain before the hit). Each such pair is held apart along its own fixed normal n (from
-    the nearest point q of e to p): the edge lies in the half-plane behind q, so
+    fewer probes remain before the hit). Each such pair is held apart along its own
+    fixed normal n (from the nearest point q of e to p): the edge lies in the
+    half-plane behind q, so
     sep(t) = p(t)·n − max over points x of e of x(t)·n starts at dist(p, e) and never
     exceeds it. A point moves along n at v·n + ω (J R r)·n, and (J R(θ) r)·n stays
     within |r|·(angle turned) of its current value, so sep shrinks no faster than
@@ -265,19 +267,30 @@ def time_of_impact(
     and never faster than the plain bound above with |r_p| and max |r_e| for L. The
     step is the least, over pairs and both ways, of (dist − λ') / rate; pairs too far
     to matter are skipped by boxes (and a sweep over x for large bodies). Near contact
-    the step
-    shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
+    the step shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
     λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and classifies
     the end. A penetrating end is the hit, with the non-penetrating start of the
     probe as ``time_bracket[0]``: ``time`` is within τ ≤ ``time_tolerance``/2 after the
-    first penetration. Not
-    penetrating at the end means either no penetration began in the step, or one began
-    and ended inside it — lasting under ``time_tolerance``/2 with no point moving more
-    than λ relative to the other body: a penetration shallower than the contact
-    resolution. Every other penetration is found, whatever the rotation speed. A
-    touch that does not penetrate (graze, slide) is stepped through by probes, so the
-    search never stalls; the number of iterations is bounded by ``max_iterations``
-    (status OUT_OF_ITERATIONS, never a hang).
+    first penetration. Not penetrating at the end means either no penetration began in
+    the step, or one began and ended inside it — lasting under ``time_tolerance``/2
+    with no point moving more than λ relative to the other body: a penetration
+    shallower than the contact resolution. Every other penetration is found, whatever
+    the rotation speed.
+
+    A sliding contact (paper Fig. 16) is followed by long steps, not probes: once
+    touching, the line ℓ of a touching edge e of body E (turning with E) is tried as a
+    separator. If every vertex of E lies behind ℓ, E stays behind it (it is rigid); each
+    edge of the other body V is charged the time during which both its ends stay on or
+    in front of ℓ (at their rate towards the turning line, as above) or it stays
+    outside E's bounding circle. Until the least of these times no edge of V meets
+    W = (open half-plane behind ℓ) ∩ (open circle), a convex set moving with E that
+    holds E's interior; a point of E's interior is outside V now (no penetration) and
+    cannot cross V's boundary, so W and V stay disjoint: no penetration can begin.
+    (Both sides are checked with the rounding tolerance, so an overlap thinner than
+    twice that tolerance is not looked for.) When no such line holds (e.g. sliding
+    under an overhang whose far end reaches below), the touch is stepped through by
+    probes; the number of iterations is bounded by ``max_iterations`` (status
+    OUT_OF_ITERATIONS, never a hang).
 
     Parameters
     ----------

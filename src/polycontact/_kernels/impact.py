@@ -352,6 +352,110 @@ def edge_table(starts, r_len):
 
 
 @njit(cache=True, nogil=True)
+def motion_window(ma, mb, t0, t1):
+    """``(mwa, mwb)``: the window tuples of :func:`_pair_rate` and :func:`_line_rate`
+    over [t0, t1], for vertices of A against edges of B and the other way round."""
+    h = t1 - t0
+    dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
+    dv0y = ma[1] - mb[1] + (ma[3] - mb[3]) * t0
+    dv1x = ma[0] - mb[0] + (ma[2] - mb[2]) * t1
+    dv1y = ma[1] - mb[1] + (ma[3] - mb[3]) * t1
+    lin = max(np.hypot(dv0x, dv0y), np.hypot(dv1x, dv1y))
+    wa0 = ma[4] + ma[5] * t0
+    wa1 = ma[4] + ma[5] * t1
+    wb0 = mb[4] + mb[5] * t0
+    wb1 = mb[4] + mb[5] * t1
+    wa = max(abs(wa0), abs(wa1))
+    wb = max(abs(wb0), abs(wb1))
+    return ((dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h, lin, h),
+            (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h, lin, h))
+
+
+@njit(cache=True, nogil=True)
+def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need):
+    """A time in [0, h] (0 as soon as it is known to be below ``need``) during which the interiors of V (vertices ``xv``, centroid
+    ``cv``) and E (``xe``, ``ce``, bounding radius ``le``) cannot come to overlap by
+    more than 2 ``eps``, certified by the line of E's edge j turning with E; 0 when the
+    line does not separate them. ``mw`` is the window tuple (:func:`motion_window`) of
+    V's vertices against E's edges over [t, t + h].
+
+    This is what lets a sliding contact (paper Fig. 16) be followed by long steps:
+    with n the outward normal of edge j and σ(x) = (x − x_j)·n, E lies in
+    {σ <= eps} at all times if all its vertices do now (the line turns with E). Each
+    edge of V is charged the time during which either both its ends keep
+    σ >= −eps — each end at its rate towards the turning line (:func:`_line_rate`),
+    and a segment lies on the side of its ends — or it stays outside E's bounding
+    circle (its distance from E's centroid shrinks no faster than |Δv| + |ω_V| max |r|,
+    as in the pair bounds). Until the shortest of these times no edge of V meets
+    W = {σ < −eps} ∩ (open circle), a convex set that moves with E and holds the
+    points of E's interior deeper than eps behind the line. Such a point is outside V
+    now (the bodies do not penetrate) and never crosses V's boundary, so it stays
+    outside V; hence W ∩ V stays empty (W is connected) and any overlap of the
+    interiors lies in the band |σ| <= eps.
+    """
+    j1 = nxt_e[j]
+    ax = xe[j, 0]
+    ay = xe[j, 1]
+    ex = xe[j1, 0] - ax
+    ey = xe[j1, 1] - ay
+    ln = np.sqrt(ex * ex + ey * ey)
+    if ln == 0.0:
+        return 0.0
+    nx = ey / ln                        # interior on the left: outward on the right
+    ny = -ex / ln
+    for k in range(xe.shape[0]):
+        if (xe[k, 0] - ax) * nx + (xe[k, 1] - ay) * ny > eps:
+            return 0.0
+    lin = mw[10]
+    wv = max(abs(mw[4]), abs(mw[5]))
+    best = h
+    for k in range(xv.shape[0]):
+        k1 = nxt_v[k]
+        t_edge = np.inf
+        for m in (k, k1):
+            sig = (xv[m, 0] - ax) * nx + (xv[m, 1] - ay) * ny + eps
+            if sig < 0.0:
+                t_edge = 0.0
+                break
+            rate = _line_rate(xv[m, 0], xv[m, 1], nx, ny, cv[0], cv[1], rv_len[m], ce[0], ce[1],
+                              mw)
+            if rate > 0.0:
+                t_edge = min(t_edge, sig / rate)
+        if t_edge < best:
+            gap = np.sqrt(_nearest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
+                                              xv[k1, 1])[2]) - le
+            if gap > 0.0:
+                rate = lin + wv * max(rv_len[k], rv_len[k1])
+                t_edge = max(t_edge, gap / rate if rate > 0.0 else np.inf)
+            best = min(best, t_edge)
+            if best < need:
+                return 0.0
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1, crit, eps,
+                need):
+    """The longest :func:`slide_time` over [t0, t1] by the lines through the pair
+    ``crit`` (vertex i of one body, edge j of the other): edge j, or either edge of the
+    vertex body at i (with the bodies' roles swapped); 0 if none reaches ``need``."""
+    mwa, mwb = motion_window(ma, mb, t0, t1)
+    h = t1 - t0
+    i = crit[1]
+    if crit[0] == 0:
+        best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, crit[2], mwa, eps, h, need)
+        for e in range(nxa.shape[0]):
+            if best == 0.0 and (e == i or nxa[e] == i):
+                best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, e, mwb, eps, h, need)
+        return best
+    best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, crit[2], mwb, eps, h, need)
+    for e in range(nxb.shape[0]):
+        if best == 0.0 and (e == i or nxb[e] == i):
+            best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, e, mwa, eps, h, need)
+    return best
+
+
+@njit(cache=True, nogil=True)
 def _crit_time(xv, cv, rv, xe, ce, nxt, re_max, i, j, mw, speed, lam, step):
     """:func:`_pair_time` of vertex i against edge j of the other body."""
     j1 = nxt[j]
@@ -386,19 +490,8 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, lam_p
     ``distance`` is exact when it is at most ``lam``; otherwise it is at least the gap.
     """
     h = t1 - t0
-    dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
-    dv0y = ma[1] - mb[1] + (ma[3] - mb[3]) * t0
-    dv1x = ma[0] - mb[0] + (ma[2] - mb[2]) * t1
-    dv1y = ma[1] - mb[1] + (ma[3] - mb[3]) * t1
-    lin = max(np.hypot(dv0x, dv0y), np.hypot(dv1x, dv1y))
-    wa0 = ma[4] + ma[5] * t0
-    wa1 = ma[4] + ma[5] * t1
-    wb0 = mb[4] + mb[5] * t0
-    wb1 = mb[4] + mb[5] * t1
-    wa = max(abs(wa0), abs(wa1))
-    wb = max(abs(wb0), abs(wb1))
-    mwa = (dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h, lin, h)
-    mwb = (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h, lin, h)
+    mwa, mwb = motion_window(ma, mb, t0, t1)
+    lin, wa, wb = mwa[10], max(abs(mwa[4]), abs(mwa[5])), max(abs(mwa[6]), abs(mwa[7]))
     step = h
     if crit[0] >= 0:
         i = crit[1]
@@ -463,6 +556,11 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
       less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
       other body; any other penetration is still penetrating at ``t + tau``.
 
+    - after the first contact, before probing, :func:`_slide_step` tries the lines
+      through the touching pair: a step it certifies (the bodies stay on either side
+      of a line turning with one of them, up to ``eps``) is taken instead, so a
+      sliding contact is followed by long steps, not by probes.
+
     A penetrating state at the end of a probe is the hit, bracketed by the probe.
     """
     xa = np.empty_like(ra)
@@ -512,6 +610,10 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
                 # time_tol / 2 at a time (so the first contact found is no later)
                 h = min(pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end,
                                   lam, lam_pair, crit)[1], 0.5 * time_tol)
+            if h < tau and first_contact >= 0.0 and crit[0] >= 0:
+                # touching: a line through the touching features may separate them
+                h = max(h, _slide_step(xa, pa, ra_len, ea[0], la, xb, pb, rb_len, eb[0], lb,
+                                       ma, mb, t, t_end, crit, eps, tau))
             if h >= t_end - t:
                 h = t_end - t
                 window = 2.0 * window
