@@ -228,10 +228,15 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                 continue
             for j in range(ne):
                 j1 = nxt[j]
+                speed = base + we * re_max[j]
+                reach = step * speed + lam
+                if (min(xe[j, 0], xe[j1, 0]) > px + reach or max(xe[j, 0], xe[j1, 0]) < px - reach
+                        or min(xe[j, 1], xe[j1, 1]) > py + reach
+                        or max(xe[j, 1], xe[j1, 1]) < py - reach):
+                    continue
                 d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
                 dmin2 = min(dmin2, d2)
-                speed = base + we * re_max[j]
-                if d2 < (step * speed + lam) ** 2:     # else it cannot shorten the step
+                if d2 < reach * reach:     # else it cannot shorten the step
                     new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
                                      xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
                                      lam_pair, step)
@@ -419,14 +424,14 @@ def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need):
                 break
             rate = _line_rate(xv[m, 0], xv[m, 1], nx, ny, cv[0], cv[1], rv_len[m], ce[0], ce[1],
                               mw)
-            if rate > 0.0:
+            if sig < rate * best:           # else this end holds beyond the best
                 t_edge = min(t_edge, sig / rate)
         if t_edge < best:
             gap = np.sqrt(_nearest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
                                               xv[k1, 1])[2]) - le
             if gap > 0.0:
                 rate = lin + wv * max(rv_len[k], rv_len[k1])
-                t_edge = max(t_edge, gap / rate if rate > 0.0 else np.inf)
+                t_edge = max(t_edge, gap / rate if gap < rate * best else best)
             best = min(best, t_edge)
             if best < need:
                 return 0.0
