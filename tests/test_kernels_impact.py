@@ -145,7 +145,7 @@ def test_slide_time_keeps_the_interiors_apart(va, wa, vb, wb, dx, frac):
     # A's vertices against the line of the bar's top edge (edge 2: (3, 0) -> (-1, 0))
     h = ki.slide_time(a.packed[0], np.array(a.centroid), la, na, bar.packed[0],
                       np.array(bar.centroid), nb, bar.bounding_radius, 2, mwa, 1e-12, 1.0,
-                      0.0)
+                      0.0, 0)
     assert 0.0 <= h <= 1.0
     if va == vb == (0.0, 0.0) and wa == wb == 0.0:
         assert h == 1.0                 # nothing moves: the whole window

@@ -178,7 +178,8 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
         return 0.0
     rate = min(speed, _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ax, ay, bx, by, cex, cey,
                                  re, mw))
-    best = (d - lam) / rate if rate > 0.0 else np.inf
+    # (no division when the time is beyond the step: a tiny rate would overflow)
+    best = (d - lam) / rate if d - lam < rate * step else step
     ex = bx - ax
     ey = by - ay
     ln = np.sqrt(ex * ex + ey * ey)
@@ -188,7 +189,7 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
         s0 = (px - ax) * nx + (py - ay) * ny
         if s0 > lam:
             rl = _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw)
-            best = max(best, (s0 - lam) / rl if rl > 0.0 else np.inf)
+            best = max(best, (s0 - lam) / rl if s0 - lam < rl * step else step)
     return min(step, best)
 
 
@@ -377,8 +378,9 @@ def motion_window(ma, mb, t0, t1):
 
 
 @njit(cache=True, nogil=True)
-def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need):
-    """A time in [0, h] (0 as soon as it is known to be below ``need``) during which the interiors of V (vertices ``xv``, centroid
+def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need, first):
+    """A time in [0, h] (0 as soon as it is known to be below ``need``; V's vertex
+    ``first``, the touching one, is looked at before the rest) during which the interiors of V (vertices ``xv``, centroid
     ``cv``) and E (``xe``, ``ce``, bounding radius ``le``) cannot come to overlap by
     more than 2 ``eps``, certified by the line of E's edge j turning with E; 0 when the
     line does not separate them. ``mw`` is the window tuple (:func:`motion_window`) of
@@ -413,6 +415,14 @@ def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need):
             return 0.0
     lin = mw[10]
     wv = max(abs(mw[4]), abs(mw[5]))
+    # inside E's circle the touching vertex's edges can only be charged by their ends
+    px = xv[first, 0]
+    py = xv[first, 1]
+    sig = (px - ax) * nx + (py - ay) * ny + eps
+    if (px - ce[0]) ** 2 + (py - ce[1]) ** 2 <= le * le and (
+            sig < 0.0 or sig < need * _line_rate(px, py, nx, ny, cv[0], cv[1], rv_len[first],
+                                                 ce[0], ce[1], mw)):
+        return 0.0
     best = h
     for k in range(xv.shape[0]):
         k1 = nxt_v[k]
@@ -447,16 +457,17 @@ def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1
     mwa, mwb = motion_window(ma, mb, t0, t1)
     h = t1 - t0
     i = crit[1]
+    j = crit[2]
     if crit[0] == 0:
-        best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, crit[2], mwa, eps, h, need)
+        best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, j, mwa, eps, h, need, i)
         for e in range(nxa.shape[0]):
             if best == 0.0 and (e == i or nxa[e] == i):
-                best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, e, mwb, eps, h, need)
+                best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, e, mwb, eps, h, need, j)
         return best
-    best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, crit[2], mwb, eps, h, need)
+    best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, j, mwb, eps, h, need, i)
     for e in range(nxb.shape[0]):
         if best == 0.0 and (e == i or nxb[e] == i):
-            best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, e, mwa, eps, h, need)
+            best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, e, mwa, eps, h, need, j)
     return best
 
 
