@@ -15,11 +15,11 @@ no relative motion at all.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
+from ._checks import finite_number
 from .motion import Motion
 from .shape import Shape, as_shape
 
@@ -33,15 +33,7 @@ BROAD_PHASE_INFLATION = 1e-12
 
 def check_t_max(t_max: Any) -> float:
     """``t_max`` as a finite non-negative float, or a ValueError naming it."""
-    if isinstance(t_max, bool):
-        raise ValueError(f"t_max: expected a number, got {t_max!r}")
-    try:
-        value = float(t_max)
-    except (TypeError, ValueError):
-        raise ValueError(f"t_max: expected a number, got {t_max!r}") from None
-    if not math.isfinite(value) or value < 0.0:
-        raise ValueError(f"t_max: expected a finite number >= 0, got {value}")
-    return value
+    return finite_number(t_max, "t_max", minimum=0.0)
 
 
 def check_motion(motion: Any, what: str) -> Motion:

@@ -35,6 +35,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ._checks import point as point_arg
 from .shape import Shape, as_shape
 from .tolerances import default_tolerance
 
@@ -205,7 +206,7 @@ class EntranceBlock:
         """
         from .relation import classify
 
-        return classify(self.a.moved(_point(point) - self.reference), self.b, tolerance=tolerance)
+        return classify(self.a.moved(point_arg(point, "point") - self.reference), self.b, tolerance=tolerance)
 
     def components_at(self, point: Any) -> ComponentsAt:
         """The components that hold ``point`` in their interior or on their boundary.
@@ -231,7 +232,7 @@ class EntranceBlock:
         """
         import shapely
 
-        p = _point(point)
+        p = point_arg(point, "point")
         geoms = np.array([c.geometry for c in self.components], dtype=object)
         outlines = np.array([_outline(g) for g in geoms], dtype=object)
         near = shapely.dwithin(outlines, shapely.Point(p), self.tolerance)
@@ -284,7 +285,7 @@ def entrance_block(
     b = as_shape(b, "b")
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
-    a0 = a.centroid.copy() if reference is None else _point(reference, "reference")
+    a0 = a.centroid.copy() if reference is None else point_arg(reference, "reference")
     a0.flags.writeable = False
     eps = default_tolerance(a.packed[0], b.packed[0], a0.reshape(1, 2))
     comps = _vertex_of_b_in_a(a, b, a0) + _vertex_of_a_in_b(a, b, a0)
@@ -401,16 +402,6 @@ def _splice(loop: np.ndarray, v: np.ndarray) -> np.ndarray | None:
 
 
 # -- helpers ---------------------------------------------------------------------------
-def _point(p: Any, what: str = "point") -> np.ndarray:
-    try:
-        arr = np.array(p, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected two numbers (x, y), got {p!r}") from None
-    if arr.shape != (2,) or not np.isfinite(arr).all():
-        raise ValueError(f"{what}: expected two finite numbers (x, y), got {p!r}")
-    return arr
-
-
 def _indices(s: Shape) -> list[tuple[int, int]]:
     """(loop, index) for every vertex (and so every edge) of ``s``, packed order."""
     return [(k, i) for k, loop in enumerate(s.loops) for i in range(len(loop))]

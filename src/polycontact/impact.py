@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import finite_number
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_t_max
 from .motion import Motion
 from .relation import Feature, State, classify
@@ -173,18 +174,6 @@ class Impact:
         return self._details[2]
 
 
-def _positive(value: Any, what: str) -> float:
-    if isinstance(value, bool):
-        raise ValueError(f"{what}: expected a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected a number, got {value!r}") from None
-    if not (math.isfinite(x) and x > 0.0):
-        raise ValueError(f"{what}: expected a finite number > 0, got {x}")
-    return x
-
-
 def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
     """Largest |coordinate| the body can reach in [0, t_max] (for the tolerance)."""
     cx, cy = shape.centroid
@@ -329,7 +318,7 @@ def time_of_impact(
     ma = check_motion(motion_a, "motion_a")
     mb = check_motion(motion_b, "motion_b")
     t_max = check_t_max(t_max)
-    tol = _positive(time_tolerance, "time_tolerance")
+    tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
         raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:

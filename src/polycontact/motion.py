@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import finite_number
+
 __all__ = ["Motion"]
 
 
@@ -28,18 +30,6 @@ def _pair(value: Any, what: str) -> tuple[float, float]:
     if not (math.isfinite(x) and math.isfinite(y)):
         raise ValueError(f"{what}: expected finite numbers, got {[x, y]}")
     return x, y
-
-
-def _number(value: Any, what: str) -> float:
-    if isinstance(value, bool):
-        raise ValueError(f"{what}: expected a number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected a number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{what}: expected a finite number, got {x}")
-    return x
 
 
 @dataclass(frozen=True)
@@ -74,12 +64,12 @@ class Motion:
         object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
         object.__setattr__(self, "acceleration", _pair(self.acceleration, "acceleration"))
         object.__setattr__(
-            self, "angular_velocity", _number(self.angular_velocity, "angular_velocity")
+            self, "angular_velocity", finite_number(self.angular_velocity, "angular_velocity")
         )
         object.__setattr__(
             self,
             "angular_acceleration",
-            _number(self.angular_acceleration, "angular_acceleration"),
+            finite_number(self.angular_acceleration, "angular_acceleration"),
         )
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:

@@ -42,6 +42,8 @@ import numpy as np
 import shapely
 import shapely.affinity
 
+from ._checks import finite_number
+from ._checks import point as point_arg
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
 from .tolerances import RELATIVE_TOLERANCE
@@ -129,7 +131,7 @@ class NoFitPolygon:
         """
         from .relation import classify
 
-        p = _as_point(point, "point")
+        p = point_arg(point, "point", error=InvalidShapeError)
         moved = self.a.moved(p - self.reference)
         return classify(moved, self.b, tolerance=tolerance).state
 
@@ -248,16 +250,6 @@ def inner_fit_polygon(
 # -- helpers -----------------------------------------------------------------------------
 
 
-def _as_point(point: Any, what: str) -> np.ndarray:
-    try:
-        p = np.array(point, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise InvalidShapeError(f"{what}: expected two numbers, got {point!r}") from None
-    if p.shape != (2,) or not np.isfinite(p).all():
-        raise InvalidShapeError(f"{what}: expected two finite numbers, got {point!r}")
-    return p
-
-
 def _reference(a: Shape, reference: Any) -> np.ndarray:
     if reference is None or (isinstance(reference, str) and reference == "centroid"):
         return np.array(a.centroid, dtype=np.float64)
@@ -267,17 +259,14 @@ def _reference(a: Shape, reference: Any) -> np.ndarray:
         raise InvalidShapeError(
             f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
         )
-    return _as_point(reference, "reference")
+    return point_arg(reference, "reference", error=InvalidShapeError)
 
 
 def _tolerance(tolerance: float | None) -> float:
     """The tolerance for the kernel: -1 asks it for the default of the sums' coordinates."""
     if tolerance is None:
         return -1.0
-    tol = float(tolerance)
-    if not np.isfinite(tol) or tol <= 0.0:
-        raise InvalidShapeError(f"tolerance: expected a finite number > 0, got {tolerance!r}")
-    return tol
+    return finite_number(tolerance, "tolerance", positive=True, error=InvalidShapeError)
 
 
 def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:

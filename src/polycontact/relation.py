@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import finite_number
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
 from .tolerances import RELATIVE_TOLERANCE, default_tolerance
@@ -260,13 +261,7 @@ def _to_shape(src: Any) -> Shape:
 
 
 def _check_tolerance(tolerance: Any) -> float:
-    try:
-        tol = float(tolerance)
-    except (TypeError, ValueError):
-        raise ValueError(f"tolerance must be a number, got {tolerance!r}") from None
-    if not 0.0 <= tol < np.inf:
-        raise ValueError(f"tolerance must be a finite number >= 0, got {tolerance!r}")
-    return tol
+    return finite_number(tolerance, "tolerance", minimum=0.0)
 
 
 _F64 = np.dtype(np.float64)
