@@ -20,6 +20,7 @@ from numba import njit
 
 from .broad_phase import overlap_intervals
 from .relation import relate_state
+from .validate import closest_on_segment
 
 NO_HIT = 0
 HIT = 1
@@ -120,21 +121,6 @@ def _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ex0, ey0, ex1, ey1, cex, cey, re
 
 
 @njit(cache=True, nogil=True)
-def _nearest_on_segment(px, py, ax, ay, bx, by):
-    """``(qx, qy, d2)``: the point of segment ab nearest p and its squared distance."""
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    u = 0.0
-    if den > 0.0:
-        u = ((px - ax) * dx + (py - ay) * dy) / den
-        u = min(1.0, max(0.0, u))
-    qx = ax + u * dx
-    qy = ay + u * dy
-    return qx, qy, (px - qx) * (px - qx) + (py - qy) * (py - qy)
-
-
-@njit(cache=True, nogil=True)
 def _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw):
     """Upper bound of the closing rate of vertex p towards the line of an edge of the
     other body, the line turning with that body (``n``: the edge's outward normal now).
@@ -172,7 +158,7 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
     ``speed``) and, when p is outside the edge's line by more than ``lam``, at its rate
     towards the turning line (:func:`_line_rate`); both are lower bounds of the same
     time. 0 when it is already within ``lam`` (no reliable normal)."""
-    qx, qy, d2 = _nearest_on_segment(px, py, ax, ay, bx, by)
+    qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     d = np.sqrt(d2)
     if d <= lam:
         return 0.0
@@ -235,7 +221,7 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                         or min(xe[j, 1], xe[j1, 1]) > py + reach
                         or max(xe[j, 1], xe[j1, 1]) < py - reach):
                     continue
-                d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
+                d2 = closest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
                 dmin2 = min(dmin2, d2)
                 if d2 < reach * reach:     # else it cannot shorten the step
                     new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
@@ -288,7 +274,7 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                 reach = step * speed + lam
                 if ex0 > px + reach or ex1 < px - reach or ey0 > py + reach or ey1 < py - reach:
                     continue
-                d2 = _nearest_on_segment(px, py, ax, ay, bx, by)[2]
+                d2 = closest_on_segment(px, py, ax, ay, bx, by)[2]
                 dmin2 = min(dmin2, d2)
                 if d2 < reach * reach:     # else it cannot shorten the step
                     new = _pair_time(px, py, cv[0], cv[1], rv_len[i], ax, ay, bx, by, ce[0],
@@ -326,7 +312,7 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                 continue
             if min(xe[j, 1], xe[j1, 1]) > py + reach or max(xe[j, 1], xe[j1, 1]) < py - reach:
                 continue
-            d2 = _nearest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
+            d2 = closest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
             dmin2 = min(dmin2, d2)
             speed = lin + wv * rv_len[i] + we * re_max[j]
             if d2 < (step * speed + lam) ** 2:
@@ -437,7 +423,7 @@ def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need, fi
             if sig < rate * best:           # else this end holds beyond the best
                 t_edge = min(t_edge, sig / rate)
         if t_edge < best:
-            gap = np.sqrt(_nearest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
+            gap = np.sqrt(closest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
                                               xv[k1, 1])[2]) - le
             if gap > 0.0:
                 rate = lin + wv * max(rv_len[k], rv_len[k1])

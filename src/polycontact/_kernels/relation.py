@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .validate import _orient, _point_segment_distance, segment_meet
+from .validate import _orient, _point_segment_distance, closest_on_segment, segment_meet
 
 SEPARATE = 0
 CONTACT = 1
@@ -318,27 +318,6 @@ def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
     return False
 
 
-@njit(cache=True, nogil=True)
-def _point_segment_distance2(px, py, ax, ay, bx, by):
-    """Squared distance from p to the closed segment ab."""
-    dx = bx - ax
-    dy = by - ay
-    wx = px - ax
-    wy = py - ay
-    t = wx * dx + wy * dy
-    if t <= 0.0:
-        return wx * wx + wy * wy
-    den = dx * dx + dy * dy
-    if t >= den:
-        ex = px - bx
-        ey = py - by
-        return ex * ex + ey * ey
-    t /= den
-    ex = wx - t * dx
-    ey = wy - t * dy
-    return ex * ex + ey * ey
-
-
 #: Pairs with at most this many (A edge, B edge) combinations in the common window are
 #: tested all against all; above it the edges are sorted and swept in x.
 _ALL_PAIRS = 256
@@ -371,16 +350,16 @@ def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
             return 0
     e2 = eps * eps
     near = 0
-    if _point_segment_distance2(px, py, rx, ry, sx, sy) <= e2:
+    if closest_on_segment(px, py, rx, ry, sx, sy)[2] <= e2:
         touch[ga] = True
         near = 1
-    if _point_segment_distance2(qx, qy, rx, ry, sx, sy) <= e2:
+    if closest_on_segment(qx, qy, rx, ry, sx, sy)[2] <= e2:
         touch[a1] = True
         near = 1
-    if _point_segment_distance2(rx, ry, px, py, qx, qy) <= e2:
+    if closest_on_segment(rx, ry, px, py, qx, qy)[2] <= e2:
         touch[gb] = True
         near = 1
-    if _point_segment_distance2(sx, sy, px, py, qx, qy) <= e2:
+    if closest_on_segment(sx, sy, px, py, qx, qy)[2] <= e2:
         touch[b1] = True
         near = 1
     if near:
@@ -513,17 +492,6 @@ def relate_state(xa, sa, xb, sb, eps):
 
 
 @njit(cache=True, nogil=True)
-def _closest_on(px, py, ax, ay, bx, by):
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    t = 0.0
-    if den > 0.0:
-        t = min(1.0, max(0.0, ((px - ax) * dx + (py - ay) * dy) / den))
-    return ax + t * dx, ay + t * dy
-
-
-@njit(cache=True, nogil=True)
 def _segment_closest(px, py, qx, qy, rx, ry, sx, sy):
     """Distance between segments pq and rs, with a closest pair ``(x1, y1, x2, y2)``."""
     o1 = _orient(px, py, qx, qy, rx, ry)
@@ -548,7 +516,7 @@ def _segment_closest(px, py, qx, qy, rx, ry, sx, sy):
             ux, uy, ax, ay, bx, by, on_first = rx, ry, px, py, qx, qy, False
         else:
             ux, uy, ax, ay, bx, by, on_first = sx, sy, px, py, qx, qy, False
-        cx, cy = _closest_on(ux, uy, ax, ay, bx, by)
+        cx, cy, _ = closest_on_segment(ux, uy, ax, ay, bx, by)
         d = _norm(ux - cx, uy - cy)
         if d < best:
             best = d
@@ -1103,7 +1071,7 @@ def penetration(xa, sa, xb, sb, eps):
         if seg[s, 4] >= best:
             break
         px, py, qx, qy = seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]
-        cx, cy = _closest_on(0.0, 0.0, px, py, qx, qy)
+        cx, cy, _ = closest_on_segment(0.0, 0.0, px, py, qx, qy)
         if _separates(xa, sa, xb, sb, cx, cy, eps):
             best = seg[s, 4]
             bdx = cx

@@ -18,7 +18,8 @@ def _orient(ax, ay, bx, by, cx, cy):
 
 
 @njit(cache=True, nogil=True)
-def _point_segment_distance(px, py, ax, ay, bx, by):
+def closest_on_segment(px, py, ax, ay, bx, by):
+    """``(qx, qy, d2)``: the point q of the closed segment ab nearest p, and |p − q|²."""
     dx = bx - ax
     dy = by - ay
     den = dx * dx + dy * dy
@@ -26,9 +27,14 @@ def _point_segment_distance(px, py, ax, ay, bx, by):
     if den > 0.0:
         t = ((px - ax) * dx + (py - ay) * dy) / den
         t = min(1.0, max(0.0, t))
-    ex = ax + t * dx - px
-    ey = ay + t * dy - py
-    return np.sqrt(ex * ex + ey * ey)
+    qx = ax + t * dx
+    qy = ay + t * dy
+    return qx, qy, (px - qx) * (px - qx) + (py - qy) * (py - qy)
+
+
+@njit(cache=True, nogil=True)
+def _point_segment_distance(px, py, ax, ay, bx, by):
+    return np.sqrt(closest_on_segment(px, py, ax, ay, bx, by)[2])
 
 
 @njit(cache=True, nogil=True)
