@@ -6,7 +6,9 @@ Inputs stay small so that the pure-Python run is quick.
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import shapely
+from catalogue import SMALL_FAR_RING
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -193,3 +195,10 @@ def test_ring_pieces_convex_small_and_too_big():
     assert sum(shapely.Polygon(p).area for p in _split(xy, starts)) == 3.0
     ok, _, _ = decompose.ring_pieces(ell, 1e-12, 5)  # too many vertices for ear clipping
     assert not ok
+
+
+def test_ring_stats_small_ring_far_from_the_origin():
+    xy = np.ascontiguousarray(SMALL_FAR_RING)
+    area, length = kn._ring_stats(xy, np.array([0, len(xy)]))
+    assert area[0] == pytest.approx(shapely.Polygon(xy).area, rel=1e-12)
+    assert length[0] == pytest.approx(shapely.LinearRing(xy).length, rel=1e-12)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from catalogue import CASES, boundary_gap, pairs, shapely_state
+from catalogue import CASES, SMALL_FAR_RING, boundary_gap, pairs, shapely_state
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -248,3 +248,10 @@ def test_raw_states_flags_invalid_rings():
     )
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
+
+
+def test_raw_ring_small_ring_far_from_the_origin():
+    # area 2e-4 at (82, 70): valid, counter-clockwise, its box exact
+    n, sign, scale, box = kr._raw_ring(SMALL_FAR_RING, RELATIVE_TOLERANCE)
+    assert (n, sign) == (len(SMALL_FAR_RING), 1.0)
+    assert box[1] == SMALL_FAR_RING[:, 0].max() and scale == SMALL_FAR_RING.max()

@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 import shapely
+from catalogue import SMALL_FAR_RING
 from hypothesis import example, given
 from hypothesis import strategies as st
 
@@ -61,18 +62,6 @@ def test_arrays_are_read_only_and_input_untouched():
         s.centroid[0] = 1.0
 
 
-# A ring of area 2e-4 at (82, 70): summing cross products of raw coordinates lost
-# six digits of its area (CI failure); they are now taken relative to a vertex.
-SMALL_FAR_RING = np.array([
-    [82.01, 70.40625], [82.0096891242171, 70.40872403959254],
-    [82.0087758256189, 70.41104425538605], [82.00731688868873, 70.41306638760024],
-    [82.00540302305868, 70.41466470984808], [82.00431176516798, 70.415272675941],
-    [82.00315322362395, 70.41573984619356], [82.00194547707989, 70.41605893057023],
-    [82.00070737201668, 70.41622494986603], [82.00008296231624, 70.41624965585679],
-    [81.99945822864973, 70.4162353134054], [81.9982175394435, 70.41608985946874],
-    [81.99583853163453, 70.41534297426826], [81.99198856384453, 70.41223472144104],
-    [81.990100075034, 70.4076612000806], [81.99346356379137, 70.39868197504693],
-])
 
 
 @given(star_polygons())

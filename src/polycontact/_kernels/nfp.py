@@ -591,9 +591,13 @@ def _ring_stats(xy, starts):
     for k in range(n):
         s = starts[k]
         e = starts[k + 1]
+        ox = xy[s, 0]  # relative to the first vertex: no cancellation far from the origin
+        oy = xy[s, 1]
         for i in range(s, e):
             j = i + 1 if i + 1 < e else s
-            area[k] += 0.5 * (xy[i, 0] * xy[j, 1] - xy[j, 0] * xy[i, 1])
+            area[k] += 0.5 * (
+                (xy[i, 0] - ox) * (xy[j, 1] - oy) - (xy[j, 0] - ox) * (xy[i, 1] - oy)
+            )
             length[k] += np.hypot(xy[j, 0] - xy[i, 0], xy[j, 1] - xy[i, 1])
     return area, length
 

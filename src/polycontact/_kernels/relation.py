@@ -783,12 +783,15 @@ def _raw_ring(xy, rel):
         n -= 1
     if n < 3:
         return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
-    # One pass: finiteness, scale, bounding box and twice the signed area.
+    # One pass: finiteness, scale, bounding box and twice the signed area (taken
+    # relative to the first vertex, so a small ring far from the origin keeps its digits).
     x0 = np.inf
     x1 = -np.inf
     y0 = np.inf
     y1 = -np.inf
     a2 = 0.0
+    ox = xy[0, 0]
+    oy = xy[0, 1]
     jx = xy[n - 1, 0]
     jy = xy[n - 1, 1]
     for i in range(n):
@@ -800,7 +803,7 @@ def _raw_ring(xy, rel):
         x1 = max(x1, x)
         y0 = min(y0, y)
         y1 = max(y1, y)
-        a2 += jx * y - x * jy
+        a2 += (jx - ox) * (y - oy) - (x - ox) * (jy - oy)
         jx = x
         jy = y
     scale = max(1.0, -x0, x1, -y0, y1)
