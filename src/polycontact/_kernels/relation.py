@@ -981,37 +981,26 @@ def _touch_segments(xa, sa, xb, sb, bound, keep_count, out):
     nb = sb[sb.shape[0] - 1]
     la = _loop_index(sa, na)
     lb = _loop_index(sb, nb)
-    r = 0
-    for e in range(na):
-        e1 = _next_vertex(e, sa, la)
-        ux = xa[e1, 0] - xa[e, 0]
-        uy = xa[e1, 1] - xa[e, 1]
-        for i in range(nb):
-            px = xb[i, 0] - xa[e, 0]
-            py = xb[i, 1] - xa[e, 1]
-            qx = xb[i, 0] - xa[e1, 0]
-            qy = xb[i, 1] - xa[e1, 1]
+    r = _vertex_edge_segments(xa, sa, la, xb, sb, lb, 1.0, bound, keep_count, out, 0)
+    return _vertex_edge_segments(xb, sb, lb, xa, sa, la, -1.0, bound, keep_count, out, r)
+
+
+@njit(cache=True, nogil=True)
+def _vertex_edge_segments(xe, se, le, xv, sv, lv, sign, bound, keep_count, out, r):
+    """The rows of :func:`_touch_segments` for vertices of body V on edges of body E,
+    appended from row r; returns the new row count. ``sign`` = +1.0 when E is A (the
+    segment is v − e), −1.0 when E is B (e − v)."""
+    for e in range(se[se.shape[0] - 1]):
+        e1 = _next_vertex(e, se, le)
+        ux = xe[e1, 0] - xe[e, 0]
+        uy = xe[e1, 1] - xe[e, 1]
+        for i in range(sv[sv.shape[0] - 1]):
+            px = sign * (xv[i, 0] - xe[e, 0])
+            py = sign * (xv[i, 1] - xe[e, 1])
+            qx = sign * (xv[i, 0] - xe[e1, 0])
+            qy = sign * (xv[i, 1] - xe[e1, 1])
             d = _origin_segment_distance(px, py, qx, qy)
-            if d >= bound or _cone_meets_left(xb, sb, lb, i, ux, uy):
-                continue
-            if keep_count:
-                out[r, 0] = px
-                out[r, 1] = py
-                out[r, 2] = qx
-                out[r, 3] = qy
-                out[r, 4] = d
-            r += 1
-    for f in range(nb):
-        f1 = _next_vertex(f, sb, lb)
-        ux = xb[f1, 0] - xb[f, 0]
-        uy = xb[f1, 1] - xb[f, 1]
-        for j in range(na):
-            px = xb[f, 0] - xa[j, 0]
-            py = xb[f, 1] - xa[j, 1]
-            qx = xb[f1, 0] - xa[j, 0]
-            qy = xb[f1, 1] - xa[j, 1]
-            d = _origin_segment_distance(px, py, qx, qy)
-            if d >= bound or _cone_meets_left(xa, sa, la, j, ux, uy):
+            if d >= bound or _cone_meets_left(xv, sv, lv, i, ux, uy):
                 continue
             if keep_count:
                 out[r, 0] = px
