@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import shapely
 from catalogue import CASES, SMALL_FAR_RING, boundary_gap, pairs, shapely_state
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from polycontact import Shape
@@ -120,6 +120,8 @@ def test_features_kernel_against_numpy(pair):
 
 
 @given(st.lists(st.floats(-100, 100), min_size=0, max_size=60))
+@example(list(range(32, 0, -1)))                 # reversed: the heap-sort fallback
+@example([1.0] * 20 + [0.0] * 20 + [0.5] * 20)   # bunched keys, bucket pass then fallback
 def test_sort_by_xmin(keys):
     box = np.zeros((len(keys), 4))
     box[:, 0] = keys
@@ -153,6 +155,51 @@ def test_long_ring_sweep_agrees_with_all_pairs(radii, snap, swap):
     rows = kr._sorted_edge_boxes(ring, n)
     assert sorted(rows[:, 4].astype(int).tolist()) == list(range(n))
     assert np.all(np.diff(rows[:, 0]) >= 0)
+
+
+def _full_ring_check(ring, eps):
+    n = len(ring)
+    folds = any(kr._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n))
+    return not folds and kr._small_ring_is_simple(ring, n, eps)
+
+
+@given(
+    st.lists(st.tuples(st.floats(1e-3, 1.0), st.sampled_from([1.0, 0.5, 1e-9, 1e-12, 1e-14])),
+             min_size=3, max_size=14),
+    st.sampled_from([1, 2, 3]),
+    st.floats(-1.0, 1.0),
+    st.sampled_from([1.0, 1e6]),
+    st.booleans(),
+)
+def test_star_certificate_is_never_wrong(steps, turns, shift, scale, clockwise):
+    # Rings whose vertices step round a point (some once, some two or three times
+    # round, like a pentagram), with angular steps down to 1e-14 and radii
+    # far apart, at two scales and both orientations: whenever the O(n) star test
+    # certifies a ring, the all-pairs check must call it simple.
+    gaps = np.array([g * w for g, w in steps])
+    ang = np.cumsum(gaps) / gaps.sum() * 2.0 * np.pi * turns
+    rad = np.array([0.2 + g for g, _ in steps])
+    ring = np.c_[np.cos(ang) * rad + shift, np.sin(ang) * rad] * scale
+    if clockwise:
+        ring = ring[::-1].copy()
+    eps = RELATIVE_TOLERANCE * max(1.0, np.abs(ring).max())
+    if kr._star_ring_is_simple(ring, len(ring), eps):
+        assert _full_ring_check(ring, eps)
+        assert shapely.Polygon(ring).is_valid
+
+
+def test_star_certificate_fires_on_convex_and_star_rings():
+    t = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
+    convex = np.c_[np.cos(t), np.sin(t)] * 3.0 + 100.0
+    star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(12) % 2, 1.0, 0.4)[:, None]
+    k = np.arange(5) * 4.0 * np.pi / 5.0
+    pentagram = np.c_[np.cos(k), np.sin(k)]
+    comb = np.array([[0, 0], [3, 0], [3, 1], [2, 1], [2, 0.2], [1, 0.2], [1, 1], [0, 1.0]])
+    for ring, certified in ((convex, True), (star, True), (convex[::-1], True),
+                            (pentagram, False), (comb, False)):
+        eps = RELATIVE_TOLERANCE * max(1.0, np.abs(ring).max())
+        assert kr._star_ring_is_simple(ring, len(ring), eps) == certified
+        assert kr._ring_is_simple(ring, len(ring), eps) == _full_ring_check(ring, eps)
 
 
 @given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
@@ -238,6 +285,33 @@ def test_raw_states_flags_invalid_rings():
     )
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
+
+
+def _comb(teeth: int) -> np.ndarray:
+    """A comb of 4·teeth + 2 vertices: simple, and not star-shaped about any point."""
+    top = [(x + dx, y) for x in range(teeth)
+           for dx, y in ((0.0, 1.0), (0.5, 1.0), (0.5, 0.3), (1.0, 0.3))]
+    return np.array([(0.0, -1.0), *top, (teeth, -1.0)])
+
+
+def test_raw_states_long_rings_that_need_the_sweep():
+    # Rings of more than 24 vertices that the O(n) certificate cannot pass are left to
+    # the sorted sweep after the pass: valid ones are classified, a crossing one flagged.
+    comb = _comb(8)
+    crossed = comb.copy()
+    crossed[[5, 9]] = crossed[[9, 5]]
+    t = np.linspace(0.0, 2.0 * np.pi, len(comb), endpoint=False)
+    star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(len(t)) % 2, 3.0, 2.0)[:, None]
+    xa = np.stack([comb, comb, star, crossed, star])
+    xb = np.stack([comb + [0.25, 0.5], star + [12.0, 0.0], comb, star, crossed])
+    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0,
+                                                                RELATIVE_TOLERANCE)
+    assert states.tolist()[3:] == [-1, -1]
+    assert used_a.tolist()[3] == -1 and used_b.tolist()[4] == -1
+    for p in range(3):
+        want = kr.classify_raw(xa[p], xb[p], -1.0, RELATIVE_TOLERANCE)
+        assert (states[p], eps[p], used_a[p], sign_a[p], used_b[p], sign_b[p]) == want
+    assert states.tolist()[:3] == [2, 0, 2]
 
 
 def test_raw_ring_small_ring_far_from_the_origin():

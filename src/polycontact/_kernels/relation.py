@@ -129,7 +129,8 @@ def _sort_into(box, cnt, order, start):
     A bucket pass (one bucket per row over the range of xmin; ``start`` is scratch of
     at least cnt + 1 entries) followed by an insertion pass: O(cnt) for spread-out keys.
     If the insertion pass does too much work (keys bunched in a few buckets) it falls
-    back to ``np.argsort``.
+    back to a heap sort in place (nothing is allocated: the batch pass that calls this
+    runs without reference counting).
     """
     if cnt == 0:
         return
@@ -164,8 +165,32 @@ def _sort_into(box, cnt, order, start):
             budget -= 1
         order[j] = cur
         if budget < 0:
-            order[:cnt] = np.argsort(box[:cnt, 0])
+            _heap_sort(box, cnt, order)
             return
+
+
+@njit(cache=True, nogil=True)
+def _heap_sort(box, cnt, order):
+    """Sort the permutation ``order[:cnt]`` by ``box[order[k], 0]`` in place."""
+    for root in range(cnt // 2 - 1, -1, -1):
+        _sift_down(box, order, root, cnt)
+    for end in range(cnt - 1, 0, -1):
+        order[0], order[end] = order[end], order[0]
+        _sift_down(box, order, 0, end)
+
+
+@njit(cache=True, nogil=True)
+def _sift_down(box, order, root, end):
+    while True:
+        child = 2 * root + 1
+        if child >= end:
+            return
+        if child + 1 < end and box[order[child + 1], 0] > box[order[child], 0]:
+            child += 1
+        if box[order[root], 0] >= box[order[child], 0]:
+            return
+        order[root], order[child] = order[child], order[root]
+        root = child
 
 
 @njit(cache=True, nogil=True)
@@ -251,8 +276,10 @@ def _cones_overlap(
             # other (true angle below 1 radian and angle x shorter length <= eps).
             sin_gap = rays[i1, 4] * rays[i2, 5] - rays[i1, 5] * rays[i2, 4]
             cos_gap = rays[i1, 4] * rays[i2, 4] + rays[i1, 5] * rays[i2, 5]
-            if cos_gap > _COS_ONE_RADIAN and (
-                np.arcsin(min(1.0, max(0.0, sin_gap))) * min(rays[i1, 1], rays[i2, 1]) <= eps
+            # (arcsin x >= x: the arcsin is needed only when sin_gap x length is small)
+            short = min(rays[i1, 1], rays[i2, 1])
+            if cos_gap > _COS_ONE_RADIAN and sin_gap * short <= eps and (
+                np.arcsin(min(1.0, max(0.0, sin_gap))) * short <= eps
             ):
                 continue
         mid = rays[i1, 0] + 0.5 * gap
@@ -673,17 +700,90 @@ def _small_ring_is_simple(xy, n, eps):
 
 
 @njit(cache=True, nogil=True)
-def _ring_is_simple(xy, n, eps):
-    """No two edges of the ring meet except consecutive ones at their shared vertex,
-    and no two consecutive edges fold back: the rules of ``validate.first_defect`` for
-    one loop. Short rings test every pair; long ones sweep edges sorted by xmin."""
+def _star_ring_is_simple(xy, n, eps):
+    """True when the ring is certified simple in O(n) as star-shaped about the mean of
+    its vertices c, with every edge more than ``2 eps`` from every edge it does not
+    share a vertex with; False means "not certified" (the ring may still be simple).
+
+    Let u_i = x_i − c. If every edge turns the same way about c (cross(u_i, u_(i+1))
+    of one strict sign) and the polar angle of u winds once (u_y changes sign exactly
+    twice), the edges lie in disjoint wedges about c that tile the plane once, each
+    edge touching only its own wedge's two rays, at its ends: the ring is simple.
+    Distances: a point of edge i is at least h_i (the distance of its line from c)
+    from c, and a point of an edge that is not adjacent to it (or the far end of an
+    adjacent edge) lies at least one whole wedge away in angle, so the two are at least
+    h_min · sin(min(γ_min, π/2)) apart, γ_min the narrowest wedge. When that exceeds
+    ``2 eps`` no two such edges meet within eps and no two consecutive edges fold back,
+    which is all :func:`_ring_is_simple` checks. The margin dwarfs the rounding of c,
+    the u_i and the products (relative 1e-16 against eps >= 1e-12 of the scale), so a
+    certified ring is simple by the exact predicate too.
+    """
+    cx = 0.0
+    cy = 0.0
+    for i in range(n):
+        cx += xy[i, 0]
+        cy += xy[i, 1]
+    cx /= n
+    cy /= n
+    ux = xy[n - 1, 0] - cx
+    uy = xy[n - 1, 1] - cy
+    u2 = ux * ux + uy * uy
+    turn = 0.0
+    changes = 0
+    h2 = np.inf     # min over edges of h_i², h_i = cross_i / |edge i|
+    s2 = 1.0        # min over wedges of sin², 1 for a wedge wider than π/2
+    for i in range(n):
+        wx = xy[i, 0] - cx
+        wy = xy[i, 1] - cy
+        w2 = wx * wx + wy * wy
+        cr = ux * wy - uy * wx
+        if turn == 0.0:
+            turn = 1.0 if cr > 0.0 else -1.0
+        cr *= turn
+        if not cr > 0.0:        # also NaN
+            return False
+        if (uy < 0.0) != (wy < 0.0):
+            changes += 1
+        ex = wx - ux
+        ey = wy - uy
+        c2 = cr * cr
+        h2 = min(h2, c2 / (ex * ex + ey * ey))
+        if ux * wx + uy * wy > 0.0:
+            s2 = min(s2, c2 / (u2 * w2))
+        ux = wx
+        uy = wy
+        u2 = w2
+    return changes == 2 and h2 * s2 > 4.0 * eps * eps
+
+
+@njit(cache=True, nogil=True)
+def _ring_is_simple_unswept(xy, n, eps):
+    """:func:`_ring_is_simple` as far as it goes without allocating: 1 simple, 0 not,
+    -1 undecided (a ring of more than ``_SMALL_RING`` vertices that
+    :func:`_star_ring_is_simple` does not certify and that has no fold: it needs the
+    sweep)."""
+    if _star_ring_is_simple(xy, n, eps):
+        return 1
     for i in range(n):
         h = i - 1 if i > 0 else n - 1
         j = i + 1 if i + 1 < n else 0
         if _folds(xy[h, 0], xy[h, 1], xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], eps):
-            return False
+            return 0
     if n <= _SMALL_RING:
-        return _small_ring_is_simple(xy, n, eps)
+        return 1 if _small_ring_is_simple(xy, n, eps) else 0
+    return -1
+
+
+@njit(cache=True, nogil=True)
+def _ring_is_simple(xy, n, eps):
+    """No two edges of the ring meet except consecutive ones at their shared vertex,
+    and no two consecutive edges fold back: the rules of ``validate.first_defect`` for
+    one loop. Rings certified by :func:`_star_ring_is_simple` (convex ones, and most
+    star-shaped ones) pass in O(n); other short rings test every pair, long ones sweep
+    edges sorted by xmin."""
+    known = _ring_is_simple_unswept(xy, n, eps)
+    if known >= 0:
+        return known == 1
     eb = _sorted_edge_boxes(xy, n)
     for oi in range(n):
         i = int(eb[oi, 4])
@@ -776,6 +876,15 @@ def _raw_ring(xy, rel):
     -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1); ``box`` the
     bounding box ``(xmin, xmax, ymin, ymax)``.
     """
+    n, sign, scale, box = _ring_summary(xy, rel)
+    if n > 0 and not _ring_is_simple(xy, n, rel * scale):
+        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
+    return n, sign, scale, box
+
+
+@njit(cache=True, nogil=True)
+def _ring_summary(xy, rel):
+    """:func:`_raw_ring` but for the simplicity check (left to the caller)."""
     n = xy.shape[0]
     if xy.shape[1] != 2:
         return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
@@ -809,8 +918,6 @@ def _raw_ring(xy, rel):
     scale = max(1.0, -x0, x1, -y0, y1)
     eps = rel * scale
     if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
-        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
-    if not _ring_is_simple(xy, n, eps):
         return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
     return n, (1.0 if a2 > 0.0 else -1.0), scale, (x0, x1, y0, y1)
 
