@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import enum
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -366,7 +366,7 @@ class RelationBatch:
 
     states: np.ndarray
     tolerances: np.ndarray
-    _packed: tuple = field(repr=False)
+    _pack: Callable[[], tuple] = field(repr=False)  # the packed pairs, built on demand
 
     def __len__(self) -> int:
         return int(self.states.shape[0])
@@ -380,7 +380,7 @@ class RelationBatch:
         """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
         from ._kernels import relation_many as km
 
-        return km.many_distances(*self._packed, self.states, self.tolerances)
+        return km.many_distances(*self._pack(), self.states, self.tolerances)
 
 
 def _split(count: int, fn: Any) -> list[Any]:
@@ -421,17 +421,15 @@ def _classify_arrays(
     None if some ring is not valid as given (the caller then explains through ``Shape``)."""
     from ._kernels import relation_many as km
 
-    parts = _split(
-        arr_a.shape[0],
-        lambda p0, p1: km.raw_states(arr_a[p0:p1], arr_b[p0:p1], tol, RELATIVE_TOLERANCE),
-    )
-    states, eps, used_a, sign_a, used_b, sign_b = (
-        np.concatenate([part[k] for part in parts]) for k in range(6)
-    )
+    out = km.raw_states_outputs(arr_a.shape[0])
+    _split(arr_a.shape[0], lambda p0, p1: km.raw_states(
+        arr_a[p0:p1], arr_b[p0:p1], tol, RELATIVE_TOLERANCE, [o[p0:p1] for o in out]))
+    states, eps, used_a, sign_a, used_b, sign_b = out
     if (states < 0).any():
         return None
     return RelationBatch(
-        states, eps, (*_ring_pack(arr_a, used_a, sign_a), *_ring_pack(arr_b, used_b, sign_b))
+        states, eps,
+        lambda: (*_ring_pack(arr_a, used_a, sign_a), *_ring_pack(arr_b, used_b, sign_b)),
     )
 
 
@@ -551,7 +549,7 @@ def classify_many(
     parts = _split(len(fa), chunk)
     states = np.concatenate([st for st, _ in parts])
     eps = np.concatenate([e for _, e in parts])
-    return RelationBatch(states, eps, (*pa, *pb))
+    return RelationBatch(states, eps, lambda: (*pa, *pb))
 
 
 def warmup() -> None:

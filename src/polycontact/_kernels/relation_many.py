@@ -48,7 +48,13 @@ def check_rings(xy, lo, n, rel):
 _UNDECIDED = -2
 
 
-def raw_states(xa, xb, tol, rel):
+def raw_states_outputs(p_count):
+    """Empty arrays for the six results of :func:`raw_states` over ``p_count`` pairs."""
+    return (np.empty(p_count, np.int8), np.zeros(p_count), np.empty(p_count, np.int64),
+            np.empty(p_count), np.empty(p_count, np.int64), np.empty(p_count))
+
+
+def raw_states(xa, xb, tol, rel, out=None):
     """Validate and classify P pairs of raw outer rings, ``xa`` (P, N, 2) against
     ``xb`` (P, M, 2), in one pass over the pairs.
 
@@ -61,10 +67,10 @@ def raw_states(xa, xb, tol, rel):
     The pass itself (:func:`_raw_states_into`) allocates nothing; the few pairs it
     leaves undecided (long rings that need a sorted sweep) are finished by
     :func:`_finish_undecided`. (A plain function: it only allocates and dispatches.)
+    ``out``, if given, is that tuple of arrays to write into (views of larger ones, say).
     """
-    p_count = xa.shape[0]
-    out = (np.empty(p_count, np.int8), np.zeros(p_count), np.empty(p_count, np.int64),
-           np.empty(p_count), np.empty(p_count, np.int64), np.empty(p_count))
+    if out is None:
+        out = raw_states_outputs(xa.shape[0])
     scratch = (*_scratch(xa.shape[1] + xb.shape[1]), np.zeros(2, np.int64),
                np.zeros(2, np.int64))
     if _raw_states_into(xa, xb, tol, rel, *out, *scratch):
