@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from .broad_phase import overlap_intervals
-from .relation import relate_state
+from .relation import _scratch, _state_in
 from .validate import closest_on_segment
 
 NO_HIT = 0
@@ -181,11 +181,12 @@ def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, la
 
 @njit(cache=True, nogil=True)
 def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, lam, lam_pair,
-                  dmin2, step, crit, way):
+                  dmin2, step, crit, way, cand, xmin, sorted_x):
     """Vertices of one body against the edges of the other (``wv``, ``we``: the bounds
     of |ω| over the window; ``nxt``, ``re_max``, ``order`` from :func:`edge_table`;
-    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that sets the step is written to
-    ``crit`` as ``(way, vertex, edge)``.
+    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that
+    sets the step is written to ``crit`` as ``(way, vertex, edge)``. ``cand`` (one
+    entry per vertex), ``xmin`` and ``sorted_x`` (one per edge) are scratch.
 
     Only vertices within reach of the edge body's box are visited; when they are few,
     each meets the edges within reach of their common box, else a sweep over the edges
@@ -233,7 +234,6 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
         return dmin2, step
     # no pair farther than `reach` can shorten the step: skip a vertex that far from
     # the other body's box
-    cand = np.empty(xv.shape[0], np.int64)
     nc = 0
     bx0 = np.inf
     bx1 = -np.inf
@@ -283,7 +283,6 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
                         step = new
                         crit[0], crit[1], crit[2] = way, i, j
         return dmin2, step
-    xmin = np.empty(ne)
     maxw = 0.0
     for j in range(ne):
         xmin[j] = min(xe[j, 0], xe[nxt[j], 0])
@@ -297,13 +296,14 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
             order[m] = order[m - 1]
             m -= 1
         order[m] = cur
-    sorted_x = xmin[order]
+    for k in range(ne):
+        sorted_x[k] = xmin[order[k]]
     for k in range(nc):
         i = cand[k]
         px = xv[i, 0]
         py = xv[i, 1]
         reach = step * (lin + wv * rv_len[i] + we * lmax) + lam
-        o = np.searchsorted(sorted_x, px - reach - maxw)
+        o = np.searchsorted(sorted_x[:ne], px - reach - maxw)
         while o < ne and sorted_x[o] <= px + reach:
             j = order[o]
             o += 1
@@ -327,9 +327,11 @@ def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, l
 
 @njit(cache=True, nogil=True)
 def edge_table(starts, r_len):
-    """``(nxt, r_max, order)``: the vertex after each vertex in its loop, the largest
-    centroid distance of each edge's two ends, and an edge order that the sweep keeps
-    sorted by smallest x (starts as 0, 1, ...)."""
+    """``(nxt, r_max, order, cand, xmin, sorted_x)``: the vertex after each vertex in
+    its loop, the largest centroid distance of each edge's two ends, an edge order that
+    the sweep keeps sorted by smallest x (starts as 0, 1, ...), and the scratch arrays of
+    :func:`_one_way_step` sized for this body (its vertices as candidates, its edges
+    swept), so that a search allocates nothing per step."""
     n = r_len.shape[0]
     nxt = np.empty(n, np.int64)
     r_max = np.empty(n)
@@ -340,7 +342,7 @@ def edge_table(starts, r_len):
             j1 = j + 1 if j + 1 < e else s
             nxt[j] = j1
             r_max[j] = max(r_len[j], r_len[j1])
-    return nxt, r_max, np.arange(n)
+    return nxt, r_max, np.arange(n), np.empty(n, np.int64), np.empty(n), np.empty(n)
 
 
 @njit(cache=True, nogil=True)
@@ -505,9 +507,9 @@ def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, lam_p
             step = _crit_time(xb, cb, rb_len[i], xa, ca, ea[0], ea[1], i, j, mwb,
                               lin + wb * rb_len[i] + wa * ea[1][j], lam_pair, step)
     dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], eb[2], mwa, lin, wa, wb,
-                                lam, lam_pair, np.inf, step, crit, 0)
+                                lam, lam_pair, np.inf, step, crit, 0, ea[3], eb[4], eb[5])
     dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], ea[2], mwb, lin, wb, wa,
-                                lam, lam_pair, dmin2, step, crit, 1)
+                                lam, lam_pair, dmin2, step, crit, 1, eb[3], ea[4], ea[5])
     return np.sqrt(dmin2), step
 
 
@@ -524,11 +526,25 @@ def _window_rates(ma, mb, t0, t1):
 
 
 @njit(cache=True, nogil=True)
-def state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps):
-    """relate_state of the two bodies placed at time t (xa, xb are scratch arrays)."""
+def state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch):
+    """The state of the two bodies placed at time t (``xa``, ``xb`` and ``scratch``, a
+    :func:`polycontact._kernels.relation._scratch` tuple, are scratch)."""
     place(ra, ca, ma, t, xa)
     place(rb, cb, mb, t, xb)
-    return relate_state(xa, sa, xb, sb, eps)
+    return _placed_state(xa, sa, xb, sb, eps, scratch)
+
+
+@njit(cache=True, nogil=True)
+def _placed_state(xa, sa, xb, sb, eps, scratch):
+    """``relate_state`` of placed bodies, with the state kernel's scratch passed in."""
+    box, ids, touch, rays, rord = scratch
+    return _state_in(xa, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays, rord)
+
+
+@njit(cache=True, nogil=True)
+def _search_scratch(ra, rb):
+    """Placed vertices of A and B and the state kernel's scratch (see :func:`state_at`)."""
+    return np.empty_like(ra), np.empty_like(rb), _scratch(ra.shape[0] + rb.shape[0])
 
 
 @njit(cache=True, nogil=True)
@@ -565,19 +581,28 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
 
     A penetrating state at the end of a probe is the hit, bracketed by the probe.
     """
-    xa = np.empty_like(ra)
-    xb = np.empty_like(rb)
     ra_len = np.empty(ra.shape[0])
     for i in range(ra.shape[0]):
         ra_len[i] = np.hypot(ra[i, 0], ra[i, 1])
     rb_len = np.empty(rb.shape[0])
     for i in range(rb.shape[0]):
         rb_len[i] = np.hypot(rb[i, 0], rb[i, 1])
-    pa = np.empty(2)
-    pb = np.empty(2)
-    ea = edge_table(sa, ra_len)
-    eb = edge_table(sb, rb_len)
-    crit = np.full(3, -1, np.int64)
+    xa, xb, scratch = _search_scratch(ra, rb)
+    return _exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps, lam,
+                         max_iter, xa, xb, ra_len, rb_len, edge_table(sa, ra_len),
+                         edge_table(sb, rb_len), np.empty(2), np.empty(2),
+                         np.full(3, -1, np.int64), scratch)
+
+
+# The searches run without Numba's reference counting (``_nrt=False``): each step passes
+# a dozen arrays down several calls, and their atomic reference counts cost as much as
+# the geometry of a small pair. Nothing in them may allocate (the compiler refuses if it
+# does): their callers pass every buffer in.
+@njit(cache=True, nogil=True, _nrt=False)
+def _exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps, lam,
+                  max_iter, xa, xb, ra_len, rb_len, ea, eb, pa, pb, crit, scratch):
+    """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
+    of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair)."""
     lam_pair = PAIR_GAP * lam
     first_contact = -1.0
     it = 0
@@ -589,7 +614,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
         pa[0], pa[1] = place(ra, ca, ma, t, xa)
         pb[0], pb[1] = place(rb, cb, mb, t, xb)
         # after t = 0 an interval opens with the bounding circles just touching: apart
-        if t == 0.0 and relate_state(xa, sa, xb, sb, eps) == _PENETRATING:
+        if t == 0.0 and _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
         while True:
@@ -636,7 +661,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
                 continue
             pa[0], pa[1] = place(ra, ca, ma, t_new, xa)
             pb[0], pb[1] = place(rb, cb, mb, t_new, xb)
-            if relate_state(xa, sa, xb, sb, eps) == _PENETRATING:
+            if _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
                 # the probe is the bracket: t_new − t = tau <= time_tol / 2, finer than
                 # asked, so no bisection
                 if first_contact < 0.0 or first_contact > t:
@@ -655,8 +680,15 @@ def sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps)
     T2 − T1 < threshold and report T2. Returns ``(status, t_hi, t_lo, first_contact,
     evaluations)``; ``first_contact`` is the earliest sample in contact (−1 if none).
     """
-    xa = np.empty_like(ra)
-    xb = np.empty_like(rb)
+    xa, xb, scratch = _search_scratch(ra, rb)
+    return _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps, xa,
+                           xb, scratch)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps, xa, xb,
+                    scratch):
+    """:func:`sampled_search` with its buffers passed in (see :func:`_exact_search`)."""
     first_contact = -1.0
     evals = 0
     for k in range(intervals.shape[0]):
@@ -664,7 +696,7 @@ def sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps)
         hi = intervals[k, 1]
         if lo == 0.0:
             evals += 1
-            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0, eps) == _PENETRATING:
+            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0, eps, scratch) == _PENETRATING:
                 return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, evals
         found = False
         while True:
@@ -672,7 +704,7 @@ def sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps)
             for i in range(n):
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
-                st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps)
+                st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
                     first_contact = t
                 if st == _PENETRATING:
