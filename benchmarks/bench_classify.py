@@ -17,7 +17,9 @@ The bodies are random concave star polygons: a radius of 1 + 0.3 sin(k t + phase
 k in 2..5, plus a jitter of half the vertex spacing. The pairs are a third separate (B
 placed near A without touching), a third contact (A moved out of a random overlap along
 a random direction, by bisection, until the boundaries touch within the tolerance) and a
-third penetrating.
+third penetrating. Star-shaped rings pass validation in O(n) (a certificate); a last
+table repeats the single-pair timing on random combs, which are not star-shaped and take
+the general check.
 """
 
 from __future__ import annotations
@@ -43,6 +45,23 @@ def star(rng: np.random.Generator, n: int) -> np.ndarray:
     return np.ascontiguousarray(np.c_[np.cos(t) * r, np.sin(t) * r])
 
 
+def comb(rng: np.random.Generator, n: int) -> np.ndarray:
+    """A random comb with n vertices (n divisible by 4, at least 8), counter-clockwise:
+    teeth of random depths on a base, scaled to about the size of :func:`star`; not
+    star-shaped about any point once it has a few deep teeth."""
+    teeth = (n - 4) // 4 + 1
+    xs = np.linspace(-1.0, 1.0, 2 * teeth)
+    tips = rng.uniform(0.4, 1.0, teeth)
+    roots = tips - rng.uniform(0.3, 0.9, teeth)
+    ring = [(-1.0, -1.0), (1.0, -1.0)]
+    for k in range(teeth - 1, -1, -1):
+        ring += [(xs[2 * k + 1], tips[k]), (xs[2 * k], tips[k])]
+        if k > 0:
+            ring += [(xs[2 * k] - 0.25 * (xs[1] - xs[0]), roots[k]),
+                     (xs[2 * k - 1] + 0.25 * (xs[1] - xs[0]), roots[k])]
+    return np.ascontiguousarray(np.array(ring[: n]) * 1.3)
+
+
 def touching(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
     """A moved along a random direction until it just touches B (bisection on the state)."""
     u = rng.normal(size=2)
@@ -60,14 +79,16 @@ def touching(a: np.ndarray, b: np.ndarray, rng: np.random.Generator) -> np.ndarr
     return None
 
 
-def make_pairs(rng: np.random.Generator, n: int, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """``count`` pairs of n-gons: separate, contact and penetrating in equal parts."""
+def make_pairs(rng: np.random.Generator, n: int, count: int,
+               body=star) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``count`` pairs of n-gons made by ``body``: separate, contact and penetrating in
+    equal parts."""
     out: list[tuple[np.ndarray, np.ndarray]] = []
     want = ["separate", "contact", "penetrating"]
     while len(out) < count:
         kind = want[len(out) % 3]
-        a = star(rng, n)
-        b = star(rng, n) + rng.uniform(-2.6, 2.6, 2)
+        a = body(rng, n)
+        b = body(rng, n) + rng.uniform(-2.6, 2.6, 2)
         state = pc.classify(a, b).state
         if kind == "separate" and state is pc.State.SEPARATE:
             out.append((a, b))
@@ -180,6 +201,18 @@ def main() -> None:
         t_rel = per_call(shapely_relate, pairs, repeats)
         print(f"{n:>8} {t_ours:>10.2f} {t_rel:>10.2f} {t_rel / t_ours:>7.1f} "
               f"{1000 * t_ours / n:>9.1f}ns")
+
+    print("\nclassify on random combs (not star-shaped: the general ring check) vs Shapely "
+          "construction + predicate (us per pair)")
+    print(f"{'vertices':>8} {'classify':>10} {'intersects':>11} {'relate':>10} "
+          f"{'x intersects':>13} {'x relate':>9}")
+    for n in (12, 96, 1024):
+        pairs = make_pairs(rng, n, 300 if n < 1000 else 60, body=comb)
+        t_ours = per_call(ours, pairs, repeats)
+        t_int = per_call(shapely_intersects, pairs, repeats)
+        t_rel = per_call(shapely_relate, pairs, repeats)
+        print(f"{n:>8} {t_ours:>10.2f} {t_int:>11.2f} {t_rel:>10.2f} "
+              f"{t_int / t_ours:>13.1f} {t_rel / t_ours:>9.1f}")
 
     print(f"\nimport polycontact: {import_time():.3f} s (cumulative, -X importtime, median of 5)")
 

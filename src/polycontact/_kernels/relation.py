@@ -200,7 +200,10 @@ def _pt(g, xa, xb, na):
     return xb[g - na, 0], xb[g - na, 1]
 
 
-@njit(cache=True, nogil=True)
+# Inlined into the state kernel: a call passes seven arrays, and in the batch pass (no
+# reference counting) that call cost about as much as the test; measured 50 -> 45 ms per
+# 100 000 pairs of 12-gons (one thread), single pairs within noise (+0.1 us).
+@njit(cache=True, nogil=True, inline="always")
 def _cones_overlap(
     px, py, xa, fa, xb, fb, na, box, ids, order, cnt, swept, maxw, eps, rays, rord
 ):
