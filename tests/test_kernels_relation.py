@@ -285,6 +285,11 @@ def test_raw_states_flags_invalid_rings():
     )
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
+    # a lopsided bow-tie (nonzero signed area, clockwise by it): invalid, with the sign
+    # _raw_ring gives an invalid ring, whichever way its area turns
+    lop = np.array([[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 1.0]])
+    _, _, used_a, sign_a, _, _ = km.raw_states(lop[None], sq[None], -1.0, RELATIVE_TOLERANCE)
+    assert used_a[0] == -1 and sign_a[0] == kr._raw_ring(lop, RELATIVE_TOLERANCE)[1] == 1.0
 
 
 def _comb(teeth: int) -> np.ndarray:
@@ -308,6 +313,7 @@ def test_raw_states_long_rings_that_need_the_sweep():
                                                                 RELATIVE_TOLERANCE)
     assert states.tolist()[3:] == [-1, -1]
     assert used_a.tolist()[3] == -1 and used_b.tolist()[4] == -1
+    assert sign_a[3] == kr._raw_ring(crossed, RELATIVE_TOLERANCE)[1] == sign_b[4]
     for p in range(3):
         want = kr.classify_raw(xa[p], xb[p], -1.0, RELATIVE_TOLERANCE)
         assert (states[p], eps[p], used_a[p], sign_a[p], used_b[p], sign_b[p]) == want

@@ -89,6 +89,8 @@ def _finish_undecided(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sig
         nb, fb, scb, bb = _raw_ring(xb[p], rel)
         used_a[p] = na
         used_b[p] = nb
+        sign_a[p] = fa
+        sign_b[p] = fb
         if na < 0 or nb < 0:
             states[p] = -1
             continue
@@ -113,8 +115,8 @@ def _raw_states_into(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sign
         kb = _ring_is_simple_unswept(xb[p], nb, rel * scb) if nb > 0 else 0
         used_a[p] = na if ka != 0 else -1
         used_b[p] = nb if kb != 0 else -1
-        sign_a[p] = fa
-        sign_b[p] = fb
+        sign_a[p] = fa if ka != 0 else 1.0     # as _raw_ring gives for an invalid ring
+        sign_b[p] = fb if kb != 0 else 1.0
         if ka == 0 or kb == 0:
             states[p] = -1
         elif ka < 0 or kb < 0:
