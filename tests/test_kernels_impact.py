@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from polycontact import Motion, Shape
 from polycontact._kernels import broad_phase as kb
 from polycontact._kernels import impact as ki
+from polycontact._kernels.advance import edge_table, pair_step, traversal_stack
 
 coef = st.floats(-10, 10, allow_nan=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
 
@@ -140,7 +141,7 @@ def test_slide_time_keeps_the_interiors_apart(va, wa, vb, wb, dx, frac):
     ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
     ra, rb = a.packed[0] - a.centroid, bar.packed[0] - bar.centroid
     la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
-    na, nb = ki.edge_table(a.packed[1], la)[0], ki.edge_table(bar.packed[1], lb)[0]
+    na, nb = edge_table(ra, a.packed[1])[0], edge_table(rb, bar.packed[1])[0]
     mwa, _ = ki.motion_window(ma.array, mb.array, 0.0, 1.0)
     # A's vertices against the line of the bar's top edge (edge 2: (3, 0) -> (-1, 0))
     h = ki.slide_time(a.packed[0], np.array(a.centroid), la, na, bar.packed[0],
@@ -192,17 +193,17 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     b = Shape([(0, 0), (1, 0), (1, 3), (0.5, 1), (0, 3)]).moved((3.0, dy))
     ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
-    la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
-    d, step = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
-                           b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1))
+    ea, eb = edge_table(ra, a.packed[1]), edge_table(rb, b.packed[1])
+    d, step = pair_step(a.packed[0], np.array(a.centroid), ea, b.packed[0], np.array(b.centroid),
+                           eb, ma.array, mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1),
+                           *traversal_stack())
     # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
     # it is never below the gap, and with lam just above the gap it is the gap
     gap = boundary_distance(*a.packed, *b.packed)
     assert d >= gap * (1 - 1e-12)
-    d_lam, _ = ki.pair_step(a.packed[0], np.array(a.centroid), la, ki.edge_table(a.packed[1], la),
-                            b.packed[0], np.array(b.centroid), lb, ki.edge_table(b.packed[1], lb),
-                            ma.array, mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1))
+    d_lam, _ = pair_step(a.packed[0], np.array(a.centroid), ea, b.packed[0],
+                            np.array(b.centroid), eb, ma.array, mb.array, 0.0, 1.0, 1.01 * gap,
+                            0.0, np.full(3, -1), *traversal_stack())
     assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -236,12 +237,12 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     t0 = 0.3
     pa, pb = a.at(ma, t0), b.at(mb, t0)
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
-    la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
     lam = 1e-3
     lam_pair = ki.PAIR_GAP * lam
-    d, step = ki.pair_step(pa.packed[0], np.array(pa.centroid), la, ki.edge_table(a.packed[1], la),
-                           pb.packed[0], np.array(pb.centroid), lb, ki.edge_table(b.packed[1], lb),
-                           ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1))
+    d, step = pair_step(pa.packed[0], np.array(pa.centroid), edge_table(ra, a.packed[1]),
+                           pb.packed[0], np.array(pb.centroid), edge_table(rb, b.packed[1]),
+                           ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1),
+                           *traversal_stack())
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)

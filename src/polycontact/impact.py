@@ -132,6 +132,8 @@ class Impact:
         a, ma, b, mb, eps = self._bodies
         if self.status is ImpactStatus.HIT:
             t_lo, t_hi = self.time_bracket
+            if self.method == "exact":
+                t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps)
             rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
             rel = rel_hi
             if self.method == "exact":
@@ -172,6 +174,27 @@ class Impact:
     def normal(self) -> np.ndarray | None:
         """Unit contact normal at the moment of impact, from A towards B."""
         return self._details[2]
+
+
+def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi: float,
+                  eps: float) -> tuple[float, float]:
+    """The exact method's bracket of the first penetration narrowed to the probe length
+    λ/S (λ the contact resolution, S the speed bound), so that the features are read
+    where the bodies touch: the search brackets it only to ``time_tolerance``. The
+    same search, on [t_lo, t_hi] (no penetration at t_lo, one at t_hi) with a
+    tolerance of 2λ/S; the coarse bracket if it stops without a hit."""
+    from ._kernels import impact as ki
+
+    la, lb = a.bounding_radius, b.bounding_radius
+    lam = CONTACT_RESOLUTION * (la + lb)
+    speed = ki.speed_bound(ma.array, la, mb.array, lb, t_lo, t_hi)
+    if speed <= 0.0 or t_hi - t_lo <= lam / speed:
+        return t_lo, t_hi
+    (ra, ea), (rb, eb) = body_frame(a), body_frame(b)
+    code, hi, lo, *_ = ki._prepared_exact_search(
+        ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
+        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps, lam, MAX_ITERATIONS)
+    return (lo, hi) if code == ki.HIT else (t_lo, t_hi)
 
 
 def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
@@ -330,17 +353,30 @@ def time_of_impact(
     from ._kernels import impact as ki
 
     eps = RELATIVE_TOLERANCE * max(_path_scale(a, ma, t_max), _path_scale(b, mb, t_max))
-    (xa, sa), (xb, sb) = a.packed, b.packed
-    ca = np.asarray(a.centroid, dtype=np.float64)
-    cb = np.asarray(b.centroid, dtype=np.float64)
+    ra, ea = body_frame(a)
+    rb, eb = body_frame(b)
     la, lb = a.bounding_radius, b.bounding_radius
     intervals, code, t_hi, t_lo, t_contact, iters, reached = ki.query(
-        xa - ca, sa, ca, ma.array, la, xb - cb, sb, cb, mb.array, lb, t_max,
-        BROAD_PHASE_INFLATION, method == "exact", tol, eps, CONTACT_RESOLUTION * (la + lb),
-        int(max_iterations), int(samples),
+        ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array, lb,
+        eb, t_max, BROAD_PHASE_INFLATION, method == "exact", tol, eps,
+        CONTACT_RESOLUTION * (la + lb), int(max_iterations), int(samples),
     )
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps)
+
+
+def body_frame(shape: Shape) -> tuple[np.ndarray, tuple]:
+    """``(r, tables)``: the shape's vertices relative to its centroid and their
+    ``_kernels.advance.edge_table``, built on first use and kept with the shape (it is
+    immutable), so that repeated queries on one shape build them once."""
+    if shape._frame is None:
+        from ._kernels.advance import edge_table
+
+        xy, starts = shape.packed
+        r = xy - shape.centroid
+        r.flags.writeable = False
+        shape._frame = (r, edge_table(r, starts))
+    return shape._frame
 
 
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,

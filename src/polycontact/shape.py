@@ -99,7 +99,8 @@ class Shape:
     polycontact.errors.InvalidShapeError: outer loop: self-intersection at (1, 1) between edge 0 and edge 2
     """
 
-    __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs")
+    __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
+                 "_frame")
 
     def __init__(
         self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
@@ -135,6 +136,7 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
+        self._frame = None        # body-frame tables of the time-of-impact search
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
         # contribute negative area, which removes them. Coordinates are taken relative to

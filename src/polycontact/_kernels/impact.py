@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .advance import edge_table, pair_step, traversal_stack
 from .broad_phase import overlap_intervals
 from .relation import _scratch, _state_in
 from .validate import closest_on_segment
@@ -61,14 +62,6 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     return lin + wa * la + wb * lb
 
 
-#: When a body's vertices times the other body's edges are at most
-#: :data:`PAIR_SCAN_MAX`, each vertex within reach of the other body's box meets every
-#: edge; otherwise, when at most :data:`FEW_VERTICES` are within reach, they meet the
-#: edges within reach of their common box, and else a sweep over the edges sorted by
-#: smallest x finds each vertex's edges.
-FEW_VERTICES = 32
-PAIR_SCAN_MAX = 256
-
 #: The pair steps of :func:`pair_step` stop this fraction of the contact resolution
 #: short of contact: the probes that follow (each a classification) then cover a gap
 #: of lam / 64 instead of lam.
@@ -83,41 +76,6 @@ WINDOW_GROWTH = 1.5
 def _bilinear_max(w0, w1, f0, f1):
     """Largest w·f for w between w0 and w1 and f between f0 and f1 (at a corner)."""
     return max(max(w0 * f0, w0 * f1), max(w1 * f0, w1 * f1))
-
-
-@njit(cache=True, nogil=True)
-def _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ex0, ey0, ex1, ey1, cex, cey, re, mw):
-    """Upper bound of the closing rate of vertex p and edge e along their fixed normal.
-
-    n = (p − q)/d, q the point of e nearest p. The edge lies in the half-plane
-    {x : (x − q)·n <= 0}, so sep(t) = p(t)·n − max over material points x of e of
-    x(t)·n equals d now and never exceeds dist(p(t), e(t)): the pair cannot touch while
-    sep > 0. A material point moves along n at v(t)·n + ω(t) f(t) with
-    f = (J R(θ) r)·n, and the max of moving points grows no faster than the fastest of
-    them, so −sep' <= −Δv(t)·n − ω_v(t) f_p(t) + max over x of ω_e(t) f_x(t), with
-    Δv = v_v − v_e. Δv·n and ω are affine in t: their extremes over the window are at its
-    ends. f is a sinusoid of amplitude |r| in θ, so while the body turns by at most Θ it
-    stays within |r| Θ of its current value (and within ±|r|); along the edge the
-    current value is affine in x and |r_x| convex, so the ends bound it. Each product
-    ω f is then bounded at a corner of its box (:func:`_bilinear_max`). A negative
-    result means the pair is separating throughout the window.
-
-    ``mw`` is a tuple holding, for the vertex body v and the edge body e: Δv at the
-    window ends (4), ω_v at the ends, ω_e at the ends, Θ_v, Θ_e, max |Δv|, the window
-    length (a tuple, not an array: no reference counting per call).
-    """
-    inv = 1.0 / d
-    nx = (px - qx) * inv
-    ny = (py - qy) * inv
-    lin = -min(mw[0] * nx + mw[1] * ny, mw[2] * nx + mw[3] * ny)
-    fv = (px - cvx) * ny - (py - cvy) * nx
-    sv = rv * mw[8]
-    rot_v = _bilinear_max(mw[4], mw[5], -min(rv, fv + sv), -max(-rv, fv - sv))
-    fa = (ex0 - cex) * ny - (ey0 - cey) * nx
-    fb = (ex1 - cex) * ny - (ey1 - cey) * nx
-    se = re * mw[9]
-    rot_e = _bilinear_max(mw[6], mw[7], max(-re, min(fa, fb) - se), min(re, max(fa, fb) + se))
-    return lin + rot_v + rot_e
 
 
 @njit(cache=True, nogil=True)
@@ -148,201 +106,6 @@ def _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw):
     se = delta + ru * mw[9]
     t3 = _bilinear_max(mw[6], mw[7], max(-ru, ge - se), min(ru, ge + se))
     return t1 + t2 + t3
-
-
-@njit(cache=True, nogil=True)
-def _pair_time(px, py, cvx, cvy, rv, ax, ay, bx, by, cex, cey, re, mw, speed, lam, step):
-    """The step after pair (p, edge ab) is charged, for a pair nearer than ``lam`` plus
-    ``step`` times its plain speed bound ``speed``: the longer of the times it needs to
-    come within ``lam`` at its fixed-normal rate (:func:`_pair_rate`, never above
-    ``speed``) and, when p is outside the edge's line by more than ``lam``, at its rate
-    towards the turning line (:func:`_line_rate`); both are lower bounds of the same
-    time. 0 when it is already within ``lam`` (no reliable normal)."""
-    qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
-    d = np.sqrt(d2)
-    if d <= lam:
-        return 0.0
-    rate = min(speed, _pair_rate(px, py, qx, qy, d, cvx, cvy, rv, ax, ay, bx, by, cex, cey,
-                                 re, mw))
-    # (no division when the time is beyond the step: a tiny rate would overflow)
-    best = (d - lam) / rate if d - lam < rate * step else step
-    ex = bx - ax
-    ey = by - ay
-    ln = np.sqrt(ex * ex + ey * ey)
-    if ln > 0.0 and best < step:
-        nx = ey / ln                    # interior on the left: outward on the right
-        ny = -ex / ln
-        s0 = (px - ax) * nx + (py - ay) * ny
-        if s0 > lam:
-            rl = _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw)
-            best = max(best, (s0 - lam) / rl if s0 - lam < rl * step else step)
-    return min(step, best)
-
-
-@njit(cache=True, nogil=True)
-def _one_way_step(xv, cv, rv_len, xe, ce, nxt, re_max, order, mw, lin, wv, we, lam, lam_pair,
-                  dmin2, step, crit, way, cand, xmin, sorted_x):
-    """Vertices of one body against the edges of the other (``wv``, ``we``: the bounds
-    of |ω| over the window; ``nxt``, ``re_max``, ``order`` from :func:`edge_table`;
-    ``order`` is kept sorted by the edges' smallest x from step to step). The pair that
-    sets the step is written to ``crit`` as ``(way, vertex, edge)``. ``cand`` (one
-    entry per vertex), ``xmin`` and ``sorted_x`` (one per edge) are scratch.
-
-    Only vertices within reach of the edge body's box are visited; when they are few,
-    each meets the edges within reach of their common box, else a sweep over the edges
-    sorted by smallest x (``et[2]``, kept nearly sorted from step to step) finds them.
-    """
-    ne = xe.shape[0]
-    x0 = np.inf
-    x1 = -np.inf
-    y0 = np.inf
-    y1 = -np.inf
-    lmax = 0.0
-    for j in range(ne):
-        x0 = min(x0, xe[j, 0])
-        x1 = max(x1, xe[j, 0])
-        y0 = min(y0, xe[j, 1])
-        y1 = max(y1, xe[j, 1])
-        lmax = max(lmax, re_max[j])
-    if xv.shape[0] * ne <= PAIR_SCAN_MAX:
-        for i in range(xv.shape[0]):
-            base = lin + wv * rv_len[i]
-            px = xv[i, 0]
-            py = xv[i, 1]
-            # no pair farther than this can shorten the step: skip a vertex that far
-            # from the other body's box
-            reach = step * (base + we * lmax) + lam
-            if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
-                continue
-            for j in range(ne):
-                j1 = nxt[j]
-                speed = base + we * re_max[j]
-                reach = step * speed + lam
-                if (min(xe[j, 0], xe[j1, 0]) > px + reach or max(xe[j, 0], xe[j1, 0]) < px - reach
-                        or min(xe[j, 1], xe[j1, 1]) > py + reach
-                        or max(xe[j, 1], xe[j1, 1]) < py - reach):
-                    continue
-                d2 = closest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
-                dmin2 = min(dmin2, d2)
-                if d2 < reach * reach:     # else it cannot shorten the step
-                    new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
-                                     xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
-                                     lam_pair, step)
-                    if new < step:
-                        step = new
-                        crit[0], crit[1], crit[2] = way, i, j
-        return dmin2, step
-    # no pair farther than `reach` can shorten the step: skip a vertex that far from
-    # the other body's box
-    nc = 0
-    bx0 = np.inf
-    bx1 = -np.inf
-    by0 = np.inf
-    by1 = -np.inf
-    for i in range(xv.shape[0]):
-        px = xv[i, 0]
-        py = xv[i, 1]
-        reach = step * (lin + wv * rv_len[i] + we * lmax) + lam
-        if px < x0 - reach or px > x1 + reach or py < y0 - reach or py > y1 + reach:
-            continue
-        cand[nc] = i
-        nc += 1
-        bx0 = min(bx0, px - reach)
-        bx1 = max(bx1, px + reach)
-        by0 = min(by0, py - reach)
-        by1 = max(by1, py + reach)
-    if nc == 0:
-        return dmin2, step
-    if nc <= FEW_VERTICES:
-        for j in range(ne):
-            j1 = nxt[j]
-            ax = xe[j, 0]
-            ay = xe[j, 1]
-            bx = xe[j1, 0]
-            by = xe[j1, 1]
-            ex0 = min(ax, bx)
-            ex1 = max(ax, bx)
-            ey0 = min(ay, by)
-            ey1 = max(ay, by)
-            if ex0 > bx1 or ex1 < bx0 or ey0 > by1 or ey1 < by0:
-                continue
-            for k in range(nc):
-                i = cand[k]
-                px = xv[i, 0]
-                py = xv[i, 1]
-                speed = lin + wv * rv_len[i] + we * re_max[j]
-                reach = step * speed + lam
-                if ex0 > px + reach or ex1 < px - reach or ey0 > py + reach or ey1 < py - reach:
-                    continue
-                d2 = closest_on_segment(px, py, ax, ay, bx, by)[2]
-                dmin2 = min(dmin2, d2)
-                if d2 < reach * reach:     # else it cannot shorten the step
-                    new = _pair_time(px, py, cv[0], cv[1], rv_len[i], ax, ay, bx, by, ce[0],
-                                     ce[1], re_max[j], mw, speed, lam_pair, step)
-                    if new < step:
-                        step = new
-                        crit[0], crit[1], crit[2] = way, i, j
-        return dmin2, step
-    maxw = 0.0
-    for j in range(ne):
-        xmin[j] = min(xe[j, 0], xe[nxt[j], 0])
-        maxw = max(maxw, abs(xe[j, 0] - xe[nxt[j], 0]))
-    # the previous step's order is nearly right: insertion sort finishes it in ~O(n)
-    for k in range(1, ne):
-        cur = order[k]
-        key = xmin[cur]
-        m = k
-        while m > 0 and xmin[order[m - 1]] > key:
-            order[m] = order[m - 1]
-            m -= 1
-        order[m] = cur
-    for k in range(ne):
-        sorted_x[k] = xmin[order[k]]
-    for k in range(nc):
-        i = cand[k]
-        px = xv[i, 0]
-        py = xv[i, 1]
-        reach = step * (lin + wv * rv_len[i] + we * lmax) + lam
-        o = np.searchsorted(sorted_x[:ne], px - reach - maxw)
-        while o < ne and sorted_x[o] <= px + reach:
-            j = order[o]
-            o += 1
-            j1 = nxt[j]
-            if max(xe[j, 0], xe[j1, 0]) < px - reach:
-                continue
-            if min(xe[j, 1], xe[j1, 1]) > py + reach or max(xe[j, 1], xe[j1, 1]) < py - reach:
-                continue
-            d2 = closest_on_segment(px, py, xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1])[2]
-            dmin2 = min(dmin2, d2)
-            speed = lin + wv * rv_len[i] + we * re_max[j]
-            if d2 < (step * speed + lam) ** 2:
-                new = _pair_time(px, py, cv[0], cv[1], rv_len[i], xe[j, 0], xe[j, 1],
-                                 xe[j1, 0], xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed,
-                                 lam_pair, step)
-                if new < step:
-                    step = new
-                    crit[0], crit[1], crit[2] = way, i, j
-    return dmin2, step
-
-
-@njit(cache=True, nogil=True)
-def edge_table(starts, r_len):
-    """``(nxt, r_max, order, cand, xmin, sorted_x)``: the vertex after each vertex in
-    its loop, the largest centroid distance of each edge's two ends, an edge order that
-    the sweep keeps sorted by smallest x (starts as 0, 1, ...), and the scratch arrays of
-    :func:`_one_way_step` sized for this body (its vertices as candidates, its edges
-    swept), so that a search allocates nothing per step."""
-    n = r_len.shape[0]
-    nxt = np.empty(n, np.int64)
-    r_max = np.empty(n)
-    for k in range(starts.shape[0] - 1):
-        s = starts[k]
-        e = starts[k + 1]
-        for j in range(s, e):
-            j1 = j + 1 if j + 1 < e else s
-            nxt[j] = j1
-            r_max[j] = max(r_len[j], r_len[j1])
-    return nxt, r_max, np.arange(n), np.empty(n, np.int64), np.empty(n), np.empty(n)
 
 
 @njit(cache=True, nogil=True)
@@ -460,60 +223,6 @@ def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1
 
 
 @njit(cache=True, nogil=True)
-def _crit_time(xv, cv, rv, xe, ce, nxt, re_max, i, j, mw, speed, lam, step):
-    """:func:`_pair_time` of vertex i against edge j of the other body."""
-    j1 = nxt[j]
-    return _pair_time(xv[i, 0], xv[i, 1], cv[0], cv[1], rv, xe[j, 0], xe[j, 1], xe[j1, 0],
-                      xe[j1, 1], ce[0], ce[1], re_max[j], mw, speed, lam, step)
-
-
-@njit(cache=True, nogil=True)
-def pair_step(xa, ca, ra_len, ea, xb, cb, rb_len, eb, ma, mb, t0, t1, lam, lam_pair, crit):
-    """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
-    vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
-
-    ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ra_len[i]`` the
-    distance of vertex i from it, ``ea`` its :func:`edge_table` (likewise B); ``ma``,
-    ``mb`` the motion vectors. ``crit`` (int64, 3) names the pair that set the last
-    step, ``(way, vertex, edge)`` (way 0: vertex of A; −1: none); it is charged first,
-    so that the step is near its final value early and the rest of the pairs are
-    mostly skipped, and it is updated.
-
-    Each pair p (vertex of one body), e (edge of the other) gets the time of
-    :func:`_pair_time`: the longer of two safe bounds, along the pair's fixed normal
-    (:func:`_pair_rate`, never above the plain speed bound
-    ``|Δv| + |ω_v| |r_p| + |ω_e| max |r_e|``; |r| is convex along the edge) and towards
-    the edge's turning line (:func:`_line_rate`); 0 within ``lam_pair``. Boundaries that
-    do not cross are at the distance of their nearest vertex–edge pair, and they cannot
-    begin to meet without some vertex reaching an edge, so the smallest pair time (both
-    ways) is a step without contact. A pair farther than ``lam`` plus the current step
-    times its plain speed bound cannot shorten the step and is skipped (whole vertices
-    by the other body's box; for large bodies, edges by the box of the few vertices
-    left or by a sweep over x).
-
-    ``distance`` is exact when it is at most ``lam``; otherwise it is at least the gap.
-    """
-    h = t1 - t0
-    mwa, mwb = motion_window(ma, mb, t0, t1)
-    lin, wa, wb = mwa[10], max(abs(mwa[4]), abs(mwa[5])), max(abs(mwa[6]), abs(mwa[7]))
-    step = h
-    if crit[0] >= 0:
-        i = crit[1]
-        j = crit[2]
-        if crit[0] == 0:
-            step = _crit_time(xa, ca, ra_len[i], xb, cb, eb[0], eb[1], i, j, mwa,
-                              lin + wa * ra_len[i] + wb * eb[1][j], lam_pair, step)
-        else:
-            step = _crit_time(xb, cb, rb_len[i], xa, ca, ea[0], ea[1], i, j, mwb,
-                              lin + wb * rb_len[i] + wa * ea[1][j], lam_pair, step)
-    dmin2, step = _one_way_step(xa, ca, ra_len, xb, cb, eb[0], eb[1], eb[2], mwa, lin, wa, wb,
-                                lam, lam_pair, np.inf, step, crit, 0, ea[3], eb[4], eb[5])
-    dmin2, step = _one_way_step(xb, cb, rb_len, xa, ca, ea[0], ea[1], ea[2], mwb, lin, wb, wa,
-                                lam, lam_pair, dmin2, step, crit, 1, eb[3], ea[4], ea[5])
-    return np.sqrt(dmin2), step
-
-
-@njit(cache=True, nogil=True)
 def _window_rates(ma, mb, t0, t1):
     dvx = ma[0] - mb[0]
     dvy = ma[1] - mb[1]
@@ -581,17 +290,20 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
 
     A penetrating state at the end of a probe is the hit, bracketed by the probe.
     """
-    ra_len = np.empty(ra.shape[0])
-    for i in range(ra.shape[0]):
-        ra_len[i] = np.hypot(ra[i, 0], ra[i, 1])
-    rb_len = np.empty(rb.shape[0])
-    for i in range(rb.shape[0]):
-        rb_len[i] = np.hypot(rb[i, 0], rb[i, 1])
+    return _prepared_exact_search(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
+                                  edge_table(rb, sb), intervals, time_tol, eps, lam, max_iter)
+
+
+@njit(cache=True, nogil=True)
+def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
+                           eps, lam, max_iter):
+    """:func:`exact_search` with each body's :func:`edge_table` given (built once per
+    shape by the caller)."""
     xa, xb, scratch = _search_scratch(ra, rb)
-    return _exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps, lam,
-                         max_iter, xa, xb, ra_len, rb_len, edge_table(sa, ra_len),
-                         edge_table(sb, rb_len), np.empty(2), np.empty(2),
-                         np.full(3, -1, np.int64), scratch)
+    stack, stau = traversal_stack()
+    return _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
+                         eps, lam, max_iter, xa, xb, np.empty(2), np.empty(2),
+                         np.full(3, -1, np.int64), stack, stau, scratch)
 
 
 # The searches run without Numba's reference counting (``_nrt=False``): each step passes
@@ -599,12 +311,14 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
 # the geometry of a small pair. Nothing in them may allocate (the compiler refuses if it
 # does): their callers pass every buffer in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps, lam,
-                  max_iter, xa, xb, ra_len, rb_len, ea, eb, pa, pb, crit, scratch):
+def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol, eps, lam,
+                  max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
     """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
-    of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair)."""
+    of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair; ``stack``,
+    ``stau``: :func:`traversal_stack`)."""
     lam_pair = PAIR_GAP * lam
     first_contact = -1.0
+    t_guess = -1.0
     it = 0
     t = 0.0
     for k in range(intervals.shape[0]):
@@ -625,21 +339,33 @@ def _exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, e
             s = speed_bound(ma, la, mb, lb, t, t_end)
             # until the first contact the pairs are stepped to lam, so that the first
             # time found within lam is at most a probe late; then closer
-            d, h = pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end, lam,
-                             lam if first_contact < 0.0 else lam_pair, crit)
+            d, h = pair_step(xa, pa, ea, xb, pb, eb, ma, mb, t, t_end, lam,
+                             lam if first_contact < 0.0 else lam_pair, crit, stack, stau)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
                 break  # at the end, or no relative motion: the state at t holds to t2
+            if h < time_tol and t >= t_guess:
+                # no contact before t + h: a penetration (just under) a tolerance ahead
+                # brackets the first one in (t, t_guess], as finely as asked (tried again
+                # only once the search has passed this guess)
+                t_guess = min(t + 0.99 * time_tol, t2)
+                place(ra, ca, ma, t_guess, xa)
+                place(rb, cb, mb, t_guess, xb)
+                if _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
+                    return HIT, t_guess, t, first_contact if first_contact >= 0.0 else t, it, \
+                        t_guess
+                place(ra, ca, ma, t, xa)
+                place(rb, cb, mb, t, xb)
             tau = min(0.5 * time_tol, lam / s)
             if h < tau and first_contact < 0.0:
                 # about to touch: step the pairs to lam_pair instead, at most
                 # time_tol / 2 at a time (so the first contact found is no later)
-                h = min(pair_step(xa, pa, ra_len, ea, xb, pb, rb_len, eb, ma, mb, t, t_end,
-                                  lam, lam_pair, crit)[1], 0.5 * time_tol)
+                h = min(pair_step(xa, pa, ea, xb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
+                                  stack, stau)[1], 0.5 * time_tol)
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
                 # touching: a line through the touching features may separate them
-                h = max(h, _slide_step(xa, pa, ra_len, ea[0], la, xb, pb, rb_len, eb[0], lb,
+                h = max(h, _slide_step(xa, pa, ea[3], ea[0], la, xb, pb, eb[3], eb[0], lb,
                                        ma, mb, t, t_end, crit, eps, tau))
             if h >= t_end - t:
                 h = t_end - t
@@ -724,19 +450,19 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
 
 
 @njit(cache=True, nogil=True)
-def query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, exact, time_tol, eps, lam,
-          max_iter, samples):
+def query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, exact, time_tol, eps,
+          lam, max_iter, samples):
     """Broad phase and search in one call (one dispatch from Python).
 
+    ``ea``, ``eb``: each body's :func:`edge_table` (used by the exact search only).
     Returns ``(intervals, status, t_hi, t_lo, first_contact, iterations, t_reached)``:
     :func:`exact_search` when ``exact``, else :func:`sampled_search` with ``samples``
     points (``t_reached`` is then t_hi on a hit, else t_max).
     """
     iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
     if exact:
-        code, hi, lo, contact, its, reached = exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb,
-                                                           lb, iv, time_tol, eps, lam,
-                                                           max_iter)
+        code, hi, lo, contact, its, reached = _prepared_exact_search(
+            ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps, lam, max_iter)
         return iv, code, hi, lo, contact, its, reached
     code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, iv, time_tol,
                                                 samples, eps)
