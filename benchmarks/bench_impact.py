@@ -92,7 +92,8 @@ def median_time(fn, repeat: int) -> float:
 
 def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
     """What a query costs without building the result: broad phase + search, one kernel
-    call (``_kernels.impact.query``) for either method. The body-frame tables are built
+    call (``_kernels.impact.exact_query`` or ``sampled_query``, each given only what it
+    uses). The body-frame tables are built
     once per shape (as ``time_of_impact`` does) before timing, like ``Shape.packed``."""
     ra, ea = body_frame(a)
     rb, eb = body_frame(b)
@@ -101,11 +102,16 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
     eps = 1e-12 * max(1.0, float(np.abs(a.packed[0]).max()), float(np.abs(b.packed[0]).max()))
     la, lb = a.bounding_radius, b.bounding_radius
 
-    def run():
-        return ki.query(ra, a.packed[1], a.centroid, va, la, ea, rb, b.packed[1], b.centroid,
-                        vb, lb, eb, t_max, BROAD_PHASE_INFLATION, method == "exact", TOL, eps,
-                        lam, 1_000_000, samples)
+    def run_exact():
+        return ki.exact_query(ra, a.packed[1], a.centroid, va, la, ea, rb, b.packed[1],
+                              b.centroid, vb, lb, eb, t_max, BROAD_PHASE_INFLATION, TOL, eps, lam,
+                              1_000_000)
 
+    def run_sampled():
+        return ki.sampled_query(ra, a.packed[1], a.centroid, va, la, rb, b.packed[1], b.centroid,
+                                vb, lb, t_max, BROAD_PHASE_INFLATION, TOL, eps, samples)
+
+    run = run_exact if method == "exact" else run_sampled
     return run
 
 

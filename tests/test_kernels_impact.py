@@ -194,16 +194,14 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     ea, eb = edge_table(ra, a.packed[1]), edge_table(rb, b.packed[1])
-    d, step = pair_step(a.packed[0], np.array(a.centroid), ea, b.packed[0], np.array(b.centroid),
-                           eb, ma.array, mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1),
-                           *traversal_stack())
+    d, step = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
+                        mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1), *traversal_stack())
     # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
     # it is never below the gap, and with lam just above the gap it is the gap
     gap = boundary_distance(*a.packed, *b.packed)
     assert d >= gap * (1 - 1e-12)
-    d_lam, _ = pair_step(a.packed[0], np.array(a.centroid), ea, b.packed[0],
-                            np.array(b.centroid), eb, ma.array, mb.array, 0.0, 1.0, 1.01 * gap,
-                            0.0, np.full(3, -1), *traversal_stack())
+    d_lam, _ = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
+                         mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1), *traversal_stack())
     assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -239,10 +237,10 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     lam = 1e-3
     lam_pair = ki.PAIR_GAP * lam
-    d, step = pair_step(pa.packed[0], np.array(pa.centroid), edge_table(ra, a.packed[1]),
-                           pb.packed[0], np.array(pb.centroid), edge_table(rb, b.packed[1]),
-                           ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1),
-                           *traversal_stack())
+    d, step = pair_step(ra, np.array(pa.centroid), edge_table(ra, a.packed[1]),
+                        rb, np.array(pb.centroid), edge_table(rb, b.packed[1]),
+                        ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1),
+                        *traversal_stack())
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)

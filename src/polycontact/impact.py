@@ -356,11 +356,15 @@ def time_of_impact(
     ra, ea = body_frame(a)
     rb, eb = body_frame(b)
     la, lb = a.bounding_radius, b.bounding_radius
-    intervals, code, t_hi, t_lo, t_contact, iters, reached = ki.query(
-        ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array, lb,
-        eb, t_max, BROAD_PHASE_INFLATION, method == "exact", tol, eps,
-        CONTACT_RESOLUTION * (la + lb), int(max_iterations), int(samples),
-    )
+    if method == "exact":
+        out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
+                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps,
+                             CONTACT_RESOLUTION * (la + lb), int(max_iterations))
+    else:
+        out = ki.sampled_query(ra, a.packed[1], a.centroid, ma.array, la, rb, b.packed[1],
+                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps,
+                               int(samples))
+    intervals, code, t_hi, t_lo, t_contact, iters, reached = out
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps)
 

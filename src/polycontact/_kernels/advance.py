@@ -295,16 +295,22 @@ def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vb
 
 
 @njit(cache=True, nogil=True)
-def _leaf_pair(way, i, j, xv, cv, vvx, vvy, wv, rv_len, xe, ce, uex, uey, we, re_len, nxt_e, kin,
-               lam, step, dmin2, crit):
+def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, sne, uex, uey, we,
+               re_len, nxt_e, kin, lam, step, dmin2, crit):
     """Vertex i of one body against edge j of the other: ``(dmin2, step)`` updated, and
-    ``crit`` set to ``(way, i, j)`` when the pair shortens the step."""
+    ``crit`` set to ``(way, i, j)`` when the pair shortens the step. The three points
+    are placed from the body frame (``rv``, ``re``), each body turned by its
+    ``(cos, sin)`` about its centroid ``cv``, ``ce``."""
     j1 = nxt_e[j]
-    px = xv[i, 0]
-    py = xv[i, 1]
+    px = cv[0] + csv * rv[i, 0] - snv * rv[i, 1]
+    py = cv[1] + snv * rv[i, 0] + csv * rv[i, 1]
+    ax = ce[0] + cse * re[j, 0] - sne * re[j, 1]
+    ay = ce[1] + sne * re[j, 0] + cse * re[j, 1]
+    bx = ce[0] + cse * re[j1, 0] - sne * re[j1, 1]
+    by = ce[1] + sne * re[j1, 0] + cse * re[j1, 1]
     d2, tau = _vertex_edge_time(px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]),
-                                rv_len[i], xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1], re_len[j],
-                                re_len[j1], ce[0], ce[1], uex, uey, we, kin, lam, step)
+                                rv_len[i], ax, ay, bx, by, re_len[j], re_len[j1], ce[0], ce[1],
+                                uex, uey, we, kin, lam, step)
     if tau < step:
         step = tau
         crit[0], crit[1], crit[2] = way, i, j
@@ -312,11 +318,12 @@ def _leaf_pair(way, i, j, xv, cv, vvx, vvy, wv, rv_len, xe, ce, uex, uey, we, re
 
 
 @njit(cache=True, nogil=True)
-def pair_step(xa, ca, ea, xb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau):
+def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau):
     """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
     vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
 
-    ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ea`` its
+    ``ra`` are A's vertices in its body frame (relative to its centroid at t = 0, as
+    given to :func:`edge_table`), ``ca`` its centroid at t0, ``ea`` its
     :func:`edge_table` (likewise B); ``ma``,
     ``mb`` the motion vectors ``[vx, vy, ax, ay, ω, α]``; [t0, t1] the window over which
     the bounds hold. ``crit`` (int64, 3) names the pair that set the last step,
@@ -358,11 +365,13 @@ def pair_step(xa, ca, ea, xb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     step = h
     dmin2 = np.inf
     if crit[0] == 0:
-        dmin2, step = _leaf_pair(0, crit[1], crit[2], xa, ca, vax, vay, wa, ra_len, xb, cb, vbx,
-                                 vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2, crit)
+        dmin2, step = _leaf_pair(0, crit[1], crit[2], ra, ca, csa, sna, vax, vay, wa, ra_len, rb,
+                                 cb, csb, snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step,
+                                 dmin2, crit)
     elif crit[0] == 1:
-        dmin2, step = _leaf_pair(1, crit[1], crit[2], xb, cb, vbx, vby, wb, rb_len, xa, ca, vax,
-                                 vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2, crit)
+        dmin2, step = _leaf_pair(1, crit[1], crit[2], rb, cb, csb, snb, vbx, vby, wb, rb_len, ra,
+                                 ca, csa, sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step,
+                                 dmin2, crit)
     stack[0, 0] = 0
     stack[0, 1] = 0
     stau[0] = 0.0
@@ -376,10 +385,12 @@ def pair_step(xa, ca, ea, xb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
         i = la[na, 2]
         j = lb[nb, 2]
         if i >= 0 and j >= 0:
-            dmin2, step = _leaf_pair(0, i, j, xa, ca, vax, vay, wa, ra_len, xb, cb, vbx, vby, wb,
-                                     rb_len, nxb, kin_ab, lam_pair, step, dmin2, crit)
-            dmin2, step = _leaf_pair(1, j, i, xb, cb, vbx, vby, wb, rb_len, xa, ca, vax, vay, wa,
-                                     ra_len, nxa, kin_ba, lam_pair, step, dmin2, crit)
+            dmin2, step = _leaf_pair(0, i, j, ra, ca, csa, sna, vax, vay, wa, ra_len, rb, cb, csb,
+                                     snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2,
+                                     crit)
+            dmin2, step = _leaf_pair(1, j, i, rb, cb, csb, snb, vbx, vby, wb, rb_len, ra, ca, csa,
+                                     sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2,
+                                     crit)
             continue
         # open the wider node (a leaf is never opened)
         if j >= 0 or (i < 0 and qa[na, 2] >= qb[nb, 2]):

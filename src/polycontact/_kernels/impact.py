@@ -32,14 +32,19 @@ _PENETRATING = 2
 
 
 @njit(cache=True, nogil=True)
+def centre(c0, m, t):
+    """The centroid ``(cx, cy)`` at time t of a body whose centroid is ``c0`` at t = 0."""
+    return c0[0] + m[0] * t + 0.5 * m[2] * t * t, c0[1] + m[1] * t + 0.5 * m[3] * t * t
+
+
+@njit(cache=True, nogil=True)
 def place(r, c0, m, t, out):
     """Write the vertices of the body at time t into ``out`` (same shape as ``r``);
     return the centroid ``(cx, cy)`` at t."""
     th = m[4] * t + 0.5 * m[5] * t * t
     cs = np.cos(th)
     sn = np.sin(th)
-    cx = c0[0] + m[0] * t + 0.5 * m[2] * t * t
-    cy = c0[1] + m[1] * t + 0.5 * m[3] * t * t
+    cx, cy = centre(c0, m, t)
     for i in range(r.shape[0]):
         x = r[i, 0]
         y = r[i, 1]
@@ -67,9 +72,14 @@ def speed_bound(ma, la, mb, lb, t0, t1):
 #: of lam / 64 instead of lam.
 PAIR_GAP = 1.0 / 64.0
 
+#: A step shorter than this fraction of the one before it (or than the time tolerance)
+#: suggests contact is near: the search then classifies the bodies a tolerance after the
+#: step's end, which can end it (see :func:`_exact_search`).
+GUESS_SHRINK = 0.2
+
 #: After a step h shorter than its window, the next window is this many times h: the
 #: directional bounds tighten as the window (the angle turned in it) shrinks.
-WINDOW_GROWTH = 1.5
+WINDOW_GROWTH = 3.0
 
 
 @njit(cache=True, nogil=True)
@@ -315,20 +325,24 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                   max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
     """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
     of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair; ``stack``,
-    ``stau``: :func:`traversal_stack`)."""
+    ``stau``: :func:`traversal_stack`). The bodies are placed (``xa``, ``xb``) only to be
+    classified or for a slide: the steps read each vertex they need from the body
+    frame."""
     lam_pair = PAIR_GAP * lam
     first_contact = -1.0
     t_guess = -1.0
+    h_prev = np.inf
     it = 0
     t = 0.0
     for k in range(intervals.shape[0]):
         t1 = intervals[k, 0]
         t2 = intervals[k, 1]
         t = t1
-        pa[0], pa[1] = place(ra, ca, ma, t, xa)
-        pb[0], pb[1] = place(rb, cb, mb, t, xb)
+        pa[0], pa[1] = centre(ca, ma, t)
+        pb[0], pb[1] = centre(cb, mb, t)
         # after t = 0 an interval opens with the bounding circles just touching: apart
-        if t == 0.0 and _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
+        if t == 0.0 and state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps,
+                                 scratch) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
         while True:
@@ -339,32 +353,33 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             s = speed_bound(ma, la, mb, lb, t, t_end)
             # until the first contact the pairs are stepped to lam, so that the first
             # time found within lam is at most a probe late; then closer
-            d, h = pair_step(xa, pa, ea, xb, pb, eb, ma, mb, t, t_end, lam,
+            d, h = pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam,
                              lam if first_contact < 0.0 else lam_pair, crit, stack, stau)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
                 break  # at the end, or no relative motion: the state at t holds to t2
-            if h < time_tol and t >= t_guess:
-                # no contact before t + h: a penetration (just under) a tolerance ahead
-                # brackets the first one in (t, t_guess], as finely as asked (tried again
-                # only once the search has passed this guess)
-                t_guess = min(t + 0.99 * time_tol, t2)
-                place(ra, ca, ma, t_guess, xa)
-                place(rb, cb, mb, t_guess, xb)
-                if _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
-                    return HIT, t_guess, t, first_contact if first_contact >= 0.0 else t, it, \
-                        t_guess
-                place(ra, ca, ma, t, xa)
-                place(rb, cb, mb, t, xb)
+            if (h < time_tol or h < GUESS_SHRINK * h_prev) and t + h >= t_guess:
+                # no contact before t + h: a penetration (just under) a tolerance later
+                # brackets the first one in (t + h, t_guess], as finely as asked. Worth a
+                # classification when the step is short or shrinking fast (the pair
+                # bounds converge quadratically near contact), once per guess.
+                t_guess = min(t + h + 0.99 * time_tol, t2)
+                if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_guess, eps,
+                            scratch) == _PENETRATING:
+                    return HIT, t_guess, t + h, first_contact if first_contact >= 0.0 else t + h, \
+                        it, t_guess
+            h_prev = h
             tau = min(0.5 * time_tol, lam / s)
             if h < tau and first_contact < 0.0:
                 # about to touch: step the pairs to lam_pair instead, at most
                 # time_tol / 2 at a time (so the first contact found is no later)
-                h = min(pair_step(xa, pa, ea, xb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
+                h = min(pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
                                   stack, stau)[1], 0.5 * time_tol)
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
                 # touching: a line through the touching features may separate them
+                place(ra, ca, ma, t, xa)
+                place(rb, cb, mb, t, xb)
                 h = max(h, _slide_step(xa, pa, ea[3], ea[0], la, xb, pb, eb[3], eb[0], lb,
                                        ma, mb, t, t_end, crit, eps, tau))
             if h >= t_end - t:
@@ -382,12 +397,13 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 # a conservative step: the boundaries have not met before t_new, so
                 # the interiors do not overlap at t_new (overlap is preceded by touch)
                 t = t_new
-                pa[0], pa[1] = place(ra, ca, ma, t, xa)
-                pb[0], pb[1] = place(rb, cb, mb, t, xb)
+                pa[0], pa[1] = centre(ca, ma, t)
+                pb[0], pb[1] = centre(cb, mb, t)
                 continue
-            pa[0], pa[1] = place(ra, ca, ma, t_new, xa)
-            pb[0], pb[1] = place(rb, cb, mb, t_new, xb)
-            if _placed_state(xa, sa, xb, sb, eps, scratch) == _PENETRATING:
+            pa[0], pa[1] = centre(ca, ma, t_new)
+            pb[0], pb[1] = centre(cb, mb, t_new)
+            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new, eps,
+                        scratch) == _PENETRATING:
                 # the probe is the bracket: t_new − t = tau <= time_tol / 2, finer than
                 # asked, so no bisection
                 if first_contact < 0.0 or first_contact > t:
@@ -450,20 +466,24 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
 
 
 @njit(cache=True, nogil=True)
-def query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, exact, time_tol, eps,
-          lam, max_iter, samples):
-    """Broad phase and search in one call (one dispatch from Python).
-
-    ``ea``, ``eb``: each body's :func:`edge_table` (used by the exact search only).
-    Returns ``(intervals, status, t_hi, t_lo, first_contact, iterations, t_reached)``:
-    :func:`exact_search` when ``exact``, else :func:`sampled_search` with ``samples``
-    points (``t_reached`` is then t_hi on a hit, else t_max).
-    """
+def exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, time_tol, eps,
+                lam, max_iter):
+    """Broad phase and :func:`exact_search` in one call (one dispatch from Python), with
+    each body's :func:`edge_table` given. Returns ``(intervals, status, t_hi, t_lo,
+    first_contact, iterations, t_reached)``."""
     iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
-    if exact:
-        code, hi, lo, contact, its, reached = _prepared_exact_search(
-            ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps, lam, max_iter)
-        return iv, code, hi, lo, contact, its, reached
+    code, hi, lo, contact, its, reached = _prepared_exact_search(
+        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps, lam, max_iter)
+    return iv, code, hi, lo, contact, its, reached
+
+
+@njit(cache=True, nogil=True)
+def sampled_query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, time_tol, eps,
+                  samples):
+    """Broad phase and :func:`sampled_search` with ``samples`` points in one call; returns
+    what :func:`exact_query` does (``iterations``: the classifications; ``t_reached``:
+    t_hi on a hit, else t_max)."""
+    iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
     code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, iv, time_tol,
                                                 samples, eps)
     return iv, code, hi, lo, contact, its, hi if code == HIT else t_max

@@ -1,0 +1,407 @@
+"""Kernels: the conservative-advancement step of the exact time-of-impact search.
+
+A step from time t0 is a time h during which no vertex of either body comes within a
+distance ``lam`` of an edge of the other. Boundaries that do not cross are as far
+apart as their nearest vertex–edge pair, and they cannot begin to meet without some
+vertex reaching an edge, so no contact (and no penetration) can begin inside the step.
+
+Every bound here is of second order. If a function of time f has f(t0) = g > 0,
+f'(t0) = r and |f''| <= K on the window, then f(t0 + τ) >= g + r τ − K τ²/2, which
+stays positive until :func:`_root`. The first derivative is exact (the velocities at
+t0), so a pair that is separating, or closing slowly, gets a long step; only the
+change of the velocities is bounded. For a material point p(t) = c(t) + R(θ(t)) r,
+
+    p̈ = a + (α J − ω² I) R r,   so   |p̈| <= |a| + (|α| + ω²) |r|
+
+over a window where |ω| <= ω_max (ω is affine in t: the largest |ω| is at an end).
+Differences of two bodies' points use the relative acceleration Δa.
+
+Pairs are found through a tree of bounding circles over each body's edges
+(:func:`edge_table`): a pair of nodes whose circles cannot come within ``lam`` of
+each other before the current step is pruned with all the vertex–edge pairs under
+it (the circles' centres are material points, held apart along their current
+direction by the same second-order bound).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .validate import closest_on_segment
+
+#: Entries of the traversal stack (see :func:`traversal_stack`).
+STACK_SIZE = 160
+
+
+@njit(nogil=True)
+def edge_table(r, starts):
+    """The tables of one body for :func:`pair_step`, from its vertices ``r`` relative to
+    its centroid (body frame, t = 0) and its loop ``starts``:
+    ``(nxt, links, circles, r_len)``.
+
+    ``nxt`` is the vertex after each vertex in its loop: edge e joins vertex e to
+    ``nxt[e]``. ``links`` and ``circles`` describe a binary tree over the edges (each
+    node's edges a run of consecutive indices, halved at each level), node 0 the root
+    and children after their parent: ``links[k] = (left, right, edge)``, the children
+    (−1 at a leaf) and the leaf's edge (−1 inside); ``circles[k] = (cx, cy, rho, rc)``,
+    the smallest circle holding the node's edges (:func:`_smallest_circle`; centre
+    (cx, cy) in the body frame, radius rho), and the centre's distance from the
+    centroid. Leaf e also stands for vertex e, so each vertex is under exactly one leaf.
+    ``r_len`` is each vertex's distance from the centroid.
+
+    >>> import numpy as np
+    >>> sq = np.array([[-1.0, -1], [1, -1], [1, 1], [-1, 1]])
+    >>> nxt, links, circles, r_len = edge_table(sq, np.array([0, 4]))
+    >>> nxt.tolist(), links.shape, round(float(circles[0, 2]) ** 2, 9)
+    ([1, 2, 3, 0], (7, 3), 2.0)
+    """
+    n = r.shape[0]
+    nxt = np.empty(n, np.int64)
+    r_len = np.empty(n)
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        for j in range(s, e):
+            nxt[j] = j + 1 if j + 1 < e else s
+            r_len[j] = np.sqrt(r[j, 0] * r[j, 0] + r[j, 1] * r[j, 1])
+    size = 2 * n - 1
+    links = np.full((size, 3), -1, np.int64)
+    circles = np.empty((size, 4))
+    span = np.empty((size, 2), np.int64)     # the node's edges: span[k, 0]:span[k, 1]
+    px = np.empty(2 * n)
+    py = np.empty(2 * n)
+    span[0, 0] = 0
+    span[0, 1] = n
+    count = 1
+    for k in range(size):                    # parents before their children
+        a = span[k, 0]
+        b = span[k, 1]
+        m = 0                                # the node's points: its edges' ends
+        for e in range(a, b):
+            px[m] = r[e, 0]
+            py[m] = r[e, 1]
+            m += 1
+            if nxt[e] != e + 1 or e + 1 == b:
+                px[m] = r[nxt[e], 0]
+                py[m] = r[nxt[e], 1]
+                m += 1
+        cx, cy = _smallest_circle(px, py, m, k)
+        far = 0.0
+        for v in range(m):
+            far = max(far, (px[v] - cx) ** 2 + (py[v] - cy) ** 2)
+        circles[k, 0] = cx
+        circles[k, 1] = cy
+        # a hair wider than the farthest end: the square roots are rounded
+        circles[k, 2] = np.sqrt(far) * (1.0 + 1e-12) + 1e-300
+        circles[k, 3] = np.sqrt(cx * cx + cy * cy)
+        if b - a == 1:
+            links[k, 2] = a
+        else:
+            m = (a + b) // 2
+            links[k, 0] = count
+            links[k, 1] = count + 1
+            span[count, 0] = a
+            span[count, 1] = m
+            span[count + 1, 0] = m
+            span[count + 1, 1] = b
+            count += 2
+    return nxt, links, circles, r_len
+
+
+@njit(nogil=True)
+def _smallest_circle(px, py, m, seed):
+    """Centre of the smallest circle holding the points ``px[:m], py[:m]`` (Welzl's
+    incremental algorithm, expected O(m) after a pseudo-random shuffle seeded by
+    ``seed``; the points are reordered). Rounding can leave a point a hair outside: the caller takes the radius
+    as the largest distance from this centre."""
+    state = np.uint64(seed) * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+    for i in range(m - 1, 0, -1):            # xorshift shuffle
+        state ^= state << np.uint64(13)
+        state ^= state >> np.uint64(7)
+        state ^= state << np.uint64(17)
+        j = np.int64(state % np.uint64(i + 1))
+        px[i], px[j] = px[j], px[i]
+        py[i], py[j] = py[j], py[i]
+    cx = px[0]
+    cy = py[0]
+    r2 = 0.0
+    for i in range(1, m):
+        if (px[i] - cx) ** 2 + (py[i] - cy) ** 2 <= r2 * (1.0 + 1e-12):
+            continue
+        cx = px[i]
+        cy = py[i]
+        r2 = 0.0
+        for j in range(i):
+            if (px[j] - cx) ** 2 + (py[j] - cy) ** 2 <= r2 * (1.0 + 1e-12):
+                continue
+            cx = 0.5 * (px[i] + px[j])
+            cy = 0.5 * (py[i] + py[j])
+            r2 = (px[i] - cx) ** 2 + (py[i] - cy) ** 2
+            for k in range(j):
+                if (px[k] - cx) ** 2 + (py[k] - cy) ** 2 <= r2 * (1.0 + 1e-12):
+                    continue
+                # the circle through i, j and k
+                ax = px[j] - px[i]
+                ay = py[j] - py[i]
+                bx = px[k] - px[i]
+                by = py[k] - py[i]
+                det = 2.0 * (ax * by - ay * bx)
+                a2 = ax * ax + ay * ay
+                b2 = bx * bx + by * by
+                if abs(det) <= 1e-12 * (a2 + b2):
+                    # (nearly) collinear: the circle on the farthest two
+                    c2 = (px[j] - px[k]) ** 2 + (py[j] - py[k]) ** 2
+                    if c2 >= a2 and c2 >= b2:
+                        cx = 0.5 * (px[j] + px[k])
+                        cy = 0.5 * (py[j] + py[k])
+                    elif b2 >= a2:
+                        cx = 0.5 * (px[i] + px[k])
+                        cy = 0.5 * (py[i] + py[k])
+                else:
+                    cx = px[i] + (by * a2 - ay * b2) / det
+                    cy = py[i] + (ax * b2 - bx * a2) / det
+                r2 = max((px[i] - cx) ** 2 + (py[i] - cy) ** 2,
+                         (px[j] - cx) ** 2 + (py[j] - cy) ** 2,
+                         (px[k] - cx) ** 2 + (py[k] - cy) ** 2)
+    return cx, cy
+
+
+@njit(nogil=True)
+def traversal_stack():
+    """Scratch of :func:`pair_step`: node pairs and their times. A tree over n edges is
+    at most ceil(log2 n) + 1 deep and the traversal holds at most the two depths plus
+    one entries, so :data:`STACK_SIZE` covers any body that fits in memory."""
+    return np.empty((STACK_SIZE, 2), np.int64), np.empty(STACK_SIZE)
+
+
+@njit(nogil=True)
+def _root(g, r, k, cap):
+    """A time in [0, cap] before which f stays positive, for f(0) = g, f'(0) = r and
+    |f''| <= k: the first zero of g + r τ − k τ²/2 (``cap`` if it stays positive to
+    ``cap``, 0 if g <= 0). Computed without cancellation."""
+    if g <= 0.0:
+        return 0.0
+    if g + (r - 0.5 * k * cap) * cap > 0.0:
+        return cap                     # concave, positive at both ends: positive between
+    if k > 0.0:
+        q = np.sqrt(r * r + 2.0 * k * g)
+        return 2.0 * g / (q - r) if r <= 0.0 else (r + q) / k
+    return g / -r
+
+
+@njit(nogil=True)
+def _root_or_linear(g, r, k, speed, cap):
+    """:func:`_root`, or g / ``speed`` when that is later (|f'| <= speed: f >= g − speed τ),
+    so that a pair never gets a shorter step than plain conservative advancement."""
+    tau = _root(g, r, k, cap)
+    if g > speed * tau:
+        tau = cap if g >= speed * cap else g / speed
+    return tau
+
+
+@njit(nogil=True)
+def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex, uey, we, kin,
+                      lam, cap):
+    """``(d², τ)``: the squared distance from vertex p to edge ab of the other body E, and
+    a time in [0, cap] during which p stays more than ``lam`` from the edge (0 if it is
+    within ``lam`` now).
+
+    ``(vx, vy)`` is p's velocity, ``rp`` its distance from its body's centroid; ``ra``,
+    ``rb`` those of the edge's ends from E's centroid ``(cex, cey)``; E moves with
+    velocity ``(uex, uey)`` and angular velocity ``we``, so its point x moves at
+    u(x) = u_E + ω_E J (x − c_E). ``kin`` is ``(Δa, K_v, K_e, V, W_v, W_e)``: the relative
+    acceleration, |α| + ω_max² of p's body and of E, the largest |Δv| and |ω| of p's body
+    and of E over the window.
+
+    The longer of two bounds, both lower bounds of the same time:
+
+    - fixed normal n = (p − q)/|p − q|, q the nearest point of the edge: every point of
+      the (straight, rigid) edge is a convex combination of its ends, so
+      dist(p, e) >= min over the ends x of n·(p − x), each a function with value and
+      slope known now and |f''| <= |p̈ − ẍ| <= Δa + K_v |r_p| + K_e |r_x|;
+    - when p is more than ``lam`` outside the edge's line, the signed distance s to the
+      line turning with E (a lower bound of the distance to the edge). In E's frame p is
+      at P = Rᵀ(p − c_E), s = n_E·(P − X), and with w = p − c_E,
+      P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w): |s''| <= Δa + K_v |r_p| + 2 W_e |ẇ| +
+      K_e |w| with |ẇ| <= V + W_v |r_p| and |w| growing by at most that speed times the
+      step. Its slope now is (ṗ − u(p))·n_E: exact, so a vertex sliding along the line
+      (or closing slowly towards it while the edge turns) keeps long steps.
+    """
+    qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
+    if d2 <= lam * lam:
+        return d2, 0.0
+    d = np.sqrt(d2)
+    nx = (px - qx) / d
+    ny = (py - qy) / d
+    kp = kin[0] + kin[1] * rp
+    sp = kin[3] + kin[4] * rp
+    uax = uex - we * (ay - cey)
+    uay = uey + we * (ax - cex)
+    ubx = uex - we * (by - cey)
+    uby = uey + we * (bx - cex)
+    tau = min(_root_or_linear((px - ax) * nx + (py - ay) * ny - lam,
+                              (vx - uax) * nx + (vy - uay) * ny, kp + kin[2] * ra,
+                              sp + kin[5] * ra, cap),
+              _root_or_linear((px - bx) * nx + (py - by) * ny - lam,
+                              (vx - ubx) * nx + (vy - uby) * ny, kp + kin[2] * rb,
+                              sp + kin[5] * rb, cap))
+    if tau < cap:
+        ex = bx - ax
+        ey = by - ay
+        ln = np.sqrt(ex * ex + ey * ey)
+        if ln > 0.0:
+            lx = ey / ln                 # interior on the left: outward on the right
+            ly = -ex / ln
+            s0 = (px - ax) * lx + (py - ay) * ly
+            if s0 > lam:
+                wx = px - cex
+                wy = py - cey
+                far = np.sqrt(wx * wx + wy * wy) + cap * sp
+                k = kp + 2.0 * kin[5] * sp + kin[2] * far
+                slope = (vx - uex + we * wy) * lx + (vy - uey - we * wx) * ly
+                tau = max(tau, _root(s0 - lam, slope, k, cap))
+    return d2, tau
+
+
+@njit(nogil=True)
+def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vby, wb, kin,
+               lam, cap):
+    """A time in [0, cap] during which node ``ka`` of A's tree and node ``kb`` of B's
+    (``qa``, ``qb``: the ``circles`` of :func:`edge_table`) stay more than ``lam`` apart
+    (0 if their circles are that close now).
+
+    The centres are material points at body-frame ``(cx, cy)``; with u = C_A − C_B and
+    n = u/|u| now, |u(t)| >= n·u(t), whose slope now is n·(Ċ_A − Ċ_B) and whose second
+    derivative is at most Δa + K_A |r_cA| + K_B |r_cB|; the circles are apart while
+    |u| > rho_A + rho_B.
+    """
+    rx = qa[ka, 0]
+    ry = qa[ka, 1]
+    xa = csa * rx - sna * ry
+    ya = sna * rx + csa * ry
+    rx = qb[kb, 0]
+    ry = qb[kb, 1]
+    xb = csb * rx - snb * ry
+    yb = snb * rx + csb * ry
+    ux = ca[0] + xa - cb[0] - xb
+    uy = ca[1] + ya - cb[1] - yb
+    dist = np.sqrt(ux * ux + uy * uy)
+    g = dist - qa[ka, 2] - qb[kb, 2] - lam
+    if g <= 0.0:
+        return 0.0
+    slope = ((vax - wa * ya - vbx + wb * yb) * ux + (vay + wa * xa - vby - wb * xb) * uy) / dist
+    return _root(g, slope, kin[0] + kin[1] * qa[ka, 3] + kin[2] * qb[kb, 3], cap)
+
+
+@njit(nogil=True)
+def _leaf_pair(way, i, j, xv, cv, vvx, vvy, wv, rv_len, xe, ce, uex, uey, we, re_len, nxt_e, kin,
+               lam, step, dmin2, crit):
+    """Vertex i of one body against edge j of the other: ``(dmin2, step)`` updated, and
+    ``crit`` set to ``(way, i, j)`` when the pair shortens the step."""
+    j1 = nxt_e[j]
+    px = xv[i, 0]
+    py = xv[i, 1]
+    d2, tau = _vertex_edge_time(px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]),
+                                rv_len[i], xe[j, 0], xe[j, 1], xe[j1, 0], xe[j1, 1], re_len[j],
+                                re_len[j1], ce[0], ce[1], uex, uey, we, kin, lam, step)
+    if tau < step:
+        step = tau
+        crit[0], crit[1], crit[2] = way, i, j
+    return min(dmin2, d2), step
+
+
+@njit(nogil=True)
+def pair_step(xa, ca, ea, xb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau):
+    """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
+    vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
+
+    ``xa`` are A's vertices placed at t0, ``ca`` its centroid there, ``ea`` its
+    :func:`edge_table` (likewise B); ``ma``,
+    ``mb`` the motion vectors ``[vx, vy, ax, ay, ω, α]``; [t0, t1] the window over which
+    the bounds hold. ``crit`` (int64, 3) names the pair that set the last step,
+    ``(way, vertex, edge)`` (way 0: vertex of A; −1: none); it is charged first, so that
+    the step is near its final value early and most node pairs are pruned, and it is
+    updated. ``stack``, ``stau``: :func:`traversal_stack`.
+
+    Each vertex–edge pair is charged :func:`_vertex_edge_time`; pairs of tree nodes
+    whose circles stay more than ``lam`` apart for the current step
+    (:func:`_node_time`) are pruned with every pair under them. ``distance`` is exact
+    when it is at most ``lam`` (a pair that close is never pruned while the step is
+    positive, and a step of 0 comes from a pair within ``lam_pair``); otherwise it is at
+    least the gap.
+    """
+    h = t1 - t0
+    tha = ma[4] * t0 + 0.5 * ma[5] * t0 * t0
+    thb = mb[4] * t0 + 0.5 * mb[5] * t0 * t0
+    csa = np.cos(tha)
+    sna = np.sin(tha)
+    csb = np.cos(thb)
+    snb = np.sin(thb)
+    vax = ma[0] + ma[2] * t0
+    vay = ma[1] + ma[3] * t0
+    vbx = mb[0] + mb[2] * t0
+    vby = mb[1] + mb[3] * t0
+    wa = ma[4] + ma[5] * t0
+    wb = mb[4] + mb[5] * t0
+    wa_max = max(abs(wa), abs(ma[4] + ma[5] * t1))
+    wb_max = max(abs(wb), abs(mb[4] + mb[5] * t1))
+    da = np.hypot(ma[2] - mb[2], ma[3] - mb[3])
+    ka = abs(ma[5]) + wa_max * wa_max
+    kb = abs(mb[5]) + wb_max * wb_max
+    lin = max(np.hypot(vax - vbx, vay - vby),
+              np.hypot(vax - vbx + (ma[2] - mb[2]) * h, vay - vby + (ma[3] - mb[3]) * h))
+    kin_ab = (da, ka, kb, lin, wa_max, wb_max)
+    kin_ba = (da, kb, ka, lin, wb_max, wa_max)
+    nxa, la, qa, ra_len = ea
+    nxb, lb, qb, rb_len = eb
+    step = h
+    dmin2 = np.inf
+    if crit[0] == 0:
+        dmin2, step = _leaf_pair(0, crit[1], crit[2], xa, ca, vax, vay, wa, ra_len, xb, cb, vbx,
+                                 vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2, crit)
+    elif crit[0] == 1:
+        dmin2, step = _leaf_pair(1, crit[1], crit[2], xb, cb, vbx, vby, wb, rb_len, xa, ca, vax,
+                                 vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2, crit)
+    stack[0, 0] = 0
+    stack[0, 1] = 0
+    stau[0] = 0.0
+    sp = 1
+    while sp > 0:
+        sp -= 1
+        crit[3] += 1
+        if stau[sp] >= step:
+            continue
+        na = stack[sp, 0]
+        nb = stack[sp, 1]
+        i = la[na, 2]
+        j = lb[nb, 2]
+        if i >= 0 and j >= 0:
+            crit[4] += 1
+            dmin2, step = _leaf_pair(0, i, j, xa, ca, vax, vay, wa, ra_len, xb, cb, vbx, vby, wb,
+                                     rb_len, nxb, kin_ab, lam_pair, step, dmin2, crit)
+            dmin2, step = _leaf_pair(1, j, i, xb, cb, vbx, vby, wb, rb_len, xa, ca, vax, vay, wa,
+                                     ra_len, nxa, kin_ba, lam_pair, step, dmin2, crit)
+            continue
+        # open the wider node (a leaf is never opened)
+        if j >= 0 or (i < 0 and qa[na, 2] >= qb[nb, 2]):
+            a1, b1, a2, b2 = la[na, 0], nb, la[na, 1], nb
+        else:
+            a1, b1, a2, b2 = na, lb[nb, 0], na, lb[nb, 1]
+        t_1 = _node_time(qa, a1, ca, csa, sna, vax, vay, wa, qb, b1, cb, csb, snb, vbx, vby, wb,
+                         kin_ab, lam, step)
+        t_2 = _node_time(qa, a2, ca, csa, sna, vax, vay, wa, qb, b2, cb, csb, snb, vbx, vby, wb,
+                         kin_ab, lam, step)
+        if t_1 < t_2:                   # the nearer pair is opened first
+            a1, b1, t_1, a2, b2, t_2 = a2, b2, t_2, a1, b1, t_1
+        if t_1 < step:
+            stack[sp, 0] = a1
+            stack[sp, 1] = b1
+            stau[sp] = t_1
+            sp += 1
+        if t_2 < step:
+            stack[sp, 0] = a2
+            stack[sp, 1] = b2
+            stau[sp] = t_2
+            sp += 1
+    return np.sqrt(dmin2), step
