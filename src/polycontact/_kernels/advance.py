@@ -231,11 +231,13 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     if d2 <= lam * lam:
         return d2, 0.0
+    sp = kin[3] + kin[4] * rp
+    if d2 > (lam + cap * (sp + kin[5] * max(ra, rb))) ** 2:
+        return d2, cap                  # out of reach at the plain speed bound
     d = np.sqrt(d2)
     nx = (px - qx) / d
     ny = (py - qy) / d
     kp = kin[0] + kin[1] * rp
-    sp = kin[3] + kin[4] * rp
     uax = uex - we * (ay - cey)
     uay = uey + we * (ax - cex)
     ubx = uex - we * (by - cey)
