@@ -290,6 +290,39 @@ def test_paper_cases_match_oracle(case):
     assert first is not None
 
 
+@pytest.mark.parametrize("case, touching", [(1, ("b", 2, 0)), (2, ("a", 23, 30))])
+def test_paper_case_features_are_read_where_the_bodies_touch(case, touching):
+    """The search brackets the hit only to the tolerance (here 1e-4 s, during which the
+    bodies move by up to 0.07 m); the features come from the bracket narrowed to the
+    contact resolution, so they name only the vertex that touches; Shapely finds it on
+    that edge, moved in by less than the bracket allows, at the bracket's end."""
+    scene = pc.load_scene(f"examples/paper-case-{case}.json", repair=True)
+    a, b = scene.bodies
+    hit = time_of_impact(a.shape, a.motion, b.shape, b.motion, t_max=scene.t_max)
+    assert [(f.body, f.vertex, f.edge) for f in hit.features] == [touching]
+    lo, hi = hit.time_bracket
+    assert hi - lo <= TOL
+    body, vertex, edge = touching
+    pv, pe = (a, b) if body == "a" else (b, a)
+    moved = pv.shape.at(pv.motion, hi)
+    other = pe.shape.at(pe.motion, hi)
+    ring = other.exterior
+    seg = shapely.LineString([ring[edge], ring[(edge + 1) % len(ring)]])
+    assert shapely.distance(shapely.Point(moved.exterior[vertex]), seg) < 0.07
+    assert shapely.contains(shapely.Polygon(ring), shapely.Point(moved.exterior[vertex]))
+
+
+def test_features_name_the_first_tooth_not_one_a_tolerance_later():
+    """Two teeth land 5e-5 s apart, inside the 1e-4 s bracket the search stops with: the
+    features come from the bracket narrowed to the contact resolution, so only the
+    first tooth is named (read over the coarse bracket, both would be)."""
+    comb = Shape([(0, 1), (0, 0), (0.2, 0.5), (1, 0.5), (1.2, 5e-5), (1.4, 1)])
+    floor = Shape([(-1, -2), (3, -2), (3, -1), (-1, -1)])
+    hit = time_of_impact(comb, Motion(velocity=(0, -1)), floor, Motion(), t_max=3)
+    assert hit.time == pytest.approx(1.0, abs=TOL)
+    assert [(f.body, f.vertex, f.edge) for f in hit.features] == [("a", 1, 2)]
+
+
 def test_paper_case_1_sampled_misses_the_first_penetration():
     scene = pc.load_scene("examples/paper-case-1.json")
     a, b = scene.bodies

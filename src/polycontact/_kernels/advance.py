@@ -115,12 +115,10 @@ def _smallest_circle(px, py, m, seed):
     incremental algorithm, expected O(m) after a pseudo-random shuffle seeded by
     ``seed``; the points are reordered). Rounding can leave a point a hair outside: the caller takes the radius
     as the largest distance from this centre."""
-    state = np.uint64(seed) * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
-    for i in range(m - 1, 0, -1):            # xorshift shuffle
-        state ^= state << np.uint64(13)
-        state ^= state >> np.uint64(7)
-        state ^= state << np.uint64(17)
-        j = np.int64(state % np.uint64(i + 1))
+    state = seed % 2147483648
+    for i in range(m - 1, 0, -1):            # shuffle (a 31-bit linear congruence)
+        state = (state * 1103515245 + 12345) % 2147483648
+        j = state % (i + 1)
         px[i], px[j] = px[j], px[i]
         py[i], py[j] = py[j], py[i]
     cx = px[0]
