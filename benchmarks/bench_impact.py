@@ -4,9 +4,10 @@ Run: ``python benchmarks/bench_impact.py [--pairs N] [--repeat R]``. Needs the `
 extra (``box2d``). Prints, in one run:
 
 1. both paper cases, exact vs sampled at the same time tolerance (1e-4 s): time per
-   query (median of R runs, full API call and kernel only) and whether the answer is
-   the first penetration found by an independent Shapely oracle; then the smallest
-   number of samples per round with which the sampled method finds it;
+   query (full API call and kernel only; the methods take turns in rounds of 100
+   calls, 4R + 1 rounds) and whether the answer is the first penetration found by an
+   independent Shapely oracle; then the smallest number of samples per round with
+   which the sampled method finds it;
 2. pairs of random convex octagons with constant velocity and angular velocity over one
    step [0, 1]: time per query of ``time_of_impact`` (API and kernel) and of Box2D's
    ``b2TimeOfImpact`` (through pybox2d), and how often each gets the wrong answer,
@@ -116,36 +117,61 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
 
 
 # -- 1. the paper's cases ----------------------------------------------------------------
+def interleaved_times(fns: dict, repeat: int, batch: int = 100) -> tuple[dict, dict]:
+    """Per-call times of several functions measured in turn, ``repeat`` rounds of
+    ``batch`` calls each (so that a burst of load on the machine hits all of them):
+    ``(medians, ratios)`` with each one's median and, for each, the median over rounds
+    of its time divided by the first function's in the same round."""
+    for fn in fns.values():
+        fn()
+    rounds = {name: [] for name in fns}
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            for _ in range(batch):
+                fn()
+            rounds[name].append((time.perf_counter() - t0) / batch)
+    first = np.array(next(iter(rounds.values())))
+    return ({name: float(np.median(ts)) for name, ts in rounds.items()},
+            {name: float(np.median(np.array(ts) / first)) for name, ts in rounds.items()})
+
+
 def paper_cases(repeat: int) -> None:
     print("== Paper cases: exact vs sampled (n = 10), time tolerance 1e-4 s ==")
-    print(f"{'case':>4} {'method':>8} {'time (s)':>11} {'right':>6} {'API ms':>8} "
-          f"{'kernel us':>10} {'evals':>6}")
+    print(f"(medians of {4 * repeat + 1} rounds of 100 calls, the methods taking turns; "
+          "ratios are medians of the per-round ratios)")
+    print(f"{'case':>4} {'method':>8} {'time (s)':>11} {'right':>6} {'API us':>8} "
+          f"{'kernel us':>10} {'steps/samples':>14}")
     for k in (1, 2):
         scene = pc.load_scene(ROOT / f"examples/paper-case-{k}.json", repair=True)
         (A, B) = scene.bodies
         a, ma, b, mb = A.shape, A.motion, B.shape, B.motion
         exact = pc.time_of_impact(a, ma, b, mb, t_max=scene.t_max)
         first, _ = truth(a, ma, b, mb, scene.t_max, 8000, exact)
-        api, kern = {}, {}
-        for method in ("exact", "sampled"):
-            hit = pc.time_of_impact(a, ma, b, mb, t_max=scene.t_max, method=method)
-            api[method] = median_time(lambda: pc.time_of_impact(
-                a, ma, b, mb, t_max=scene.t_max, method=method), repeat)
-            kern[method] = median_time(kernel_query(a, ma, b, mb, scene.t_max, method), repeat)
+        hits = {m: pc.time_of_impact(a, ma, b, mb, t_max=scene.t_max, method=m)
+                for m in ("exact", "sampled")}
+        api, api_ratio = interleaved_times(
+            {m: (lambda m=m: pc.time_of_impact(a, ma, b, mb, t_max=scene.t_max, method=m))
+             for m in ("exact", "sampled")}, 4 * repeat + 1)
+        kern, kern_ratio = interleaved_times(
+            {m: kernel_query(a, ma, b, mb, scene.t_max, m) for m in ("exact", "sampled")},
+            4 * repeat + 1)
+        for method, hit in hits.items():
             right = hit.collides and abs(hit.time - first) <= TOL
             print(f"{k:>4} {method:>8} {hit.time:>11.5f} {str(right):>6} "
-                  f"{api[method] * 1e3:>8.3f} {kern[method] * 1e6:>10.1f} {hit.iterations:>6}")
+                  f"{api[method] * 1e6:>8.1f} {kern[method] * 1e6:>10.1f} {hit.iterations:>14}")
         print(f"     oracle first penetration {first:.5f} s; exact/sampled time ratio: "
-              f"API {api['exact'] / api['sampled']:.2f}, kernel "
-              f"{kern['exact'] / kern['sampled']:.2f}")
+              f"API {1 / api_ratio['sampled']:.2f}, kernel {1 / kern_ratio['sampled']:.2f}")
         for n in (10, 20, 50, 100, 200, 500, 1000, 2000):
             hit = pc.time_of_impact(a, ma, b, mb, t_max=scene.t_max, method="sampled",
                                     samples=n)
             if hit.collides and abs(hit.time - first) <= TOL:
-                cost = median_time(kernel_query(a, ma, b, mb, scene.t_max, "sampled", n),
-                                   repeat)
+                times, ratio = interleaved_times(
+                    {"exact": kernel_query(a, ma, b, mb, scene.t_max, "exact"),
+                     "sampled": kernel_query(a, ma, b, mb, scene.t_max, "sampled", n)},
+                    4 * repeat + 1)
                 print(f"     sampled finds it from n = {n} samples per round "
-                      f"(kernel {cost * 1e6:.1f} us, {cost / kern['exact']:.2f} x exact)")
+                      f"(kernel {times['sampled'] * 1e6:.1f} us, {ratio['sampled']:.2f} x exact)")
                 break
         else:
             print("     sampled does not find it with up to 2000 samples per round")

@@ -268,26 +268,36 @@ def time_of_impact(
     taken is longer and has the same guarantee: boundaries meet first where a vertex
     reaches an edge, so it is enough that no vertex p comes within λ' of any edge e of
     the other body (λ' = λ until the first contact is found, λ/64 after it, so that
-    fewer probes remain before the hit). Each such pair is held apart along its own
-    fixed normal n (from the nearest point q of e to p): the edge lies in the
-    half-plane behind q, so
-    sep(t) = p(t)·n − max over points x of e of x(t)·n starts at dist(p, e) and never
-    exceeds it. A point moves along n at v·n + ω (J R r)·n, and (J R(θ) r)·n stays
-    within |r|·(angle turned) of its current value, so sep shrinks no faster than
-    −Δv·n − ω_p f_p + max_x ω_e f_x evaluated over boxes that hold these quantities on
-    the window (extremes at its ends or corners; see ``_kernels.impact._pair_rate``),
-    and never faster than the plain bound above with |r_p| and max |r_e| for L. The
-    step is the least, over pairs and both ways, of (dist − λ') / rate; pairs too far
-    to matter are skipped by boxes (and a sweep over x for large bodies). Near contact
-    the step shrinks; below the probe length τ = min(time_tolerance / 2, λ / S), with
-    λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and classifies
-    the end. A penetrating end is the hit, with the non-penetrating start of the
-    probe as ``time_bracket[0]``: ``time`` is within τ ≤ ``time_tolerance``/2 after the
-    first penetration. Not penetrating at the end means either no penetration began in
-    the step, or one began and ended inside it — lasting under ``time_tolerance``/2
-    with no point moving more than λ relative to the other body: a penetration
-    shallower than the contact resolution. Every other penetration is found, whatever
-    the rotation speed.
+    fewer probes remain before the hit). Each such pair is held apart by a
+    second-order bound: along its fixed normal n (from the nearest point of e to p),
+    dist(p, e) ≥ min over the ends x of e of n·(p − x) (a straight edge lies between
+    its ends), and each n·(p − x) has its slope now known exactly (the velocities at t)
+    and its second derivative bounded by |Δa| + (|α_A| + ω_A²)|r_p| + (|α_B| + ω_B²)|r_x|
+    over the window (p̈ = a + (α J − ω²) R r for a point of a turning body), so it
+    stays positive until the first root of g + r τ − K τ²/2; when p is outside the
+    edge's line, its distance to the line turning with e's body (in that body's frame,
+    with the Coriolis and centripetal terms) gives a second bound, and the plain
+    (d − λ')/S a third; the pair gets the longest. A separating or slowly closing pair
+    thus keeps long steps however fast the bodies spin. Pairs are found through a tree
+    of smallest enclosing circles over each body's edges: a pair of circles held apart
+    by the same second-order bound on their centres for the whole step stands for
+    every vertex–edge pair under it. The step is the least pair time, both ways.
+
+    Near contact the steps shrink fast (the bounds converge quadratically). After a
+    step to t + h that is shorter than ``time_tolerance`` or than a fifth of the step
+    before, the bodies are classified at t + h + 0.99 ``time_tolerance``: penetrating
+    there ends the search with ``time_bracket`` = (t + h, that time) — no penetration
+    began before t + h, so ``time`` is within ``time_tolerance`` after the first
+    penetration. Otherwise, below the probe length τ = min(time_tolerance / 2, λ / S),
+    with λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and
+    classifies the end. A penetrating end is the hit, with the non-penetrating start
+    of the probe as ``time_bracket[0]``. Not penetrating at the end means either no
+    penetration began in the step, or one began and ended inside it — lasting under
+    ``time_tolerance``/2 with no point moving more than λ relative to the other body:
+    a penetration shallower than the contact resolution. Every other penetration is
+    found, whatever the rotation speed. ``features``, ``point`` and ``normal`` are
+    computed when first asked for, from the bracket narrowed by the same search to τ,
+    so that they describe the touch and not a configuration up to a tolerance later.
 
     A sliding contact (paper Fig. 16) is followed by long steps, not probes: once
     touching, the line ℓ of a touching edge e of body E (turning with E) is tried as a

@@ -120,8 +120,8 @@ def _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw):
 
 @njit(cache=True, nogil=True)
 def motion_window(ma, mb, t0, t1):
-    """``(mwa, mwb)``: the window tuples of :func:`_pair_rate` and :func:`_line_rate`
-    over [t0, t1], for vertices of A against edges of B and the other way round."""
+    """``(mwa, mwb)``: the window tuples of :func:`_line_rate` over [t0, t1], for
+    vertices of A against edges of B and the other way round."""
     h = t1 - t0
     dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
     dv0y = ma[1] - mb[1] + (ma[3] - mb[3]) * t0
@@ -273,7 +273,7 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
 
     Returns ``(status, t_hi, t_lo, first_contact, iterations, t_reached)``: on a hit the
     bodies penetrate at ``t_hi`` and do not at ``t_lo`` (``t_hi − t_lo`` below
-    ``time_tol``); ``first_contact`` is the first visited time with boundary distance
+    ``time_tol``; no penetration begins before ``t_lo``); ``first_contact`` is the first visited time with boundary distance
     <= ``lam`` (−1 if none); ``t_reached`` is how far the search got.
 
     Invariant: no penetration has been skipped before ``t`` (see
@@ -281,8 +281,11 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     t with boundary distance d and speed bound S over a window [t, t + H]:
 
     - :func:`pair_step` gives a step h <= H during which no vertex–edge pair can
-      meet (each pair charged its closing rate along its own normal), so the
-      boundaries cannot meet and no penetration can start. If h is at least the probe
+      meet (second-order bounds, see :mod:`polycontact._kernels.advance`), so the
+      boundaries cannot meet and no penetration can start. After a step shorter than
+      ``time_tol`` or than ``GUESS_SHRINK`` times the one before, the bodies are
+      classified at ``t + h + 0.99 time_tol``: penetrating there is the hit, bracketed
+      by (t + h, that time). If h is at least the probe
       length ``tau = min(time_tol / 2, lam / S)`` it is taken. The pairs are held
       ``lam`` apart until the first contact (so that the first time found within
       ``lam`` is at most a probe late) and ``PAIR_GAP · lam`` apart after it, which
