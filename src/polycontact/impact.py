@@ -87,7 +87,9 @@ class Impact:
         First penetration time (the bodies penetrate at ``time``), or None.
     first_contact : float or None
         First time found at which the bodies touch (boundary distance within the
-        contact resolution; for a collision, ``time_bracket[0]``), or None.
+        contact resolution), or None. For a collision it is at most ``time_bracket[0]``;
+        when no touch was found before the bracket it is the bracket's start, up to
+        ``time_tolerance`` before the bodies actually touch.
     state : State or None
         The relation at the reported instant: ``time`` for a hit, t = 0 when
         penetrating at the start, ``first_contact`` for a contact without collision;
