@@ -121,7 +121,7 @@ def test_vertex_edge_time_keeps_the_pair_apart(mv, me, rp, ra, rb, t0, cap):
     vel = vv + wv * np.array([-(p[1] - cv[1]), p[0] - cv[0]])
     d2, tau = ka._vertex_edge_time(p[0], p[1], vel[0], vel[1], np.hypot(*rp), a[0], a[1], b[0],
                                    b[1], np.hypot(*ra), np.hypot(*rb), ce[0], ce[1], ve[0], ve[1],
-                                   we, _kin(mv, me, t0, t0 + cap), lam, cap)
+                                   we, _kin(mv, me, t0, t0 + cap), lam, cap, 0.0)
     assert math.isclose(math.sqrt(d2), _segment_distance(p, a, b), rel_tol=1e-9)
     assert 0.0 <= tau <= cap
     for t in np.linspace(t0, t0 + tau, 200):
@@ -172,9 +172,42 @@ def test_vertex_edge_time_along_a_turning_line(half, y0, s0, x, slide, we, ae, w
     vel = mv[:2] + wv * np.array([-rp[1], rp[0]])
     d2, tau = ka._vertex_edge_time(p0[0], p0[1], vel[0], vel[1], np.hypot(*rp), ra[0], ra[1],
                                    rb[0], rb[1], np.hypot(*ra), np.hypot(*rb), 0.0, 0.0, 0.0, 0.0,
-                                   we, _kin(mv, me, 0.0, cap), lam, cap)
+                                   we, _kin(mv, me, 0.0, cap), lam, cap, 0.0)
     assert 0.0 <= tau <= cap
     for t in np.linspace(0.0, tau, 400):
         q = _placed(cv0, mv, rp[None], t)[0]
         ea, eb = _placed(ce0, me, np.array([ra, rb]), t)
         assert _segment_distance(q, ea, eb) >= lam * (1 - 1e-9) - 1e-12
+
+
+def _placed_polygon(shape, motion, t):
+    return shapely.Polygon(_placed(np.asarray(shape.centroid), motion.array,
+                                   shape.exterior - shape.centroid, t))
+
+
+@given(st.floats(-2, 2), st.floats(-0.3, 0.3), st.floats(-0.5, 0.5), st.floats(-1, 1),
+       st.floats(-0.5, 0.5), st.floats(-0.5, 0.5), st.floats(-0.8, 0.8), st.floats(0.05, 1.0))
+@example(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)        # a pure slide under the overhang
+def test_touching_step_allows_no_penetration_deeper_than_touch(vx, vy, wa, ax, wb, ay, dx,
+                                                              window):
+    """Bodies touching flush (a block on a floor under an overhang, so no line separates
+    them), moving at random, spinning and accelerating: during the step granted with
+    ``touch``, neither body gets deeper than about ``touch`` into the other (Shapely:
+    the other body shrunk by 2·touch is never met)."""
+    from polycontact import Motion, Shape
+
+    block = Shape([(0, 0), (1, 0), (1, 1), (0, 1)]).moved((dx, 0.0))
+    floor = Shape([(-3, -1), (2.3, -1), (2.3, 1.5), (2.0, 1.5), (2.0, 0), (-3, 0)])
+    ma = Motion((vx, vy), (ax, ay), wa, 0.0)
+    mb = Motion((0.0, 0.0), (0.0, 0.0), wb, 0.0)
+    ra, rb = block.packed[0] - block.centroid, floor.packed[0] - floor.centroid
+    lam, touch = 1e-3, 1e-4
+    _, step = ka.pair_step(ra, np.array(block.centroid), ka.edge_table(ra, block.packed[1]), rb,
+                           np.array(floor.centroid), ka.edge_table(rb, floor.packed[1]),
+                           ma.array, mb.array, 0.0, window, lam, lam / 64, np.full(3, -1),
+                           *ka.traversal_stack(), touch)
+    assert 0.0 <= step <= window
+    for t in np.linspace(0.0, step, 40):
+        pa, pb = _placed_polygon(block, ma, t), _placed_polygon(floor, mb, t)
+        assert not shapely.intersects(pa, pb.buffer(-2 * touch, join_style="mitre"))
+        assert not shapely.intersects(pb, pa.buffer(-2 * touch, join_style="mitre"))

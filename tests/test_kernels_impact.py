@@ -112,14 +112,29 @@ def test_exact_search_on_flush_squares():
 
 
 def test_exact_search_reports_the_budget():
+    # a square spinning in a square hole it fits exactly, the holed body spinning with
+    # it: in contact throughout with no relative motion, but each body's own spin is
+    # all the bounds see, so the touch is stepped through by probes
+    sq = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
+    b = Shape([(-3, -3), (3, -3), (3, 3), (-3, 3)], [[(-1, -1), (-1, 1), (1, 1), (1, -1)]])
+    spin = Motion(angular_velocity=1.0)
+    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, spin, b, spin)
+    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
+                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
+    assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0 and out[5] < 1.0
+
+
+def test_exact_search_follows_a_slide_under_an_overhang():
+    # sliding contact from t = 0 under an overhang whose leg reaches below A's top (no
+    # line separates the bodies): the touching pairs keep to their edges' lines, so the
+    # slide is stepped over, and the hit on the leg at t = 0.8 is found in a few steps
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    # sliding contact from t = 0 under an overhang whose leg reaches below A's top:
-    # no separating line, so it is followed by probes
     b = Shape([(0.5, 1), (1.8, 1), (1.8, 0), (2.1, 0), (2.1, 2), (0.5, 2)])
     ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
     out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
                           b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
-    assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0
+    assert out[0] == ki.HIT and out[2] <= 0.8 <= out[1] and out[1] - out[2] <= 1e-4
+    assert out[3] == 0.0 and out[4] < 10
 
 
 def test_exact_search_follows_a_slide_in_few_steps():
@@ -195,13 +210,13 @@ def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     ea, eb = edge_table(ra, a.packed[1]), edge_table(rb, b.packed[1])
     d, step = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
-                        mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1), *traversal_stack())
+                        mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1), *traversal_stack(), 0.0)
     # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
     # it is never below the gap, and with lam just above the gap it is the gap
     gap = boundary_distance(*a.packed, *b.packed)
     assert d >= gap * (1 - 1e-12)
     d_lam, _ = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
-                         mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1), *traversal_stack())
+                         mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1), *traversal_stack(), 0.0)
     assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -240,7 +255,7 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     d, step = pair_step(ra, np.array(pa.centroid), edge_table(ra, a.packed[1]),
                         rb, np.array(pb.centroid), edge_table(rb, b.packed[1]),
                         ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1),
-                        *traversal_stack())
+                        *traversal_stack(), 0.0)
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)

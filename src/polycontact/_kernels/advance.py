@@ -199,11 +199,40 @@ def _root_or_linear(g, r, k, speed, cap):
 
 
 @njit(cache=True, nogil=True)
+def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap):
+    """A time in [0, cap] during which vertex p stays more than ``level`` in front of the
+    line of edge ab as the line turns with its body E (0 if it is not now; arguments as
+    in :func:`_vertex_edge_time`).
+
+    In E's frame p is at P = Rᵀ(p − c_E) and its signed distance to the line is
+    s = n_E·(P − X); with w = p − c_E, P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w), so
+    |s''| <= Δa + K_v |r_p| + 2 W_e |ẇ| + K_e |w|, with |ẇ| <= V + W_v |r_p| and |w|
+    growing by at most that speed times the step; s' now is (ṗ − u(p))·n_E.
+    """
+    ex = bx - ax
+    ey = by - ay
+    ln = np.sqrt(ex * ex + ey * ey)
+    if ln == 0.0:
+        return 0.0
+    lx = ey / ln                         # interior on the left: outward on the right
+    ly = -ex / ln
+    wx = px - cex
+    wy = py - cey
+    sp = kin[3] + kin[4] * rp
+    far = np.sqrt(wx * wx + wy * wy) + cap * sp
+    k = kin[0] + kin[1] * rp + 2.0 * kin[5] * sp + kin[2] * far
+    slope = (vx - uex + we * wy) * lx + (vy - uey - we * wx) * ly
+    return _root((px - ax) * lx + (py - ay) * ly - level, slope, k, cap)
+
+
+@njit(cache=True, nogil=True)
 def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex, uey, we, kin,
-                      lam, cap):
+                      lam, cap, touch):
     """``(d², τ)``: the squared distance from vertex p to edge ab of the other body E, and
-    a time in [0, cap] during which p stays more than ``lam`` from the edge (0 if it is
-    within ``lam`` now).
+    a time in [0, cap] during which p stays more than ``lam`` from the edge. A pair within
+    ``lam`` now gets 0, or, when ``touch`` > 0, the time during which p stays no more
+    than ``touch`` behind the edge's turning line (:func:`_line_time`; see
+    :func:`pair_step` for what that proves).
 
     ``(vx, vy)`` is p's velocity, ``rp`` its distance from its body's centroid; ``ra``,
     ``rb`` those of the edge's ends from E's centroid ``(cex, cey)``; E moves with
@@ -223,11 +252,15 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
       at P = Rᵀ(p − c_E), s = n_E·(P − X), and with w = p − c_E,
       P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w): |s''| <= Δa + K_v |r_p| + 2 W_e |ẇ| +
       K_e |w| with |ẇ| <= V + W_v |r_p| and |w| growing by at most that speed times the
-      step. Its slope now is (ṗ − u(p))·n_E: exact, so a vertex sliding along the line
-      (or closing slowly towards it while the edge turns) keeps long steps.
+      step (:func:`_line_time`). Its slope now is (ṗ − u(p))·n_E: exact, so a vertex
+      sliding along the line (or closing slowly towards it while the edge turns) keeps
+      long steps.
     """
     qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     if d2 <= lam * lam:
+        if touch > 0.0:
+            return d2, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
+                                  -touch, cap)
         return d2, 0.0
     sp = kin[3] + kin[4] * rp
     if d2 > (lam + cap * (sp + kin[5] * max(ra, rb))) ** 2:
@@ -247,20 +280,8 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
                               (vx - ubx) * nx + (vy - uby) * ny, kp + kin[2] * rb,
                               sp + kin[5] * rb, cap))
     if tau < cap:
-        ex = bx - ax
-        ey = by - ay
-        ln = np.sqrt(ex * ex + ey * ey)
-        if ln > 0.0:
-            lx = ey / ln                 # interior on the left: outward on the right
-            ly = -ex / ln
-            s0 = (px - ax) * lx + (py - ay) * ly
-            if s0 > lam:
-                wx = px - cex
-                wy = py - cey
-                far = np.sqrt(wx * wx + wy * wy) + cap * sp
-                k = kp + 2.0 * kin[5] * sp + kin[2] * far
-                slope = (vx - uex + we * wy) * lx + (vy - uey - we * wx) * ly
-                tau = max(tau, _root(s0 - lam, slope, k, cap))
+        tau = max(tau, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
+                                  lam, cap))
     return d2, tau
 
 
@@ -296,7 +317,7 @@ def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vb
 
 @njit(cache=True, nogil=True)
 def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, sne, uex, uey, we,
-               re_len, nxt_e, kin, lam, step, dmin2, crit):
+               re_len, nxt_e, kin, lam, step, dmin2, crit, touch):
     """Vertex i of one body against edge j of the other: ``(dmin2, step)`` updated, and
     ``crit`` set to ``(way, i, j)`` when the pair shortens the step. The three points
     are placed from the body frame (``rv``, ``re``), each body turned by its
@@ -310,7 +331,7 @@ def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, s
     by = ce[1] + sne * re[j1, 0] + cse * re[j1, 1]
     d2, tau = _vertex_edge_time(px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]),
                                 rv_len[i], ax, ay, bx, by, re_len[j], re_len[j1], ce[0], ce[1],
-                                uex, uey, we, kin, lam, step)
+                                uex, uey, we, kin, lam, step, touch)
     if tau < step:
         step = tau
         crit[0], crit[1], crit[2] = way, i, j
@@ -318,7 +339,8 @@ def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, s
 
 
 @njit(cache=True, nogil=True)
-def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau):
+def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau,
+              touch):
     """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
     vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
 
@@ -337,6 +359,20 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     when it is at most ``lam`` (a pair that close is never pruned while the step is
     positive, and a step of 0 comes from a pair within ``lam_pair``); otherwise it is at
     least the gap.
+
+    With ``touch`` > 0 (bodies in contact), a pair already within ``lam_pair`` is charged
+    instead the time during which its vertex stays no more than ``touch`` behind its
+    edge's turning line. Then, if the bodies do not penetrate at t0, no penetration
+    deeper than ``touch`` begins within the step: an overlap of the interiors begins
+    where a vertex p of one body reaches an edge e of the other (edges cannot start to
+    cross otherwise, and a vertex meeting a vertex is a vertex on the edges at it).
+    Pairs farther than ``lam_pair`` do not meet within the step. A pair within it keeps
+    p in front of e's line up to ``touch``; if p entered the other body near e, or near
+    a corner of e (at a convex corner the body is behind both edges' lines there, at a
+    reflex one behind one of them, and both edges' pairs are within ``lam_pair``), it
+    would be behind that line. So a sliding contact — a translating body along a
+    straight edge, under an overhang or not — is followed by steps as long as the
+    nearest other pair allows.
     """
     h = t1 - t0
     tha = ma[4] * t0 + 0.5 * ma[5] * t0 * t0
@@ -367,11 +403,11 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     if crit[0] == 0:
         dmin2, step = _leaf_pair(0, crit[1], crit[2], ra, ca, csa, sna, vax, vay, wa, ra_len, rb,
                                  cb, csb, snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step,
-                                 dmin2, crit)
+                                 dmin2, crit, touch)
     elif crit[0] == 1:
         dmin2, step = _leaf_pair(1, crit[1], crit[2], rb, cb, csb, snb, vbx, vby, wb, rb_len, ra,
                                  ca, csa, sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step,
-                                 dmin2, crit)
+                                 dmin2, crit, touch)
     stack[0, 0] = 0
     stack[0, 1] = 0
     stau[0] = 0.0
@@ -387,10 +423,10 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
         if i >= 0 and j >= 0:
             dmin2, step = _leaf_pair(0, i, j, ra, ca, csa, sna, vax, vay, wa, ra_len, rb, cb, csb,
                                      snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2,
-                                     crit)
+                                     crit, touch)
             dmin2, step = _leaf_pair(1, j, i, rb, cb, csb, snb, vbx, vby, wb, rb_len, ra, ca, csa,
                                      sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2,
-                                     crit)
+                                     crit, touch)
             continue
         # open the wider node (a leaf is never opened)
         if j >= 0 or (i < 0 and qa[na, 2] >= qb[nb, 2]):
