@@ -41,9 +41,9 @@ __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MA
 #: affordable to follow.
 CONTACT_RESOLUTION = 1e-6
 
-#: Default iteration budget of the exact method (one iteration places both bodies and
-#: steps or classifies them). Reached only by long sliding contacts that no line through
-#: the touching edges separates; the result then says so.
+#: Default iteration budget of the exact method (one iteration steps, or classifies the
+#: bodies at the end of a probe). Reached only by long contacts that last while the
+#: bodies turn (see ``time_of_impact``); the result then says so.
 MAX_ITERATIONS = 1_000_000
 
 _METHODS = ("exact", "sampled")
@@ -312,9 +312,14 @@ def time_of_impact(
     cannot cross V's boundary, so W and V stay disjoint: no penetration can begin.
     (Both sides are checked with the rounding tolerance, so an overlap thinner than
     twice that tolerance is not looked for.) When no such line holds (e.g. sliding
-    under an overhang whose far end reaches below), the touch is stepped through by
-    probes; the number of iterations is bounded by ``max_iterations`` (status
-    OUT_OF_ITERATIONS, never a hang).
+    under an overhang whose far end reaches below), the touching vertex–edge pairs
+    are held instead: every pair not touching must stay apart (as in a step), and
+    every touching pair must keep its vertex no more than the rounding tolerance
+    behind its edge's turning line (second-order bound). An overlap can only begin
+    where a vertex crosses an edge, so none begins. When that fails too (a contact
+    that lasts while the bodies turn), the touch is stepped through by probes; the
+    number of iterations is bounded by ``max_iterations`` (status OUT_OF_ITERATIONS,
+    never a hang).
 
     Parameters
     ----------
