@@ -152,6 +152,20 @@ def test_slide_then_hit_a_step():
     assert hit.iterations < 50
 
 
+def test_accelerating_slide_ends_with_a_verdict():
+    # A slides along the floor towards B's leg, slowing down (acceleration along the
+    # edge), and has not reached it by t_max: contact throughout, no collision. Only the
+    # acceleration across the edge's line may end such a step, and there is none
+    floor = Shape([(-3, -1), (2.3, -1), (2.3, 1.5), (2.0, 1.5), (2.0, 0), (-3, 0)])
+    a = SQ.moved((-1.9, 0.0))
+    ma = Motion(velocity=(1.05, 0.0), acceleration=(-0.1, 0.0))
+    mb = Motion(velocity=(-0.01, 0.0))
+    hit = time_of_impact(a, ma, floor, mb, t_max=2)
+    assert hit.status is ImpactStatus.NO_HIT and hit.first_contact == 0.0
+    assert hit.iterations < 100
+    assert oracle_first_penetration(a, ma, floor, mb, 0, 2, 2001) is None
+
+
 def test_contact_without_relative_motion_runs_out_of_iterations_with_a_status():
     # a square spinning in a square hole it fits exactly, the holed body spinning with
     # it about the same centre: touching throughout with no relative motion, but the

@@ -121,7 +121,8 @@ def test_vertex_edge_time_keeps_the_pair_apart(mv, me, rp, ra, rb, t0, cap):
     vel = vv + wv * np.array([-(p[1] - cv[1]), p[0] - cv[0]])
     d2, tau = ka._vertex_edge_time(p[0], p[1], vel[0], vel[1], np.hypot(*rp), a[0], a[1], b[0],
                                    b[1], np.hypot(*ra), np.hypot(*rb), ce[0], ce[1], ve[0], ve[1],
-                                   we, _kin(mv, me, t0, t0 + cap), lam, cap, 0.0)
+                                   we, _kin(mv, me, t0, t0 + cap), lam, cap, 0.0,
+                                   *(mv[2:4] - me[2:4]))
     assert math.isclose(math.sqrt(d2), _segment_distance(p, a, b), rel_tol=1e-9)
     assert 0.0 <= tau <= cap
     for t in np.linspace(t0, t0 + tau, 200):
@@ -156,23 +157,27 @@ def test_node_time_keeps_the_circles_apart(ma, mb, ra, rb, rho_a, rho_b, t0, cap
 
 @given(st.floats(1, 5), st.floats(-2, 2), st.floats(2e-3, 0.5), st.floats(-1, 1),
        st.floats(-20, 20), st.floats(-3, 3), st.floats(-3, 3), st.floats(-3, 3),
-       st.tuples(st.floats(-1, 1), st.floats(-1, 1)), st.floats(0.01, 1.0))
-def test_vertex_edge_time_along_a_turning_line(half, y0, s0, x, slide, we, ae, wv, rp, cap):
-    """A vertex just outside an edge's line, sliding fast along it while the edge's body
-    turns: the case where the bound towards the turning line is the longer one (its
-    Coriolis and centripetal terms matter)."""
+       st.tuples(st.floats(-1, 1), st.floats(-1, 1)), st.floats(0.01, 1.0),
+       st.floats(-20, 20))
+def test_vertex_edge_time_along_a_turning_line(half, y0, s0, x, slide, we, ae, wv, rp, cap,
+                                               push):
+    """A vertex just outside an edge's line, sliding fast along it (and pushed along it)
+    while the edge's body turns: the case where the bound towards the turning line is
+    the longer one (its Coriolis and centripetal terms, and the push turning across
+    the line, matter)."""
     lam = 1e-3
     ce0 = np.array([0.0, 0.0])
     ra, rb = np.array([-half, y0]), np.array([half, y0])     # interior above (on the left)
     rp = np.array(rp) * 0.5
     p0 = np.array([x * half, y0 - s0])
     cv0 = p0 - rp
-    mv = np.array([slide, 0.0, 0.0, 0.0, wv, 0.0])
+    mv = np.array([slide, 0.0, push, 0.0, wv, 0.0])
     me = np.array([0.0, 0.0, 0.0, 0.0, we, ae])
     vel = mv[:2] + wv * np.array([-rp[1], rp[0]])
     d2, tau = ka._vertex_edge_time(p0[0], p0[1], vel[0], vel[1], np.hypot(*rp), ra[0], ra[1],
                                    rb[0], rb[1], np.hypot(*ra), np.hypot(*rb), 0.0, 0.0, 0.0, 0.0,
-                                   we, _kin(mv, me, 0.0, cap), lam, cap, 0.0)
+                                   we, _kin(mv, me, 0.0, cap), lam, cap, 0.0,
+                                   *(mv[2:4] - me[2:4]))
     assert 0.0 <= tau <= cap
     for t in np.linspace(0.0, tau, 400):
         q = _placed(cv0, mv, rp[None], t)[0]

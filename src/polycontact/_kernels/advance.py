@@ -199,15 +199,19 @@ def _root_or_linear(g, r, k, speed, cap):
 
 
 @njit(cache=True, nogil=True)
-def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap):
+def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap, dax,
+               day):
     """A time in [0, cap] during which vertex p stays more than ``level`` in front of the
     line of edge ab as the line turns with its body E (0 if it is not now; arguments as
     in :func:`_vertex_edge_time`).
 
     In E's frame p is at P = Rᵀ(p − c_E) and its signed distance to the line is
     s = n_E·(P − X); with w = p − c_E, P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w), so
-    |s''| <= Δa + K_v |r_p| + 2 W_e |ẇ| + K_e |w|, with |ẇ| <= V + W_v |r_p| and |w|
-    growing by at most that speed times the step; s' now is (ṗ − u(p))·n_E.
+    |s''| <= |n·Δa| + K_v |r_p| + 2 W_e |ẇ| + K_e |w|, with |ẇ| <= V + W_v |r_p| and
+    |w| growing by at most that speed times the step; s' now is (ṗ − u(p))·n_E. The
+    relative acceleration ``(dax, day)`` counts only across the line (n turns by at
+    most W_e·cap, which adds |Δa| W_e cap), so a body sliding along a still edge while
+    it speeds up or slows down keeps long steps.
     """
     ex = bx - ax
     ey = by - ay
@@ -220,14 +224,16 @@ def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, 
     wy = py - cey
     sp = kin[3] + kin[4] * rp
     far = np.sqrt(wx * wx + wy * wy) + cap * sp
-    k = kin[0] + kin[1] * rp + 2.0 * kin[5] * sp + kin[2] * far
+    # the relative acceleration (dax, day) across the line, which turns by <= W_e·cap
+    k = (abs(dax * lx + day * ly) + kin[0] * kin[5] * cap + kin[1] * rp + 2.0 * kin[5] * sp
+         + kin[2] * far)
     slope = (vx - uex + we * wy) * lx + (vy - uey - we * wx) * ly
     return _root((px - ax) * lx + (py - ay) * ly - level, slope, k, cap)
 
 
 @njit(cache=True, nogil=True)
 def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex, uey, we, kin,
-                      lam, cap, touch):
+                      lam, cap, touch, dax, day):
     """``(d², τ)``: the squared distance from vertex p to edge ab of the other body E, and
     a time in [0, cap] during which p stays more than ``lam`` from the edge. A pair within
     ``lam`` now gets 0, or, when ``touch`` > 0, the time during which p stays no more
@@ -260,7 +266,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     if d2 <= lam * lam:
         if touch > 0.0:
             return d2, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
-                                  -touch, cap)
+                                  -touch, cap, dax, day)
         return d2, 0.0
     sp = kin[3] + kin[4] * rp
     if d2 > (lam + cap * (sp + kin[5] * max(ra, rb))) ** 2:
@@ -281,7 +287,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
                               sp + kin[5] * rb, cap))
     if tau < cap:
         tau = max(tau, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
-                                  lam, cap))
+                                  lam, cap, dax, day))
     return d2, tau
 
 
@@ -317,7 +323,7 @@ def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vb
 
 @njit(cache=True, nogil=True)
 def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, sne, uex, uey, we,
-               re_len, nxt_e, kin, lam, step, dmin2, crit, touch):
+               re_len, nxt_e, kin, lam, step, dmin2, crit, touch, dax, day):
     """Vertex i of one body against edge j of the other: ``(dmin2, step)`` updated, and
     ``crit`` set to ``(way, i, j)`` when the pair shortens the step. The three points
     are placed from the body frame (``rv``, ``re``), each body turned by its
@@ -331,7 +337,7 @@ def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, s
     by = ce[1] + sne * re[j1, 0] + cse * re[j1, 1]
     d2, tau = _vertex_edge_time(px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]),
                                 rv_len[i], ax, ay, bx, by, re_len[j], re_len[j1], ce[0], ce[1],
-                                uex, uey, we, kin, lam, step, touch)
+                                uex, uey, we, kin, lam, step, touch, dax, day)
     if tau < step:
         step = tau
         crit[0], crit[1], crit[2] = way, i, j
@@ -389,7 +395,9 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     wb = mb[4] + mb[5] * t0
     wa_max = max(abs(wa), abs(ma[4] + ma[5] * t1))
     wb_max = max(abs(wb), abs(mb[4] + mb[5] * t1))
-    da = np.hypot(ma[2] - mb[2], ma[3] - mb[3])
+    dax = ma[2] - mb[2]
+    day = ma[3] - mb[3]
+    da = np.sqrt(dax * dax + day * day)
     ka = abs(ma[5]) + wa_max * wa_max
     kb = abs(mb[5]) + wb_max * wb_max
     lin = max(np.hypot(vax - vbx, vay - vby),
@@ -403,11 +411,11 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     if crit[0] == 0:
         dmin2, step = _leaf_pair(0, crit[1], crit[2], ra, ca, csa, sna, vax, vay, wa, ra_len, rb,
                                  cb, csb, snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step,
-                                 dmin2, crit, touch)
+                                 dmin2, crit, touch, dax, day)
     elif crit[0] == 1:
         dmin2, step = _leaf_pair(1, crit[1], crit[2], rb, cb, csb, snb, vbx, vby, wb, rb_len, ra,
                                  ca, csa, sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step,
-                                 dmin2, crit, touch)
+                                 dmin2, crit, touch, dax, day)
     stack[0, 0] = 0
     stack[0, 1] = 0
     stau[0] = 0.0
@@ -423,10 +431,10 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
         if i >= 0 and j >= 0:
             dmin2, step = _leaf_pair(0, i, j, ra, ca, csa, sna, vax, vay, wa, ra_len, rb, cb, csb,
                                      snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2,
-                                     crit, touch)
+                                     crit, touch, dax, day)
             dmin2, step = _leaf_pair(1, j, i, rb, cb, csb, snb, vbx, vby, wb, rb_len, ra, ca, csa,
                                      sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2,
-                                     crit, touch)
+                                     crit, touch, dax, day)
             continue
         # open the wider node (a leaf is never opened)
         if j >= 0 or (i < 0 and qa[na, 2] >= qb[nb, 2]):
