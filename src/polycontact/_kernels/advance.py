@@ -243,24 +243,23 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     ``(vx, vy)`` is p's velocity, ``rp`` its distance from its body's centroid; ``ra``,
     ``rb`` those of the edge's ends from E's centroid ``(cex, cey)``; E moves with
     velocity ``(uex, uey)`` and angular velocity ``we``, so its point x moves at
-    u(x) = u_E + ω_E J (x − c_E). ``kin`` is ``(Δa, K_v, K_e, V, W_v, W_e)``: the relative
-    acceleration, |α| + ω_max² of p's body and of E, the largest |Δv| and |ω| of p's body
-    and of E over the window.
+    u(x) = u_E + ω_E J (x − c_E). ``kin`` is ``(|Δa|, K_v, K_e, V, W_v, W_e)``: the
+    relative acceleration, |α| + ω_max² of p's body and of E, the largest |Δv| and |ω|
+    of p's body and of E over the window; ``(dax, day)`` is Δa itself.
 
-    The longer of two bounds, both lower bounds of the same time:
+    The longest of three lower bounds of the same time:
 
     - fixed normal n = (p − q)/|p − q|, q the nearest point of the edge: every point of
       the (straight, rigid) edge is a convex combination of its ends, so
       dist(p, e) >= min over the ends x of n·(p − x), each a function with value and
-      slope known now and |f''| <= |p̈ − ẍ| <= Δa + K_v |r_p| + K_e |r_x|;
-    - when p is more than ``lam`` outside the edge's line, the signed distance s to the
-      line turning with E (a lower bound of the distance to the edge). In E's frame p is
-      at P = Rᵀ(p − c_E), s = n_E·(P − X), and with w = p − c_E,
-      P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w): |s''| <= Δa + K_v |r_p| + 2 W_e |ẇ| +
-      K_e |w| with |ẇ| <= V + W_v |r_p| and |w| growing by at most that speed times the
-      step (:func:`_line_time`). Its slope now is (ṗ − u(p))·n_E: exact, so a vertex
-      sliding along the line (or closing slowly towards it while the edge turns) keeps
-      long steps.
+      slope known now and |f''| <= |p̈ − ẍ| <= |Δa| + K_v |r_p| + K_e |r_x|;
+    - the same with the plain speed bound |f'| <= V + W_v |r_p| + W_e |r_x|
+      (:func:`_root_or_linear`);
+    - when p is more than ``lam`` outside the edge's line, its signed distance to the
+      line turning with E (:func:`_line_time`), a lower bound of the distance to the
+      edge. Its slope now is the velocity of p relative to E's point under it, so a
+      vertex sliding along the line (or closing slowly towards it while the edge
+      turns) keeps long steps.
     """
     qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     if d2 <= lam * lam:
