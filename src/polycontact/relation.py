@@ -553,10 +553,12 @@ def classify_many(
 
 
 def warmup() -> None:
-    """Compile (or load from the cache) the classification kernels now.
+    """Compile (or load from the cache) the classification and time-of-impact kernels
+    now.
 
     Numba compiles each kernel on its first call; call this once at start-up to pay
-    that cost up front instead of on the first :func:`classify`.
+    that cost up front instead of on the first :func:`classify` or
+    :func:`polycontact.time_of_impact`.
 
     Examples
     --------
@@ -569,3 +571,10 @@ def warmup() -> None:
         rs = classify(Shape(sq), Shape(sq + d))
         rs.distance, rs.features
     classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances
+    from .impact import time_of_impact
+    from .motion import Motion
+
+    for method in ("exact", "sampled"):
+        hit = time_of_impact(Shape(sq), Motion(velocity=(1.0, 0.0)), Shape(sq + (3.0, 0.0)),
+                             Motion(), t_max=5.0, method=method)
+        hit.features
