@@ -356,8 +356,11 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             s = speed_bound(ma, la, mb, lb, t, t_end)
             # until the first contact the pairs are stepped to lam, so that the first
             # time found within lam is at most a probe late; then closer
+            # once touching, a touching pair is held to its edge's line instead (a slide
+            # is stepped over, see pair_step)
             d, h = pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam,
-                             lam if first_contact < 0.0 else lam_pair, crit, stack, stau, 0.0)
+                             lam if first_contact < 0.0 else lam_pair, crit, stack, stau,
+                             0.0 if first_contact < 0.0 else eps)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
@@ -379,12 +382,8 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 # time_tol / 2 at a time (so the first contact found is no later)
                 h = min(pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
                                   stack, stau, 0.0)[1], 0.5 * time_tol)
-            if h < tau and first_contact >= 0.0:
-                # touching: the touching pairs may keep to their edges' lines (a slide)
-                h = max(h, pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair,
-                                     crit, stack, stau, eps)[1])
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
-                # or a line through the touching features may separate them
+                # touching: a line through the touching features may separate them
                 place(ra, ca, ma, t, xa)
                 place(rb, cb, mb, t, xb)
                 h = max(h, _slide_step(xa, pa, ea[3], ea[0], la, xb, pb, eb[3], eb[0], lb,
