@@ -301,25 +301,26 @@ def time_of_impact(
     computed when first asked for, from the bracket narrowed by the same search to τ,
     so that they describe the touch and not a configuration up to a tolerance later.
 
-    A sliding contact (paper Fig. 16) is followed by long steps, not probes: once
-    touching, the line ℓ of a touching edge e of body E (turning with E) is tried as a
-    separator. If every vertex of E lies behind ℓ, E stays behind it (it is rigid); each
-    edge of the other body V is charged the time during which both its ends stay on or
-    in front of ℓ (at their rate towards the turning line, as above) or it stays
-    outside E's bounding circle. Until the least of these times no edge of V meets
-    W = (open half-plane behind ℓ) ∩ (open circle), a convex set moving with E that
-    holds E's interior; a point of E's interior is outside V now (no penetration) and
-    cannot cross V's boundary, so W and V stay disjoint: no penetration can begin.
-    (Both sides are checked with the rounding tolerance, so an overlap thinner than
-    twice that tolerance is not looked for.) When no such line holds (e.g. sliding
-    under an overhang whose far end reaches below), the touching vertex–edge pairs
-    are held instead: every pair not touching must stay apart (as in a step), and
-    every touching pair must keep its vertex no more than the rounding tolerance
-    behind its edge's turning line (second-order bound). An overlap can only begin
-    where a vertex crosses an edge, so none begins. When that fails too (a contact
-    that lasts while the bodies turn), the touch is stepped through by probes; the
-    number of iterations is bounded by ``max_iterations`` (status OUT_OF_ITERATIONS,
-    never a hang).
+    A sliding contact (paper Fig. 16) is followed by long steps, not probes. Once the
+    bodies touch, each step holds the touching vertex–edge pairs (those within λ/64)
+    differently: every other pair must stay apart, as before, and every touching pair
+    must keep its vertex no more than the rounding tolerance behind its edge's turning
+    line (second-order bound). An overlap can only begin where a vertex crosses an
+    edge, so none begins; this follows a translating body along an edge, under an
+    overhang or not. Where that step is still short (at a corner, where a vertex must
+    stay in front of both edges' lines), the line ℓ of a touching edge e of body E
+    (turning with E) is tried as a separator. If every vertex of E lies behind ℓ, E
+    stays behind it (it is rigid); each edge of the other body V is charged the time
+    during which both its ends stay on or in front of ℓ (at their rate towards the
+    turning line) or it stays outside E's bounding circle. Until the least of these
+    times no edge of V meets W = (open half-plane behind ℓ) ∩ (open circle), a convex
+    set moving with E that holds E's interior; a point of E's interior is outside V now
+    (no penetration) and cannot cross V's boundary, so W and V stay disjoint: no
+    penetration can begin. (Both certificates allow the rounding tolerance, so an
+    overlap thinner than that is not looked for; it is contact.) When both fail (a
+    contact that lasts while the bodies turn), the touch is stepped through by probes;
+    the number of iterations is bounded by ``max_iterations`` (status
+    OUT_OF_ITERATIONS, never a hang).
 
     Parameters
     ----------
@@ -370,10 +371,11 @@ def time_of_impact(
     from ._kernels import impact as ki
 
     eps = RELATIVE_TOLERANCE * max(_path_scale(a, ma, t_max), _path_scale(b, mb, t_max))
-    ra, ea = body_frame(a)
-    rb, eb = body_frame(b)
+    exact = method == "exact"
+    ra, ea = body_frame(a, tables=exact)
+    rb, eb = body_frame(b, tables=exact)
     la, lb = a.bounding_radius, b.bounding_radius
-    if method == "exact":
+    if exact:
         out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
                              b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps,
                              CONTACT_RESOLUTION * (la + lb), int(max_iterations))
@@ -386,18 +388,21 @@ def time_of_impact(
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps)
 
 
-def body_frame(shape: Shape) -> tuple[np.ndarray, tuple]:
-    """``(r, tables)``: the shape's vertices relative to its centroid and their
-    ``_kernels.advance.edge_table``, built on first use and kept with the shape (it is
-    immutable), so that repeated queries on one shape build them once."""
-    if shape._frame is None:
+def body_frame(shape: Shape, tables: bool = True) -> tuple[np.ndarray, tuple | None]:
+    """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
+    for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
+    sampled method does not need it). Built on first use and kept with the shape (it
+    is immutable), so that repeated queries on one shape build them once."""
+    r, tab = shape._frame if shape._frame is not None else (None, None)
+    if r is None:
+        r = shape.packed[0] - shape.centroid
+        r.flags.writeable = False
+    if tables and tab is None:
         from ._kernels.advance import edge_table
 
-        xy, starts = shape.packed
-        r = xy - shape.centroid
-        r.flags.writeable = False
-        shape._frame = (r, edge_table(r, starts))
-    return shape._frame
+        tab = edge_table(r, shape.packed[1])
+    shape._frame = (r, tab)
+    return r, tab
 
 
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
