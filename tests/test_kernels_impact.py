@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from polycontact import Motion, Shape
 from polycontact._kernels import broad_phase as kb
 from polycontact._kernels import impact as ki
-from polycontact._kernels.advance import edge_table, pair_step, traversal_stack
+from polycontact._kernels.advance import edge_table, pair_step, traversal_stack, window_kinematics
 
 coef = st.floats(-10, 10, allow_nan=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
 
@@ -159,11 +159,11 @@ def test_slide_time_keeps_the_interiors_apart(va, wa, vb, wb, dx, frac):
     ra, rb = a.packed[0] - a.centroid, bar.packed[0] - bar.centroid
     la, lb = np.hypot(*ra.T), np.hypot(*rb.T)
     na, nb = edge_table(ra, a.packed[1])[0], edge_table(rb, bar.packed[1])[0]
-    mwa, _ = ki.motion_window(ma.array, mb.array, 0.0, 1.0)
+    mva, mvb, kin, _ = window_kinematics(ma.array, mb.array, 0.0, 1.0)
     # A's vertices against the line of the bar's top edge (edge 2: (3, 0) -> (-1, 0))
-    h = ki.slide_time(a.packed[0], np.array(a.centroid), la, na, bar.packed[0],
-                      np.array(bar.centroid), nb, bar.bounding_radius, 2, mwa, 1e-12, 1.0,
-                      0.0, 0)
+    h = ki.slide_time(a.packed[0], np.array(a.centroid), mva, la, na, bar.packed[0],
+                      np.array(bar.centroid), mvb, nb, bar.bounding_radius, 2, kin, 0.0, 0.0,
+                      1e-12, 1.0, 0.0, 0)
     assert 0.0 <= h <= 1.0
     if va == vb == (0.0, 0.0) and wa == wb == 0.0:
         assert h == 1.0                 # nothing moves: the whole window

@@ -113,8 +113,8 @@ def edge_table(r, starts):
 def _smallest_circle(px, py, m, seed):
     """Centre of the smallest circle holding the points ``px[:m], py[:m]`` (Welzl's
     incremental algorithm, expected O(m) after a pseudo-random shuffle seeded by
-    ``seed``; the points are reordered). Rounding can leave a point a hair outside: the caller takes the radius
-    as the largest distance from this centre."""
+    ``seed``; the points are reordered). Rounding can leave a point a hair outside:
+    the caller takes the radius as the largest distance from this centre."""
     state = seed % 2147483648
     for i in range(m - 1, 0, -1):            # shuffle (a 31-bit linear congruence)
         state = (state * 1103515245 + 12345) % 2147483648
@@ -344,6 +344,35 @@ def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, s
 
 
 @njit(cache=True, nogil=True)
+def window_kinematics(ma, mb, t0, t1):
+    """``((vax, vay, ωa), (vbx, vby, ωb), kin_ab, kin_ba)``: each body's velocity and
+    angular velocity at t0, and the window tuples of the bounds over [t0, t1] for
+    vertices of A against edges of B and the other way round:
+    ``(|Δa|, K_v, K_e, V, W_v, W_e)`` with K = |α| + ω_max², V the largest |Δv| and W
+    the largest |ω| over the window (ω and Δv are affine in t: their largest norms are
+    at the window's ends)."""
+    h = t1 - t0
+    vax = ma[0] + ma[2] * t0
+    vay = ma[1] + ma[3] * t0
+    vbx = mb[0] + mb[2] * t0
+    vby = mb[1] + mb[3] * t0
+    wa = ma[4] + ma[5] * t0
+    wb = mb[4] + mb[5] * t0
+    wa_max = max(abs(wa), abs(ma[4] + ma[5] * t1))
+    wb_max = max(abs(wb), abs(mb[4] + mb[5] * t1))
+    dax = ma[2] - mb[2]
+    day = ma[3] - mb[3]
+    da = np.sqrt(dax * dax + day * day)
+    ka = abs(ma[5]) + wa_max * wa_max
+    kb = abs(mb[5]) + wb_max * wb_max
+    dvx = vax - vbx
+    dvy = vay - vby
+    lin = np.sqrt(max(dvx * dvx + dvy * dvy, (dvx + dax * h) ** 2 + (dvy + day * h) ** 2))
+    return ((vax, vay, wa), (vbx, vby, wb), (da, ka, kb, lin, wa_max, wb_max),
+            (da, kb, ka, lin, wb_max, wa_max))
+
+
+@njit(cache=True, nogil=True)
 def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau,
               touch):
     """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
@@ -386,23 +415,9 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     sna = np.sin(tha)
     csb = np.cos(thb)
     snb = np.sin(thb)
-    vax = ma[0] + ma[2] * t0
-    vay = ma[1] + ma[3] * t0
-    vbx = mb[0] + mb[2] * t0
-    vby = mb[1] + mb[3] * t0
-    wa = ma[4] + ma[5] * t0
-    wb = mb[4] + mb[5] * t0
-    wa_max = max(abs(wa), abs(ma[4] + ma[5] * t1))
-    wb_max = max(abs(wb), abs(mb[4] + mb[5] * t1))
+    (vax, vay, wa), (vbx, vby, wb), kin_ab, kin_ba = window_kinematics(ma, mb, t0, t1)
     dax = ma[2] - mb[2]
     day = ma[3] - mb[3]
-    da = np.sqrt(dax * dax + day * day)
-    ka = abs(ma[5]) + wa_max * wa_max
-    kb = abs(mb[5]) + wb_max * wb_max
-    lin = max(np.hypot(vax - vbx, vay - vby),
-              np.hypot(vax - vbx + (ma[2] - mb[2]) * h, vay - vby + (ma[3] - mb[3]) * h))
-    kin_ab = (da, ka, kb, lin, wa_max, wb_max)
-    kin_ba = (da, kb, ka, lin, wb_max, wa_max)
     nxa, la, qa, ra_len = ea
     nxb, lb, qb, rb_len = eb
     step = h

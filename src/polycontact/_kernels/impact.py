@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .advance import edge_table, pair_step, traversal_stack
+from .advance import _line_time, edge_table, pair_step, traversal_stack, window_kinematics
 from .broad_phase import overlap_intervals
 from .relation import _scratch, _state_in
 from .validate import closest_on_segment
@@ -63,8 +63,8 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     norm of an affine function of t, hence convex, so its maximum over [t0, t1] is at
     an end.
     """
-    lin, wa, wb = _window_rates(ma, mb, t0, t1)
-    return lin + wa * la + wb * lb
+    kin = window_kinematics(ma, mb, t0, t1)[2]
+    return kin[3] + kin[4] * la + kin[5] * lb
 
 
 #: The pair steps of :func:`pair_step` stop this fraction of the contact resolution
@@ -77,95 +77,46 @@ PAIR_GAP = 1.0 / 64.0
 #: step's end, which can end it (see :func:`_exact_search`).
 GUESS_SHRINK = 0.2
 
-#: After a step h shorter than its window, the next window is this many times h: the
-#: directional bounds tighten as the window (the angle turned in it) shrinks.
+#: After a step h shorter than its window, the next window is this many times h. The
+#: window enters the bounds through the largest |ω| and |Δv| over it (with angular or
+#: linear acceleration) and the angle turned in it (slide steps), so a shorter window
+#: gives tighter bounds; a longer one lets a step run further.
 WINDOW_GROWTH = 3.0
 
 
 @njit(cache=True, nogil=True)
-def _bilinear_max(w0, w1, f0, f1):
-    """Largest w·f for w between w0 and w1 and f between f0 and f1 (at a corner)."""
-    return max(max(w0 * f0, w0 * f1), max(w1 * f0, w1 * f1))
-
-
-@njit(cache=True, nogil=True)
-def _line_rate(px, py, nx, ny, cvx, cvy, rv, cex, cey, mw):
-    """Upper bound of the closing rate of vertex p towards the line of an edge of the
-    other body, the line turning with that body (``n``: the edge's outward normal now).
-
-    The signed distance s = (p − x)·n(t), x a point of the line, changes at
-    (ṗ − ẋ_p)·n(t) with ẋ_p = v_e + ω_e J (p − c_e), the velocity of the other body's
-    point under p. So −s' = −Δv·n(t) − ω_v (J (p − c_v))·n(t) + ω_e (J (p − c_e))·n(t).
-    While n turns by at most Θ_e: Δv·n(t) is within |Δv| Θ_e of Δv·n(now) (affine in
-    t: extremes at the window ends); (J R_v r_p)·n is within |r_p| (Θ_v + Θ_e) of its
-    current value; p − c_e moves by at most δ = h (|Δv| + |ω_v| |r_p|), so
-    (J (p − c_e))·n is within δ + (|p − c_e| + δ) Θ_e of its current value. The
-    products with ω are bounded at a corner (:func:`_bilinear_max`). The distance from
-    p to the edge is at least s, so the pair stays apart while s > 0.
-    """
-    lin = mw[10]
-    t1 = -min(mw[0] * nx + mw[1] * ny, mw[2] * nx + mw[3] * ny) + lin * mw[9]
-    gv = (px - cvx) * ny - (py - cvy) * nx
-    sv = rv * (mw[8] + mw[9])
-    t2 = _bilinear_max(mw[4], mw[5], -min(rv, gv + sv), -max(-rv, gv - sv))
-    ux = px - cex
-    uy = py - cey
-    delta = lin * mw[11] + rv * mw[8]
-    ru = np.sqrt(ux * ux + uy * uy) + delta
-    ge = ux * ny - uy * nx
-    se = delta + ru * mw[9]
-    t3 = _bilinear_max(mw[6], mw[7], max(-ru, ge - se), min(ru, ge + se))
-    return t1 + t2 + t3
-
-
-@njit(cache=True, nogil=True)
-def motion_window(ma, mb, t0, t1):
-    """``(mwa, mwb)``: the window tuples of :func:`_line_rate` over [t0, t1], for
-    vertices of A against edges of B and the other way round."""
-    h = t1 - t0
-    dv0x = ma[0] - mb[0] + (ma[2] - mb[2]) * t0
-    dv0y = ma[1] - mb[1] + (ma[3] - mb[3]) * t0
-    dv1x = ma[0] - mb[0] + (ma[2] - mb[2]) * t1
-    dv1y = ma[1] - mb[1] + (ma[3] - mb[3]) * t1
-    lin = max(np.hypot(dv0x, dv0y), np.hypot(dv1x, dv1y))
-    wa0 = ma[4] + ma[5] * t0
-    wa1 = ma[4] + ma[5] * t1
-    wb0 = mb[4] + mb[5] * t0
-    wb1 = mb[4] + mb[5] * t1
-    wa = max(abs(wa0), abs(wa1))
-    wb = max(abs(wb0), abs(wb1))
-    return ((dv0x, dv0y, dv1x, dv1y, wa0, wa1, wb0, wb1, wa * h, wb * h, lin, h),
-            (-dv0x, -dv0y, -dv1x, -dv1y, wb0, wb1, wa0, wa1, wb * h, wa * h, lin, h))
-
-
-@njit(cache=True, nogil=True)
-def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need, first):
+def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, day, eps, h, need,
+               first):
     """A time in [0, h] (0 as soon as it is known to be below ``need``; V's vertex
-    ``first``, the touching one, is looked at before the rest) during which the interiors of V (vertices ``xv``, centroid
-    ``cv``) and E (``xe``, ``ce``, bounding radius ``le``) cannot come to overlap by
-    more than 2 ``eps``, certified by the line of E's edge j turning with E; 0 when the
-    line does not separate them. ``mw`` is the window tuple (:func:`motion_window`) of
-    V's vertices against E's edges over [t, t + h].
+    ``first``, the touching one, is looked at before the rest) during which the
+    interiors of V (vertices ``xv``, centroid ``cv``) and E (``xe``, ``ce``, bounding
+    radius ``le``) cannot come to overlap by more than 2 ``eps``, certified by the line
+    of E's edge j turning with E; 0 when the line does not separate them. ``mv``,
+    ``me`` are each body's ``(vx, vy, ω)`` now, ``kin`` the window tuple of V's
+    vertices against E's edges and ``(dax, day)`` their relative acceleration
+    (:func:`polycontact._kernels.advance.window_kinematics`).
 
-    This is what lets a sliding contact (paper Fig. 16) be followed by long steps:
-    with n the outward normal of edge j and σ(x) = (x − x_j)·n, E lies in
+    This is what lets a sliding contact (paper Fig. 16) be followed by long steps past
+    corners: with n the outward normal of edge j and σ(x) = (x − x_j)·n, E lies in
     {σ <= eps} at all times if all its vertices do now (the line turns with E). Each
     edge of V is charged the time during which either both its ends keep
-    σ >= −eps — each end at its rate towards the turning line (:func:`_line_rate`),
-    and a segment lies on the side of its ends — or it stays outside E's bounding
-    circle (its distance from E's centroid shrinks no faster than |Δv| + |ω_V| max |r|,
-    as in the pair bounds). Until the shortest of these times no edge of V meets
-    W = {σ < −eps} ∩ (open circle), a convex set that moves with E and holds the
-    points of E's interior deeper than eps behind the line. Such a point is outside V
-    now (the bodies do not penetrate) and never crosses V's boundary, so it stays
-    outside V; hence W ∩ V stays empty (W is connected) and any overlap of the
-    interiors lies in the band |σ| <= eps.
+    σ >= −eps — each end by the second-order bound towards the turning line
+    (:func:`polycontact._kernels.advance._line_time`), and a segment lies on the side
+    of its ends — or it stays outside E's bounding circle (its distance from E's
+    centroid shrinks no faster than V + W_v max |r|, as in the pair bounds). Until the
+    shortest of these times no edge of V meets W = {σ < −eps} ∩ (open circle), a convex
+    set that moves with E and holds the points of E's interior deeper than eps behind
+    the line. Such a point is outside V now (the bodies do not penetrate) and never
+    crosses V's boundary, so it stays outside V; hence W ∩ V stays empty (W is
+    connected) and any overlap of the interiors lies in the band |σ| <= eps.
     """
     j1 = nxt_e[j]
     ax = xe[j, 0]
     ay = xe[j, 1]
-    ex = xe[j1, 0] - ax
-    ey = xe[j1, 1] - ay
+    bx = xe[j1, 0]
+    by = xe[j1, 1]
+    ex = bx - ax
+    ey = by - ay
     ln = np.sqrt(ex * ex + ey * ey)
     if ln == 0.0:
         return 0.0
@@ -174,34 +125,25 @@ def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need, fi
     for k in range(xe.shape[0]):
         if (xe[k, 0] - ax) * nx + (xe[k, 1] - ay) * ny > eps:
             return 0.0
-    lin = mw[10]
-    wv = max(abs(mw[4]), abs(mw[5]))
     # inside E's circle the touching vertex's edges can only be charged by their ends
     px = xv[first, 0]
     py = xv[first, 1]
-    sig = (px - ax) * nx + (py - ay) * ny + eps
-    if (px - ce[0]) ** 2 + (py - ce[1]) ** 2 <= le * le and (
-            sig < 0.0 or sig < need * _line_rate(px, py, nx, ny, cv[0], cv[1], rv_len[first],
-                                                 ce[0], ce[1], mw)):
+    if (px - ce[0]) ** 2 + (py - ce[1]) ** 2 <= le * le and _end_time(
+            xv, cv, mv, rv_len, first, ax, ay, bx, by, ce, me, kin, dax, day, eps,
+            need) < need:
         return 0.0
     best = h
     for k in range(xv.shape[0]):
         k1 = nxt_v[k]
-        t_edge = np.inf
-        for m in (k, k1):
-            sig = (xv[m, 0] - ax) * nx + (xv[m, 1] - ay) * ny + eps
-            if sig < 0.0:
-                t_edge = 0.0
-                break
-            rate = _line_rate(xv[m, 0], xv[m, 1], nx, ny, cv[0], cv[1], rv_len[m], ce[0], ce[1],
-                              mw)
-            if sig < rate * best:           # else this end holds beyond the best
-                t_edge = min(t_edge, sig / rate)
+        t_edge = min(_end_time(xv, cv, mv, rv_len, k, ax, ay, bx, by, ce, me, kin, dax, day, eps,
+                               best),
+                     _end_time(xv, cv, mv, rv_len, k1, ax, ay, bx, by, ce, me, kin, dax, day, eps,
+                               best))
         if t_edge < best:
             gap = np.sqrt(closest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
                                               xv[k1, 1])[2]) - le
             if gap > 0.0:
-                rate = lin + wv * max(rv_len[k], rv_len[k1])
+                rate = kin[3] + kin[4] * max(rv_len[k], rv_len[k1])
                 t_edge = max(t_edge, gap / rate if gap < rate * best else best)
             best = min(best, t_edge)
             if best < need:
@@ -210,38 +152,43 @@ def slide_time(xv, cv, rv_len, nxt_v, xe, ce, nxt_e, le, j, mw, eps, h, need, fi
 
 
 @njit(cache=True, nogil=True)
+def _end_time(xv, cv, mv, rv_len, m, ax, ay, bx, by, ce, me, kin, dax, day, eps, cap):
+    """How long V's vertex m keeps σ >= −eps for the line of ab turning with E
+    (:func:`polycontact._kernels.advance._line_time`), up to ``cap``."""
+    x = xv[m, 0]
+    y = xv[m, 1]
+    return _line_time(x, y, mv[0] - mv[2] * (y - cv[1]), mv[1] + mv[2] * (x - cv[0]), rv_len[m],
+                      ax, ay, bx, by, ce[0], ce[1], me[0], me[1], me[2], kin, -eps, cap, dax,
+                      day)
+
+
+@njit(cache=True, nogil=True)
 def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1, crit, eps,
                 need):
     """The longest :func:`slide_time` over [t0, t1] by the lines through the pair
     ``crit`` (vertex i of one body, edge j of the other): edge j, or either edge of the
     vertex body at i (with the bodies' roles swapped); 0 if none reaches ``need``."""
-    mwa, mwb = motion_window(ma, mb, t0, t1)
+    mva, mvb, kin_ab, kin_ba = window_kinematics(ma, mb, t0, t1)
+    dax = ma[2] - mb[2]
+    day = ma[3] - mb[3]
     h = t1 - t0
     i = crit[1]
     j = crit[2]
     if crit[0] == 0:
-        best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, j, mwa, eps, h, need, i)
+        best = slide_time(xa, ca, mva, ra_len, nxa, xb, cb, mvb, nxb, lb, j, kin_ab, dax, day,
+                          eps, h, need, i)
         for e in range(nxa.shape[0]):
             if best == 0.0 and (e == i or nxa[e] == i):
-                best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, e, mwb, eps, h, need, j)
+                best = slide_time(xb, cb, mvb, rb_len, nxb, xa, ca, mva, nxa, la, e, kin_ba, dax,
+                                  day, eps, h, need, j)
         return best
-    best = slide_time(xb, cb, rb_len, nxb, xa, ca, nxa, la, j, mwb, eps, h, need, i)
+    best = slide_time(xb, cb, mvb, rb_len, nxb, xa, ca, mva, nxa, la, j, kin_ba, dax, day, eps, h,
+                      need, i)
     for e in range(nxb.shape[0]):
         if best == 0.0 and (e == i or nxb[e] == i):
-            best = slide_time(xa, ca, ra_len, nxa, xb, cb, nxb, lb, e, mwa, eps, h, need, j)
+            best = slide_time(xa, ca, mva, ra_len, nxa, xb, cb, mvb, nxb, lb, e, kin_ab, dax, day,
+                              eps, h, need, j)
     return best
-
-
-@njit(cache=True, nogil=True)
-def _window_rates(ma, mb, t0, t1):
-    dvx = ma[0] - mb[0]
-    dvy = ma[1] - mb[1]
-    dax = ma[2] - mb[2]
-    day = ma[3] - mb[3]
-    lin = max(np.hypot(dvx + dax * t0, dvy + day * t0), np.hypot(dvx + dax * t1, dvy + day * t1))
-    wa = max(abs(ma[4] + ma[5] * t0), abs(ma[4] + ma[5] * t1))
-    wb = max(abs(mb[4] + mb[5] * t0), abs(mb[4] + mb[5] * t1))
-    return lin, wa, wb
 
 
 @njit(cache=True, nogil=True)
@@ -273,8 +220,9 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
 
     Returns ``(status, t_hi, t_lo, first_contact, iterations, t_reached)``: on a hit the
     bodies penetrate at ``t_hi`` and do not at ``t_lo`` (``t_hi − t_lo`` below
-    ``time_tol``; no penetration begins before ``t_lo``); ``first_contact`` is the first visited time with boundary distance
-    <= ``lam`` (−1 if none); ``t_reached`` is how far the search got.
+    ``time_tol``; no penetration begins before ``t_lo``); ``first_contact`` is the first
+    visited time with boundary distance <= ``lam`` (−1 if none); ``t_reached`` is how
+    far the search got.
 
     Invariant: no penetration has been skipped before ``t`` (see
     :func:`polycontact.time_of_impact` for the argument). From a non-penetrating time
@@ -296,10 +244,12 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
       less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
       other body; any other penetration is still penetrating at ``t + tau``.
 
-    - after the first contact, before probing, :func:`_slide_step` tries the lines
-      through the touching pair: a step it certifies (the bodies stay on either side
-      of a line turning with one of them, up to ``eps``) is taken instead, so a
-      sliding contact is followed by long steps, not by probes.
+    - after the first contact the steps hold touching pairs to their edges' turning
+      lines (``touch = eps`` in :func:`pair_step`: no penetration beyond ``eps``
+      begins), and before probing :func:`_slide_step` tries the lines through the
+      touching pair as separators (the bodies stay on either side of a line turning
+      with one of them, up to ``eps``), so a sliding contact is followed by long
+      steps, not by probes.
 
     A penetrating state at the end of a probe is the hit, bracketed by the probe.
     """
