@@ -269,6 +269,13 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=200)
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
+    # Compile (or load) the kernels the way the README tells users to, first. The code
+    # Numba caches depends on the order: the sampled search measures 10-15% faster when
+    # it is compiled into an empty cache before the classifier than after it (as
+    # warmup(), the test suite or any classify call leaves it); the exact search does
+    # not change. Starting from warmup() makes the figures independent of what ran
+    # before; the README gives both.
+    pc.warmup()
     paper_cases(args.repeat)
     box2d_vs_exact(args.pairs, args.repeat)
 
