@@ -199,6 +199,18 @@ def _root_or_linear(g, r, k, speed, cap):
 
 
 @njit(cache=True, nogil=True)
+def outward_normal(ax, ay, bx, by):
+    """``(length, nx, ny)`` of edge ab and its unit outward normal (the interior is on
+    the edge's left, so the normal points right); the normal is (0, 0) for a point."""
+    ex = bx - ax
+    ey = by - ay
+    ln = np.sqrt(ex * ex + ey * ey)
+    if ln == 0.0:
+        return 0.0, 0.0, 0.0
+    return ln, ey / ln, -ex / ln
+
+
+@njit(cache=True, nogil=True)
 def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap, dax,
                day):
     """A time in [0, cap] during which vertex p stays more than ``level`` in front of the
@@ -213,13 +225,9 @@ def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, 
     most W_e·cap, which adds |Δa| W_e cap), so a body sliding along a still edge while
     it speeds up or slows down keeps long steps.
     """
-    ex = bx - ax
-    ey = by - ay
-    ln = np.sqrt(ex * ex + ey * ey)
+    ln, lx, ly = outward_normal(ax, ay, bx, by)
     if ln == 0.0:
         return 0.0
-    lx = ey / ln                         # interior on the left: outward on the right
-    ly = -ex / ln
     wx = px - cex
     wy = py - cey
     sp = kin[3] + kin[4] * rp

@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .advance import _line_time, edge_table, pair_step, traversal_stack, window_kinematics
+from .advance import (_line_time, edge_table, outward_normal, pair_step, traversal_stack,
+                      window_kinematics)
 from .broad_phase import overlap_intervals
 from .relation import _scratch, _state_in
 from .validate import closest_on_segment
@@ -115,13 +116,9 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
     ay = xe[j, 1]
     bx = xe[j1, 0]
     by = xe[j1, 1]
-    ex = bx - ax
-    ey = by - ay
-    ln = np.sqrt(ex * ex + ey * ey)
+    ln, nx, ny = outward_normal(ax, ay, bx, by)
     if ln == 0.0:
         return 0.0
-    nx = ey / ln                        # interior on the left: outward on the right
-    ny = -ex / ln
     for k in range(xe.shape[0]):
         if (xe[k, 0] - ax) * nx + (xe[k, 1] - ay) * ny > eps:
             return 0.0
