@@ -6,17 +6,20 @@ from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-# "default" for local runs (fresh random examples each run); "ci" is selected by .ci/run
-# and is derandomized, so a CI verdict can be reproduced exactly; "deep" draws many more
-# examples for a search before a release; "nojit" for the pure-Python run of the kernels
-# (NUMBA_DISABLE_JIT=1), which is slower, so it draws fewer examples.
+# "default" for local runs (fresh random examples each run); "ci" is selected by .ci/run,
+# which passes --hypothesis-seed derived from the commit: the same commit replays the same
+# examples (a CI verdict can be reproduced), a new commit draws new ones (no example set
+# is replayed forever); no example database, so nothing but the seed decides. "deep" draws
+# many more examples for a search before a release; "nojit" for the pure-Python run of the
+# kernels (NUMBA_DISABLE_JIT=1), which is slower, so it draws fewer examples. Tests that
+# need another count say so with profiles.examples(n), which scales with the profile.
 settings.register_profile(
     "default", max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
 settings.register_profile(
     "ci",
     max_examples=300,
-    derandomize=True,
+    database=None,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow],
 )

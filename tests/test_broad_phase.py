@@ -4,8 +4,9 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from profiles import examples
 
 from polycontact import Motion, Shape, broad_phase_intervals
 
@@ -73,7 +74,7 @@ def test_paper_case_2_interval_matches_the_paper():
 finite = st.floats(-3, 3, allow_nan=False)
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(st.tuples(finite, finite), st.tuples(finite, finite), st.tuples(finite, finite),
        st.tuples(finite, finite), st.tuples(st.floats(-8, 8), st.floats(-8, 8)))
 def test_intervals_match_dense_sampling(va, aa, vb, ab, offset):

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, note, settings
+from hypothesis import given, note
 from hypothesis import strategies as st
+from profiles import examples
 
 import polycontact as pc
 from polycontact.entrance import Element
@@ -212,14 +213,14 @@ def test_the_two_methods_give_the_same_region(a, b):
     assert pairs.area == pytest.approx(swept.area, rel=1e-9)
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_union_is_the_minkowski_sum(a, b):
     note_bodies(a, b)
     _same_region(pc.entrance_block(a, b).to_shapely(), _minkowski_reference(a, b, a.centroid))
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
     note_bodies(a, b)
@@ -237,7 +238,7 @@ def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
         assert comp.geometry.buffer(1e-9 * scale).covers(union)
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(bodies(max_vertices=7), bodies(max_vertices=7), st.data())
 def test_components_mean_what_their_features_say(a, b, data):
     note_bodies(a, b)

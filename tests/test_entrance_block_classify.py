@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
-from hypothesis import assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
+from profiles import examples
 from test_entrance_block import FRAME, NOTCHED_HOLE, SQUARE, bodies, note_bodies
 
 import polycontact as pc
@@ -19,7 +20,7 @@ def _shapely_state(a: pc.Shape, b: pc.Shape) -> str:
     return "contact" if pa.intersects(pb) else "separate"
 
 
-@settings(max_examples=80)
+@examples(80)
 @given(bodies(max_vertices=8), bodies(max_vertices=8), st.data())
 def test_classify_agrees_with_shapely_away_from_the_boundary(a, b, data):
     note_bodies(a, b)
@@ -48,7 +49,7 @@ def _nearly_parallel(a: pc.Shape, b: pc.Shape) -> bool:
     return bool(np.any((ang > 1e-12) & (ang < 1e-2)))
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(bodies(max_vertices=8), bodies(max_vertices=8))
 def test_classify_is_contact_on_the_boundary_of_the_block(a, b):
     note_bodies(a, b)

@@ -13,8 +13,9 @@ import math
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from profiles import examples
 
 import polycontact as pc
 from polycontact import ImpactStatus, Motion, Shape, State, time_of_impact
@@ -94,7 +95,7 @@ def random_motion(rng: np.random.Generator, toward: np.ndarray) -> Motion:
     )
 
 
-@settings(max_examples=25)
+@examples(25)
 @given(st.integers(0, 2**32 - 1))
 def test_random_concave_pairs_match_oracle(seed):
     rng = np.random.default_rng(seed)

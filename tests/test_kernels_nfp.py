@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 import shapely
 from catalogue import SMALL_FAR_RING
-from hypothesis import example, given, settings
+from hypothesis import example, given
 from hypothesis import strategies as st
+from profiles import examples
 
 from polycontact._kernels import decompose
 from polycontact._kernels import nfp as kn
@@ -38,7 +39,7 @@ def convex_polys(draw, grid=4):
     return np.asarray(hull.exterior.coords)[:-1].astype(float)
 
 
-@settings(max_examples=100)
+@examples(100)
 @given(convex_polys(), convex_polys())
 def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
     xy, starts = kn.convex_sums(*_packed([p]), *_packed([q]))
@@ -49,7 +50,7 @@ def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
     assert kn._ring_stats(xy, starts)[0][0] > 0  # counter-clockwise
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(st.lists(convex_polys(), min_size=2, max_size=4))
 def test_outline_rings_are_the_union(polys):
     xy, starts = _packed(polys)
@@ -111,7 +112,7 @@ def lattice_polygons(draw):
     return max(shapely.get_parts(geom), key=lambda g: g.area)
 
 
-@settings(max_examples=60)
+@examples(60)
 @given(lattice_polygons())
 @example(shapely.Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]]))
 def test_convex_pieces_tile_the_polygon(poly):
@@ -133,7 +134,7 @@ def test_is_convex():
     assert not decompose.is_convex(np.array([[0, 0], [2, 0], [1, 0.5], [1, 2]], float))
 
 
-@settings(max_examples=80)
+@examples(80)
 @given(lattice_polygons())
 @example(shapely.Polygon([(0, 0), (2, 0), (4, 0), (4, 1), (2, 1), (2, 3), (0, 3), (0, 1)]))
 def test_ear_triangles_tile_a_simple_polygon(poly):

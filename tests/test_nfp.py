@@ -10,8 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
-from hypothesis import assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
+from profiles import examples
 from nfp_reference import hole_count, reference_region, same_region
 
 import polycontact as pc
@@ -232,7 +233,7 @@ def grid_shapes(draw, size=4):
         assume(False)
 
 
-@settings(max_examples=150)
+@examples(150)
 @given(star_shapes(), star_shapes())
 def test_random_concave_with_holes_against_reference(a, b):
     nfp = pc.no_fit_polygon(a, b)
@@ -240,7 +241,7 @@ def test_random_concave_with_holes_against_reference(a, b):
     assert same_region(nfp.region, ref) is None
 
 
-@settings(max_examples=200)
+@examples(200)
 @given(grid_shapes(), grid_shapes())
 def test_grid_shapes_against_reference_and_lattice(a, b):
     nfp = pc.no_fit_polygon(a, b, reference="origin")
@@ -311,7 +312,7 @@ def test_inner_fit_rectangle_in_bin():
     assert pc.inner_fit_polygon([(0, 0), (11, 0), (11, 1)], bin_).is_empty
 
 
-@settings(max_examples=80)
+@examples(80)
 @given(grid_shapes(size=3), grid_shapes(size=5))
 def test_inner_fit_against_brute_force(a, container):
     ifp = pc.inner_fit_polygon(a, container, reference="origin")

@@ -7,8 +7,9 @@ import pytest
 import shapely
 import shapely.affinity
 from catalogue import CASES, boundary_gap, pairs, shapely_state, shifted, translated
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from profiles import examples
 
 from polycontact import Shape, State, classify, classify_many
 
@@ -112,7 +113,7 @@ def _escape_along(a: Shape, b: Shape, directions: np.ndarray, t_max: float) -> n
     return hi
 
 
-@settings(max_examples=15)
+@examples(15)
 @given(pairs(n_max=7, holes=False))
 def test_depth_against_brute_force(pair):
     a, b, _ = pair
@@ -163,7 +164,7 @@ def test_array_path_matches_shape_path(pair, flip_a, close_b):
     np.testing.assert_array_equal(xb, before[1])
 
 
-@settings(max_examples=30)
+@examples(30)
 @given(st.lists(pairs(), min_size=1, max_size=12))
 def test_classify_many_matches_classify(many):
     shapes_a = [p[0] for p in many]

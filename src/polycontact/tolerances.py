@@ -1,5 +1,24 @@
 """Named tolerances, each with the reason for its value.
 
+The default distance tolerance follows the **size of the bodies** and the **float
+spacing of their coordinates**, never an absolute constant:
+
+    eps = max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * 2**-52 * magnitude)
+
+where ``extent`` is the size of the largest body involved (the larger side of its
+bounding box) and ``magnitude`` the largest absolute coordinate involved. The first
+term is what a user means by "the same place" (a shift of 1e-9 of a body's size is
+seen as a shift, at any scale); the second keeps the tolerance above the rounding of
+the few operations that produce and compare coordinates (a translation, a rotation, a
+difference of two coordinates) when small bodies sit far from the origin. Lengths are
+compared with ``eps``; areas with ``eps * length``.
+
+Coordinates must lie in ``[-COORDINATE_LIMIT, COORDINATE_LIMIT]`` and every body must
+be larger than ``EXTENT_FLOOR``: the kernels form products of up to three coordinate
+differences (areas, centroids, Minkowski sums), which would overflow or underflow
+float64 beyond these bounds. Inputs outside them are refused with an error that says
+so; they are never answered wrongly.
+
 Tolerances are always passed to kernels as arguments (Numba freezes module globals at
 compile time), so these constants are only defaults read by the public functions.
 """
@@ -8,26 +27,74 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["RELATIVE_TOLERANCE", "default_tolerance"]
+__all__ = [
+    "RELATIVE_TOLERANCE",
+    "ROUNDING_ULPS",
+    "COORDINATE_LIMIT",
+    "EXTENT_FLOOR",
+    "tolerance_for",
+    "default_tolerance",
+]
 
-#: Distances below ``RELATIVE_TOLERANCE * scale`` count as zero, where ``scale`` is the
-#: largest absolute coordinate involved (at least 1). 1e-12 is about 4500 units in the
-#: last place of a float64 coordinate: far above the rounding of the few arithmetic
-#: operations that produce the inputs (a translation, a rotation), and far below any gap
-#: a user means: a shift of 1e-9 of a shape's size is still seen as a shift.
+#: Relative to the size of the bodies: 1e-12 of a body's extent counts as zero. Far
+#: below any gap a user means (a shift of 1e-9 of a body's size is seen, 1000 times
+#: the tolerance), far above the rounding of arithmetic on coordinates of that size.
 RELATIVE_TOLERANCE = 1e-12
 
+#: Relative to the float spacing of the coordinates: 64 units in the last place of the
+#: largest |coordinate| (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
+#: small body far from the origin moves its vertices by rounding errors of a few ulps
+#: of its coordinates; 64 ulps is well above that and still resolves 1e-4 at 1e9.
+ROUNDING_ULPS = 64.0
 
-def default_tolerance(*coordinate_arrays: np.ndarray) -> float:
+#: Largest |coordinate| accepted. Products of three coordinate differences (up to
+#: (2e100)**3 = 8e300) stay finite in float64 (max ~1.8e308).
+COORDINATE_LIMIT = 1e100
+
+#: Smallest body extent accepted: products of three lengths (1e-300) stay normal floats.
+EXTENT_FLOOR = 1e-100
+
+_ULP = 2.0**-52
+
+
+def tolerance_for(extent: float, magnitude: float) -> float:
+    """The absolute tolerance for bodies of size ``extent`` whose coordinates reach
+    ``magnitude`` (both >= 0): ``max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS *
+    2**-52 * magnitude)``.
+
+    Examples
+    --------
+    >>> tolerance_for(1.0, 1.0)                  # a unit body at the origin
+    1e-12
+    >>> f"{tolerance_for(1e-6, 1e-6):.3g}"       # the same body scaled to a micrometre
+    '1e-18'
+    >>> round(tolerance_for(1.0, 1e9) / 1e-6, 3)  # a unit body at 1e9: the float spacing
+    14.211
+    """
+    return max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * _ULP * magnitude)
+
+
+def default_tolerance(*bodies: np.ndarray) -> float:
     """The absolute tolerance used when the caller gives none.
+
+    Each argument is the (N, 2) coordinate array of one body (or one loop of it):
+    ``extent`` is the largest side of any argument's own bounding box, so two unit
+    bodies far apart keep a tolerance of their size, and ``magnitude`` the largest
+    absolute coordinate of all. See :func:`tolerance_for`.
 
     Examples
     --------
     >>> default_tolerance(np.array([[0.0, 0.0], [300.0, -5.0]]))
     3e-10
+    >>> default_tolerance(np.array([[0.0, 0.0], [1e-5, 1e-5]]))
+    1e-17
     """
-    scale = 1.0
-    for xy in coordinate_arrays:
+    extent = 0.0
+    magnitude = 0.0
+    for xy in bodies:
         if len(xy):
-            scale = max(scale, float(np.max(np.abs(xy))))
-    return RELATIVE_TOLERANCE * scale
+            lo = xy.min(axis=0)
+            hi = xy.max(axis=0)
+            extent = max(extent, float(hi[0] - lo[0]), float(hi[1] - lo[1]))
+            magnitude = max(magnitude, float(-lo.min()), float(hi.max()))
+    return tolerance_for(extent, magnitude)
