@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import InvalidShapeError
+
 __all__ = [
     "RELATIVE_TOLERANCE",
     "ROUNDING_ULPS",
@@ -34,6 +36,7 @@ __all__ = [
     "EXTENT_FLOOR",
     "tolerance_for",
     "default_tolerance",
+    "check_range",
 ]
 
 #: Relative to the size of the bodies: 1e-12 of a body's extent counts as zero. Far
@@ -98,3 +101,35 @@ def default_tolerance(*bodies: np.ndarray) -> float:
             extent = max(extent, float(hi[0] - lo[0]), float(hi[1] - lo[1]))
             magnitude = max(magnitude, float(-lo.min()), float(hi.max()))
     return tolerance_for(extent, magnitude)
+
+
+def check_range(xy: np.ndarray, what: str) -> None:
+    """Refuse coordinates that float64 cannot carry through the kernels.
+
+    ``xy`` is a finite float64 (N, 2) array of one body (or loop), ``what`` names it in
+    the error. Raises :class:`polycontact.InvalidShapeError` if some |coordinate|
+    exceeds :data:`COORDINATE_LIMIT` or the body's extent is below :data:`EXTENT_FLOOR`
+    (and not zero: a zero extent is a degenerate ring, refused elsewhere).
+
+    Examples
+    --------
+    >>> check_range(np.array([[0.0, 0.0], [1.0, 1.0]]), "a")
+    >>> check_range(np.array([[0.0, 0.0], [1e200, 1.0]]), "a")
+    Traceback (most recent call last):
+    ...
+    polycontact.errors.InvalidShapeError: a: coordinate 1e+200 of vertex 1 is beyond ±1e+100: products of coordinates would overflow float64
+    """
+    big = np.abs(xy) > COORDINATE_LIMIT
+    if big.any():
+        i, j = (int(k) for k in np.argwhere(big)[0])
+        raise InvalidShapeError(
+            f"{what}: coordinate {xy[i, j]:g} of vertex {i} is beyond ±{COORDINATE_LIMIT:g}: "
+            "products of coordinates would overflow float64"
+        )
+    if len(xy):
+        extent = float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+        if 0.0 < extent < EXTENT_FLOOR:
+            raise InvalidShapeError(
+                f"{what}: extent {extent:g} is below {EXTENT_FLOOR:g}: products of its "
+                "lengths would underflow float64 (scale the coordinates up)"
+            )
