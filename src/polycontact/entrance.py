@@ -50,17 +50,20 @@ FAMILIES = {"A2-B0": "A2-B0", "A0-B2": "A0-B2", "A1e-B1f": "A1-B1", "A1-B1f": "A
 class Element(NamedTuple):
     """One vertex or edge of a body: ``body`` "a" or "b", ``kind`` "vertex" or "edge".
 
-    ``loop`` and ``index`` are 0-based into ``Shape.loops``; edge k joins vertex k and
-    vertex k + 1 of its loop.
+    ``loop`` and ``index`` are 0-based in the caller's numbering (the vertices as passed,
+    whatever their orientation; see :meth:`polycontact.Shape.input_vertex`); edge k joins
+    vertex k and vertex k + 1 of its loop. They are None for a vertex or edge that
+    ``repair=True`` created.
     """
 
     body: str
     kind: str
-    loop: int
-    index: int
+    loop: int | None
+    index: int | None
 
     def __str__(self) -> str:
-        where = "" if self.loop == 0 else f" of hole {self.loop - 1}"
+        where = ("" if self.loop == 0 else " of a loop made by the repair"
+                 if self.loop is None else f" of hole {self.loop - 1}")
         return f"{self.body.upper()} {self.kind} {self.index}{where}"
 
 
@@ -303,7 +306,7 @@ def _vertex_of_b_in_a(a: Shape, b: Shape, a0: np.ndarray) -> tuple[Component, ..
     geoms = _translated_polygons(reflected, b.packed[0])
     return tuple(
         Component("A2-B0", (Element("b", "vertex", k, i),), g)
-        for (k, i), g in zip(_indices(b), geoms)
+        for (k, i), g in zip(_indices(b, "vertex"), geoms)
     )
 
 
@@ -312,7 +315,7 @@ def _vertex_of_a_in_b(a: Shape, b: Shape, a0: np.ndarray) -> tuple[Component, ..
     geoms = _translated_polygons(list(b.loops), a0 - a.packed[0])
     return tuple(
         Component("A0-B2", (Element("a", "vertex", k, j),), g)
-        for (k, j), g in zip(_indices(a), geoms)
+        for (k, j), g in zip(_indices(a, "vertex"), geoms)
     )
 
 
@@ -327,7 +330,7 @@ def _edge_pairs(a: Shape, b: Shape, a0: np.ndarray, eps: float) -> tuple[Compone
         axis=2,
     ) + a0
     geoms = _parallelograms(corners.reshape(-1, 4, 2), eps)
-    ia, ib = _indices(a), _indices(b)
+    ia, ib = _indices(a, "edge"), _indices(b, "edge")
     return tuple(
         Component(
             "A1e-B1f",
@@ -345,7 +348,7 @@ def _swept(a: Shape, b: Shape, a0: np.ndarray, eps: float) -> tuple[Component, .
     reflected = [a0 - loop for loop in a.loops]
     f0, f1 = _edges(b)
     comps = []
-    for (k, i), start, end in zip(_indices(b), f0, f1):
+    for (k, i), start, end in zip(_indices(b, "edge"), f0, f1):
         areas, segments = zip(*(_swept_loop(loop + start, end - start, eps) for loop in reflected))
         area = areas[0] if len(areas) == 1 else shapely.union_all(areas, grid_size=_grid(eps))
         lines = [g for group in segments for g in group]
@@ -402,9 +405,12 @@ def _splice(loop: np.ndarray, v: np.ndarray) -> np.ndarray | None:
 
 
 # -- helpers ---------------------------------------------------------------------------
-def _indices(s: Shape) -> list[tuple[int, int]]:
-    """(loop, index) for every vertex (and so every edge) of ``s``, packed order."""
-    return [(k, i) for k, loop in enumerate(s.loops) for i in range(len(loop))]
+def _indices(s: Shape, kind: str) -> list[tuple[int | None, int | None]]:
+    """(loop, index) in the caller's numbering of every vertex or edge of ``s``, in
+    packed (stored) order."""
+    index = s.input_vertex if kind == "vertex" else s.input_edge
+    return [(s.input_loop(k), index(k, i)) for k, loop in enumerate(s.loops)
+            for i in range(len(loop))]
 
 
 def _edges(s: Shape) -> tuple[np.ndarray, np.ndarray]:

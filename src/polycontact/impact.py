@@ -108,7 +108,8 @@ class Impact:
         How far in time the search got (t_max when it finished).
     features : tuple of Feature
         At the touching configuration: which vertex of which body meets which edge of
-        the other (0-based indices into ``Shape.loops``, body "a" or "b").
+        the other (body "a" or "b"; 0-based indices in the caller's numbering, the
+        vertices as passed, see :class:`polycontact.Feature`).
     point : ndarray of shape (2,) or None
         Contact point at the moment of impact (or of first contact).
     normal : ndarray of shape (2,) or None

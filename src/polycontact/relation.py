@@ -51,12 +51,18 @@ _STATES = (State.SEPARATE, State.CONTACT, State.PENETRATING)
 class Feature:
     """One way the two boundaries meet.
 
+    Every index is 0-based and in the caller's numbering: the position in the vertices
+    as passed (a closing point and repeated points counted), whatever orientation they
+    were given in; edge ``k`` joins vertex ``k`` and vertex ``k + 1`` (mod the number
+    passed) of its loop. For a shape built with ``repair=True`` an index is None where
+    the repair created the vertex or edge (see :meth:`Shape.input_vertex`).
+
     Attributes
     ----------
     body : str
         ``"a"`` or ``"b"``: the body that owns ``vertex`` (and ``own_edge``).
     loop : int
-        Loop of ``body`` (0 outer, 1.. holes, as in :attr:`Shape.loops`).
+        Loop of ``body``: 0 the outer loop, 1.. the holes in the order given.
     vertex : int or None
         Vertex of ``body``; None for ``"edges-cross"``.
     other_loop : int
@@ -72,13 +78,19 @@ class Feature:
         ``body="a"``).
     own_edge : int or None
         For ``"edges-cross"``, the crossing edge of ``body``; otherwise None.
+
+    Examples
+    --------
+    >>> cw = [(0, 0), (0, 1), (1, 1), (1, 0)]       # clockwise: stored reversed
+    >>> classify(cw, [(1, 0.5), (2, 0), (2, 1)]).features
+    (Feature(body='b', loop=0, vertex=0, other_loop=0, edge=2, kind='vertex-on-edge', own_edge=None),)
     """
 
     body: str
-    loop: int
+    loop: int | None
     vertex: int | None
-    other_loop: int
-    edge: int
+    other_loop: int | None
+    edge: int | None
     kind: str
     own_edge: int | None = None
 
@@ -102,7 +114,7 @@ class Relation:
     features : tuple of Feature
         Every vertex within the tolerance of the other boundary, every vertex strictly
         inside the other body, every proper edge crossing (A's vertices first, then
-        B's, then crossings).
+        B's, then crossings), numbered as the caller gave the vertices.
     point : ndarray of shape (2,) or None
         A witness point. Contact: a touching vertex (the one of the first feature).
         Penetrating: the crossing point of the first edge crossing if there is one,
@@ -128,7 +140,8 @@ class Relation:
 
     @cached_property
     def shapes(self) -> tuple[Shape, Shape]:
-        """The two bodies as oriented :class:`Shape` objects (indices refer to these)."""
+        """The two bodies as oriented :class:`Shape` objects (their ``input_vertex`` and
+        ``input_edge`` map the stored order to the caller's, used by the features)."""
         return _to_shape(self._pair[0]), _to_shape(self._pair[1])
 
     @cached_property
@@ -174,20 +187,20 @@ class Relation:
     def features(self) -> tuple[Feature, ...]:
         """Every feature of the meeting (see the class docstring)."""
         a, b = self.shapes
-        sa = a.packed[1]
-        sb = b.packed[1]
         a_on, b_on, a_in, b_in, cross = self._raw_features
         out: list[Feature] = []
-        for body, own, other, on, inside in (("a", sa, sb, a_on, a_in), ("b", sb, sa, b_on, b_in)):
+        for body, own, other, on, inside in (("a", a, b, a_on, a_in), ("b", b, a, b_on, b_in)):
             for kind, rows in (("vertex-on-edge", on), ("vertex-inside", inside)):
                 for v, e, _ in rows:
-                    k, vi = _local(own, v)
-                    ko, ei = _local(other, e)
-                    out.append(Feature(body, k, vi, ko, ei, kind))
+                    k, vi = _local(own.packed[1], v)
+                    ko, ei = _local(other.packed[1], e)
+                    out.append(Feature(body, own.input_loop(k), own.input_vertex(k, vi),
+                                       other.input_loop(ko), other.input_edge(ko, ei), kind))
         for e, f, _, _ in cross:
-            k, ei = _local(sa, e)
-            ko, fi = _local(sb, f)
-            out.append(Feature("a", k, None, ko, fi, "edges-cross", ei))
+            k, ei = _local(a.packed[1], e)
+            ko, fi = _local(b.packed[1], f)
+            out.append(Feature("a", a.input_loop(k), None, b.input_loop(ko),
+                               b.input_edge(ko, fi), "edges-cross", a.input_edge(k, ei)))
         return tuple(out)
 
     @cached_property
@@ -257,7 +270,13 @@ def _to_shape(src: Any) -> Shape:
     raw, n, sign = src  # the bytes of a C-contiguous float64 (N, 2) ring, copied at call
     arr = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
     ring = arr[:n] if sign > 0 else arr[:n][::-1]
-    return Shape._trusted([np.array(ring, dtype=np.float64)])
+    # The caller's numbering: only a closing point was dropped (it is the caller's
+    # vertex n, so edge n - 1 ends there), and the ring was reversed if clockwise.
+    index = np.arange(n, dtype=np.int64)
+    edge = index if sign > 0 else np.roll(index[::-1], -1)
+    vertex = index if sign > 0 else index[::-1]
+    inputs = (np.zeros(1, dtype=np.int64), np.ascontiguousarray(np.stack([vertex, edge], axis=1)))
+    return Shape._trusted([np.array(ring, dtype=np.float64)], inputs=inputs)
 
 
 def _check_tolerance(tolerance: Any) -> float:

@@ -5,9 +5,12 @@ fixed world frame, x to the right and y up; angles are radians, counter-clockwis
 positive. Outer loops are stored counter-clockwise and holes clockwise, whatever order
 the caller gave, so "interior on the left" holds for every edge. Loop 0 is the outer
 loop, loops 1.. are the holes in the order given. Vertex and edge indices are 0-based;
-edge ``k`` of a loop joins its vertex ``k`` and vertex ``(k + 1) % n``. If a loop had to
-be reversed, the indices refer to the stored (reversed) order: see
-:attr:`Shape.loops`.
+edge ``k`` of a loop joins its vertex ``k`` and vertex ``(k + 1) % n``. Indices that
+leave the library (features, entrance-block elements, the command line) are in the
+caller's numbering, the order of the vertices as passed, whatever the stored orientation
+and with repeated or closing points counted; :meth:`Shape.input_vertex`,
+:meth:`Shape.input_edge` and :meth:`Shape.input_loop` map the stored order
+(:attr:`Shape.loops`) to it.
 """
 
 from __future__ import annotations
@@ -78,8 +81,9 @@ class Shape:
         Hole loops, closed or not, in either orientation.
     repair : bool, default False
         If the loops are invalid, try ``shapely.make_valid`` and keep the result when it
-        is a single polygon; :attr:`repairs` then says what changed (vertex indices
-        refer to the repaired loops).
+        is a single polygon; :attr:`repairs` then says what changed. Indices still
+        refer to the caller's vertices where the repaired loops keep them; a vertex or
+        edge the repair created has none (see :meth:`input_vertex`).
 
     Raises
     ------
@@ -100,7 +104,7 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame")
+                 "_frame", "_input")
 
     def __init__(
         self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
@@ -113,18 +117,35 @@ class Shape:
         try:
             loops = [_clean_ring(vertices, "outer loop")]
             loops += [_clean_ring(h, f"hole {i}") for i, h in enumerate(holes)]
+            given = list(loops)
             self._init_from_loops(loops, repairs=())
         except InvalidShapeError as exc:
             if not repair:
                 raise
             self._init_repaired(vertices, holes, str(exc))
+            return
+        self._input = _input_maps(
+            [vertices, *holes], [not np.array_equal(g, r) for g, r in zip(given, self._loops)]
+        )
 
     # -- construction -------------------------------------------------------------
     @classmethod
-    def _trusted(cls, loops: Sequence[np.ndarray], repairs: tuple[str, ...] = ()) -> Shape:
-        """Build from loops already oriented and valid (e.g. a rigid motion of a Shape)."""
+    def _trusted(
+        cls,
+        loops: Sequence[np.ndarray],
+        repairs: tuple[str, ...] = (),
+        inputs: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> Shape:
+        """Build from loops already oriented and valid (e.g. a rigid motion of a Shape).
+
+        ``inputs`` is the map to the caller's numbering (``_input`` of the shape moved);
+        None means the loops are in the caller's numbering already.
+        """
         self = cls.__new__(cls)
         self._set(loops, repairs)
+        if inputs is None:
+            inputs = _identity_map(self._starts)
+        self._input = inputs
         return self
 
     def _set(self, loops: Sequence[np.ndarray], repairs: tuple[str, ...]) -> None:
@@ -204,6 +225,7 @@ class Shape:
         if lost is not None:
             note += f", area changed by {lost:g}"
         self._init_from_loops(loops, repairs=(note,))
+        self._input = _repaired_maps(self, [vertices, *holes])
 
     # -- properties ---------------------------------------------------------------
     @property
@@ -218,8 +240,62 @@ class Shape:
 
     @property
     def loops(self) -> tuple[np.ndarray, ...]:
-        """Every loop, outer first: loop index k in features refers to this tuple."""
+        """Every loop, outer first, as stored (outer counter-clockwise, holes clockwise,
+        repeated and closing points dropped). Its indices are the stored numbering; the
+        features report the caller's (see :meth:`input_vertex`)."""
         return self._loops
+
+    def input_loop(self, loop: int) -> int | None:
+        """The caller's index of stored loop ``loop``: the same index (0 the outer loop,
+        1.. the holes in the order given), or None for a loop that ``repair=True`` made
+        and that holds none of the caller's vertices.
+
+        Examples
+        --------
+        >>> Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (2, 1), (2, 2)]]).input_loop(1)
+        1
+        """
+        k = int(self._input[0][loop])
+        return None if k < 0 else k
+
+    def input_vertex(self, loop: int, i: int) -> int | None:
+        """The caller's index of stored vertex ``i`` of loop ``loop``.
+
+        That is its position in the vertices as passed (0-based, repeated and closing
+        points counted), whatever the stored orientation; None for a vertex that
+        ``repair=True`` created (where the repair cut an edge).
+
+        Examples
+        --------
+        >>> sq = Shape([(0, 0), (0, 2), (2, 2), (2, 0), (0, 0)])  # clockwise, closed
+        >>> sq.exterior[0].tolist(), sq.input_vertex(0, 0), sq.input_vertex(0, 3)
+        ([2.0, 0.0], 3, 0)
+        """
+        return self._lookup(loop, i, 0)
+
+    def input_edge(self, loop: int, i: int) -> int | None:
+        """The caller's index of stored edge ``i`` of loop ``loop``.
+
+        Stored edge ``i`` joins stored vertices ``i`` and ``i + 1``; the answer ``k`` is
+        the caller's edge joining their vertices ``k`` and ``k + 1`` (mod the number of
+        vertices passed) that holds it: where repeated points were dropped, the one edge
+        of non-zero length between them. None for an edge that ``repair=True`` made and
+        that lies on no single edge of the caller's.
+
+        Examples
+        --------
+        >>> sq = Shape([(0, 0), (0, 2), (2, 2), (2, 0)])          # clockwise
+        >>> sq.exterior[0].tolist(), sq.exterior[1].tolist(), sq.input_edge(0, 0)
+        ([2.0, 0.0], [2.0, 2.0], 2)
+        """
+        return self._lookup(loop, i, 1)
+
+    def _lookup(self, loop: int, i: int, column: int) -> int | None:
+        n = int(self._starts[loop + 1] - self._starts[loop])
+        if not 0 <= i < n:
+            raise IndexError(f"index {i} is out of range for loop {loop} of {n} vertices")
+        k = int(self._input[1][self._starts[loop] + i, column])
+        return None if k < 0 else k
 
     @property
     def packed(self) -> tuple[np.ndarray, np.ndarray]:
@@ -263,6 +339,7 @@ class Shape:
         return Shape._trusted(
             [xy[self._starts[k] : self._starts[k + 1]] for k in range(len(self._loops))],
             self.repairs,
+            self._input,
         )
 
     def at(self, motion: Any, t: float) -> Shape:
@@ -364,6 +441,94 @@ def as_shape(obj: Any, what: str = "shape") -> Shape:
         return Shape(obj)
     except InvalidShapeError as exc:
         raise InvalidShapeError(f"{what}: {exc}") from None
+
+
+def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The map of loops already in the caller's numbering (see :func:`_input_maps`)."""
+    local = np.arange(int(starts[-1]), dtype=np.int64) - np.repeat(starts[:-1], np.diff(starts))
+    return (_frozen(np.arange(len(starts) - 1)), _frozen(np.stack([local, local], axis=1)))
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=np.int64)
+    a.flags.writeable = False
+    return a
+
+
+def _ring_map(raw: np.ndarray, reverse: bool) -> np.ndarray:
+    """(n, 2): the caller's vertex and edge index of each stored vertex and edge of a ring.
+
+    ``raw`` is the ring as passed (float64, already validated by :func:`_clean_ring`); the
+    stored ring drops its consecutive repeats and closing points, and is reversed when
+    ``reverse``. A stored vertex is the first vertex of its run of repeats; a stored edge
+    is the caller's edge from the last vertex of one run to the first of the next.
+    """
+    keep = np.ones(len(raw), dtype=bool)
+    keep[1:] = np.any(raw[1:] != raw[:-1], axis=1)
+    first = np.flatnonzero(keep)
+    end = len(raw)
+    if len(first) > 1 and np.all(raw[first[-1]] == raw[0]):  # closing point(s)
+        end = int(first[-1])
+        first = first[:-1]
+    vertex = first
+    edge = np.append(first[1:], end) - 1
+    if reverse:
+        vertex = vertex[::-1]
+        edge = np.roll(edge[::-1], -1)
+    return np.stack([vertex, edge], axis=1)
+
+
+def _input_maps(rings: Sequence[ArrayLike], reversed_: Sequence[bool]) -> tuple:
+    """``(loop map, packed (n, 2) vertex and edge map)`` of loops built from ``rings``."""
+    maps = [_ring_map(np.asarray(r, dtype=np.float64), rev) for r, rev in zip(rings, reversed_)]
+    return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
+
+
+def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple:
+    """The map of a repaired shape to the caller's ``rings``.
+
+    A stored loop belongs to the caller's loop that shares most of its vertices; a stored
+    vertex is the first caller's vertex of that loop at the same coordinates; a stored
+    edge is the caller's edge, next to a vertex at one of its ends, that holds both ends
+    within the tolerance. What the repair created maps to -1.
+    """
+    raws = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
+    where: list[dict[tuple[float, float], list[int]]] = []
+    for raw in raws:
+        found: dict[tuple[float, float], list[int]] = {}
+        for c, p in enumerate(map(tuple, raw.tolist())):
+            found.setdefault(p, []).append(c)
+        where.append(found)
+    eps = default_tolerance(*raws, shape.packed[0])
+    loop_map = []
+    rows = []
+    for ring in shape.loops:
+        pts = list(map(tuple, ring.tolist()))
+        hits = [sum(p in found for p in pts) for found in where]
+        k = int(np.argmax(hits)) if hits and max(hits) > 0 else -1
+        loop_map.append(k)
+        rows.append(np.full((len(ring), 2), -1, dtype=np.int64))
+        if k < 0:
+            continue
+        raw, found, n = raws[k], where[k], len(raws[k])
+        for i, p in enumerate(pts):
+            rows[-1][i, 0] = found.get(p, [-1])[0]
+            q = pts[(i + 1) % len(pts)]
+            near = {(c + d) % n for c in found.get(p, []) + found.get(q, []) for d in (-1, 0)}
+            for c in sorted(near):
+                s, e = raw[c], raw[(c + 1) % n]
+                if np.any(s != e) and max(_to_segment(ring[i], s, e),
+                                           _to_segment(ring[(i + 1) % len(ring)], s, e)) <= eps:
+                    rows[-1][i, 1] = c
+                    break
+    return _frozen(np.array(loop_map)), _frozen(np.concatenate(rows))
+
+
+def _to_segment(p: np.ndarray, s: np.ndarray, e: np.ndarray) -> float:
+    """Distance from point ``p`` to the segment from ``s`` to ``e`` (not a point)."""
+    u = e - s
+    t = min(1.0, max(0.0, float(np.dot(p - s, u)) / float(np.dot(u, u))))
+    return float(np.hypot(*(s + t * u - p)))
 
 
 def _fmt(v: float) -> str:
