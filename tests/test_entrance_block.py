@@ -105,9 +105,11 @@ def test_holes_contribute_vertices_and_edges():
         kinds = [c.kind for c in eb.components]
         assert kinds.count("A2-B0") == 10 and kinds.count("A0-B2") == 6
         assert len(eb.of_family("A1-B1")) == n_edge
-        hole_vertex = eb.components[4 + 2]  # B loop 1 (the hole), vertex 2
-        assert hole_vertex.features == (Element("b", "vertex", 1, 2),)
-        assert str(hole_vertex.features[0]) == "B vertex 2 of hole 0"
+        # B loop 1 (the hole, given counter-clockwise, stored reversed): stored vertex 2
+        # is vertex 3 as given
+        hole_vertex = eb.components[4 + 2]
+        assert hole_vertex.features == (Element("b", "vertex", 1, 3),)
+        assert str(hole_vertex.features[0]) == "B vertex 3 of hole 0"
     # A with a hole: E(A(2), B(0)_i) is A reflected, hole included
     eb = pc.entrance_block(b, a, reference=(0.0, 0.0))
     first = eb.components[0].geometry
@@ -255,10 +257,10 @@ def test_components_mean_what_their_features_say(a, b, data):
                     continue  # too close to call in floating point
                 feat = c.features
                 if c.kind == "A2-B0":
-                    meets = moved.to_shapely().intersects(shapely.Point(b.loops[feat[0].loop][feat[0].index]))
+                    meets = moved.to_shapely().intersects(shapely.Point(_vertex(b, feat[0])))
                 elif c.kind == "A0-B2":
                     meets = b.to_shapely().intersects(
-                        shapely.Point(moved.loops[feat[0].loop][feat[0].index]))
+                        shapely.Point(_vertex(moved, feat[0])))
                 elif c.kind == "A1e-B1f":
                     meets = _edge(moved, feat[0]).intersects(_edge(b, feat[1]))
                 else:
@@ -272,6 +274,19 @@ def _outline(geom: shapely.Geometry) -> shapely.Geometry:
     return shapely.union_all([p.boundary if p.geom_type == "Polygon" else p for p in parts])
 
 
+def _stored(s: pc.Shape, el: Element) -> int:
+    """The stored index of an element given in the caller's numbering."""
+    index = s.input_vertex if el.kind == "vertex" else s.input_edge
+    found = [i for i in range(len(s.loops[el.loop])) if index(el.loop, i) == el.index]
+    assert len(found) == 1, el
+    return found[0]
+
+
+def _vertex(s: pc.Shape, el: Element) -> np.ndarray:
+    return s.loops[el.loop][_stored(s, el)]
+
+
 def _edge(s: pc.Shape, el: Element) -> shapely.LineString:
     loop = s.loops[el.loop]
-    return shapely.LineString([loop[el.index], loop[(el.index + 1) % len(loop)]])
+    i = _stored(s, el)
+    return shapely.LineString([loop[i], loop[(i + 1) % len(loop)]])

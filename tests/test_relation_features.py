@@ -96,13 +96,16 @@ def test_features_consistent_with_state(pair):
     elif r.state is State.CONTACT:
         assert kinds == {"vertex-on-edge"}
     for f in r.features:
+        # the features are in the numbering the shapes were built with: map them back
         own, other = (a, b) if f.body == "a" else (b, a)
         assert 0 <= f.loop < len(own.loops) and 0 <= f.other_loop < len(other.loops)
-        assert 0 <= f.edge < len(other.loops[f.other_loop])
+        loop = other.loops[f.other_loop]
+        stored = [i for i in range(len(loop)) if other.input_edge(f.other_loop, i) == f.edge]
+        assert len(stored) == 1
         if f.kind == "vertex-on-edge":
-            loop = other.loops[f.other_loop]
-            p, q = loop[f.edge], loop[(f.edge + 1) % len(loop)]
-            v = own.loops[f.loop][f.vertex]
+            p, q = loop[stored[0]], loop[(stored[0] + 1) % len(loop)]
+            mine = own.loops[f.loop]
+            v = mine[[own.input_vertex(f.loop, i) for i in range(len(mine))].index(f.vertex)]
             t = np.clip(np.dot(v - p, q - p) / np.dot(q - p, q - p), 0, 1)
             assert np.hypot(*(p + t * (q - p) - v)) <= r.tolerance
 
