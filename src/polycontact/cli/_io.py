@@ -68,3 +68,13 @@ def positive_number(text: str) -> float:
 def non_negative_number(text: str) -> float:
     """argparse type: a finite number >= 0."""
     return _number_option(text, zero_allowed=True)
+
+
+def index_text(index: int | None) -> str:
+    """A vertex, edge or loop number as printed: the file's number, or a note for one
+    that ``--repair`` created (it has none in the file).
+
+    >>> index_text(3), index_text(None)
+    ('3', '(new, made by --repair)')
+    """
+    return "(new, made by --repair)" if index is None else str(index)

@@ -7,7 +7,7 @@ import json
 import sys
 from typing import Any
 
-from ._io import non_negative_number, read_shape
+from ._io import index_text, non_negative_number, read_shape
 
 
 def add_parser(subparsers: Any) -> None:
@@ -16,7 +16,9 @@ def add_parser(subparsers: Any) -> None:
         help="whether two bodies are separate, in contact or penetrating",
         description="Classify two bodies where they stand: separate, contact (touching, "
         "interiors disjoint) or penetrating (interiors overlap). Each file is a JSON "
-        'body {"vertices": [[x, y], ...], "holes": [...]}, a GeoJSON Polygon or WKT.',
+        'body {"vertices": [[x, y], ...], "holes": [...]}, a GeoJSON Polygon or WKT. '
+        "Vertex and edge numbers are 0-based, in the order of the vertices in the file "
+        "(edge k joins vertex k and k + 1), whatever their orientation.",
     )
     p.add_argument("a", metavar="A.json", help="first body (A)")
     p.add_argument("b", metavar="B.json", help="second body (B)")
@@ -54,13 +56,15 @@ def relation_text(rep: dict) -> list[str]:
              "features:" if rep["features"] else "features: none"]
     for f in rep["features"]:
         other = "b" if f["body"] == "a" else "a"
+        n = {k: index_text(f.get(k)) for k in ("vertex", "loop", "edge", "other_loop",
+                                                 "own_edge")}
         if f["kind"] == "edges-cross":
-            lines.append(f"  edge {f['own_edge']} (loop {f['loop']}) of {f['body']} crosses "
-                         f"edge {f['edge']} (loop {f['other_loop']}) of {other}")
+            lines.append(f"  edge {n['own_edge']} (loop {n['loop']}) of {f['body']} crosses "
+                         f"edge {n['edge']} (loop {n['other_loop']}) of {other}")
         else:
             where = "on" if f["kind"] == "vertex-on-edge" else "inside, nearest"
-            lines.append(f"  vertex {f['vertex']} (loop {f['loop']}) of {f['body']} {where} "
-                         f"edge {f['edge']} (loop {f['other_loop']}) of {other}")
+            lines.append(f"  vertex {n['vertex']} (loop {n['loop']}) of {f['body']} {where} "
+                         f"edge {n['edge']} (loop {n['other_loop']}) of {other}")
     for key in ("point", "normal"):
         if rep[key] is not None:
             lines.append(f"{key}: ({rep[key][0]:.12g}, {rep[key][1]:.12g})")

@@ -7,7 +7,7 @@ import json
 import sys
 from typing import Any
 
-from ._io import CommandError, positive_number
+from ._io import CommandError, index_text, positive_number
 
 
 def _samples(text: str) -> int:
@@ -25,7 +25,8 @@ def add_parser(subparsers: Any) -> None:
         "collide",
         help="first time of impact among the bodies of a scene",
         description="Find when and where the bodies of a scene first penetrate "
-        "(the first impact among all pairs).",
+        "(the first impact among all pairs). Vertex and edge numbers are 0-based, in "
+        "the order of each body's vertices in the file (edge k joins vertex k and k + 1).",
     )
     p.add_argument("scene", metavar="SCENE.json", help="scene file (see the README)")
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
@@ -91,12 +92,14 @@ def _text(rep: dict) -> str:
     if rep["first_contact"] is not None:
         lines.append(f"first contact at t = {rep['first_contact']:.6f}")
     for f in rep["features"]:
-        if f["vertex"] is None:
-            lines.append(f"  edge {f['own_edge']} of {f['body']} crosses edge {f['edge']} "
+        n = {k: index_text(f.get(k)) for k in ("vertex", "loop", "edge", "other_loop",
+                                                 "own_edge")}
+        if f["kind"] == "edges-cross":
+            lines.append(f"  edge {n['own_edge']} of {f['body']} crosses edge {n['edge']} "
                          f"of {f['other_body']}")
         else:
-            lines.append(f"  vertex {f['vertex']} (loop {f['loop']}) of {f['body']} meets "
-                         f"edge {f['edge']} (loop {f['other_loop']}) of {f['other_body']}")
+            lines.append(f"  vertex {n['vertex']} (loop {n['loop']}) of {f['body']} meets "
+                         f"edge {n['edge']} (loop {n['other_loop']}) of {f['other_body']}")
     if rep["point"] is not None:
         lines.append(f"point: ({rep['point'][0]:.6g}, {rep['point'][1]:.6g})")
     if rep["normal"] is not None:
