@@ -189,18 +189,16 @@ class Relation:
         a, b = self.shapes
         a_on, b_on, a_in, b_in, cross = self._raw_features
         out: list[Feature] = []
+        # the kernels give packed rows of the stored loops: map them to the caller's
         for body, own, other, on, inside in (("a", a, b, a_on, a_in), ("b", b, a, b_on, b_in)):
             for kind, rows in (("vertex-on-edge", on), ("vertex-inside", inside)):
-                for v, e, _ in rows:
-                    k, vi = _local(own.packed[1], v)
-                    ko, ei = _local(other.packed[1], e)
-                    out.append(Feature(body, own.input_loop(k), own.input_vertex(k, vi),
-                                       other.input_loop(ko), other.input_edge(ko, ei), kind))
-        for e, f, _, _ in cross:
-            k, ei = _local(a.packed[1], e)
-            ko, fi = _local(b.packed[1], f)
-            out.append(Feature("a", a.input_loop(k), None, b.input_loop(ko),
-                               b.input_edge(ko, fi), "edges-cross", a.input_edge(k, ei)))
+                k, v = own._to_input([r[0] for r in rows], 0)
+                ko, e = other._to_input([r[1] for r in rows], 1)
+                out += [Feature(body, *x, kind) for x in zip(k, v, ko, e)]
+        k, e = a._to_input([r[0] for r in cross], 1)
+        ko, f = b._to_input([r[1] for r in cross], 1)
+        out += [Feature("a", x[0], None, x[1], x[2], "edges-cross", x[3])
+                for x in zip(k, ko, f, e)]
         return tuple(out)
 
     @cached_property

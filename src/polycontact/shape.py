@@ -290,6 +290,15 @@ class Shape:
         """
         return self._lookup(loop, i, 1)
 
+    def _to_input(self, packed: Sequence[int], column: int) -> tuple[list, list]:
+        """Caller's loops and indices (None where there is none) of the vertices
+        (``column`` 0) or edges (1) at rows ``packed`` of :attr:`packed`, in bulk."""
+        rows = np.asarray(packed, dtype=np.int64)
+        loops = self._input[0][np.searchsorted(self._starts, rows, side="right") - 1]
+        index = self._input[1][rows, column]
+        return ([None if k < 0 else k for k in loops.tolist()],
+                [None if i < 0 else i for i in index.tolist()])
+
     def _lookup(self, loop: int, i: int, column: int) -> int | None:
         n = int(self._starts[loop + 1] - self._starts[loop])
         if not 0 <= i < n:
