@@ -37,27 +37,30 @@ def _to_edge(p: np.ndarray, ring: np.ndarray, k: int) -> float:
     return float(np.hypot(*(s + t * u - p)))
 
 
-def _check(features, rings: dict[str, np.ndarray], tol: float) -> None:
-    """Every feature read in the caller's arrays means what its kind says."""
-    polys = {k: shapely.Polygon(r) for k, r in rings.items()}
+def _check(features, rings: dict, tol: float) -> None:
+    """Every feature read in the caller's arrays means what its kind says. ``rings``
+    maps "a" and "b" to the caller's outer ring, or to a list of loops (outer, holes)."""
+    loops = {k: r if isinstance(r, list) else [r] for k, r in rings.items()}
+    polys = {k: shapely.Polygon(ls[0], ls[1:]) for k, ls in loops.items()}
     for f in features:
         own, other = f.body, "b" if f.body == "a" else "a"
-        assert f.loop == 0 and f.other_loop == 0
-        assert 0 <= f.edge < len(rings[other])
+        assert 0 <= f.loop < len(loops[own]) and 0 <= f.other_loop < len(loops[other])
+        mine, theirs = loops[own][f.loop], loops[other][f.other_loop]
+        assert 0 <= f.edge < len(theirs)
         if f.kind == "edges-cross":
-            assert 0 <= f.own_edge < len(rings[own])
-            ea = shapely.LineString(rings[own][[f.own_edge, (f.own_edge + 1) % len(rings[own])]])
-            eb = shapely.LineString(rings[other][[f.edge, (f.edge + 1) % len(rings[other])]])
+            assert 0 <= f.own_edge < len(mine)
+            ea = shapely.LineString(mine[[f.own_edge, (f.own_edge + 1) % len(mine)]])
+            eb = shapely.LineString(theirs[[f.edge, (f.edge + 1) % len(theirs)]])
             assert ea.distance(eb) <= tol
             continue
-        assert 0 <= f.vertex < len(rings[own])
-        p = rings[own][f.vertex]
-        d = _to_edge(p, rings[other], f.edge)
+        assert 0 <= f.vertex < len(mine)
+        p = mine[f.vertex]
+        d = _to_edge(p, theirs, f.edge)
         if f.kind == "vertex-on-edge":
             assert d <= tol, (f, d)
         else:  # vertex-inside: inside the other body, and the edge is its nearest
             assert polys[other].contains(shapely.Point(p))
-            assert d <= polys[other].exterior.distance(shapely.Point(p)) + tol
+            assert d <= polys[other].boundary.distance(shapely.Point(p)) + tol
 
 
 # -- the paper's case 2 ----------------------------------------------------------------
@@ -238,3 +241,27 @@ def test_cli_json_features_index_the_files_vertices(pair):
                            f["kind"], f.get("own_edge")) for f in rep["features"]]
     assert tuple(features) == pc.classify(a, b).features
     _check(features, {"a": a, "b": b}, 4 * rep["tolerance"])
+
+
+@examples(60)
+@given(caller_rings(), caller_rings(), st.data())
+def test_hole_features_index_the_callers_hole(hole, b, data):
+    """A body with a hole given in any form; B touches (or crosses) an edge of the hole."""
+    hole = hole * 0.5
+    outer = np.array([[-2.0, -2.0], [-2.0, 2.0], [2.0, 2.0], [2.0, -2.0]])  # clockwise
+    b = b * 0.3
+    k = data.draw(st.integers(0, len(hole) - 1))
+    s, e = hole[k], hole[(k + 1) % len(hole)]
+    assume(np.any(s != e))
+    target = s + data.draw(st.floats(0.2, 0.8)) * (e - s)
+    b = np.ascontiguousarray(b + (target - b[data.draw(st.integers(0, len(b) - 1))]))
+    assume(_valid(b))
+    try:
+        a = pc.Shape(outer, [hole])
+    except pc.InvalidShapeError:
+        assume(False)
+    for x, y, rings in ((a, b, {"a": [outer, hole], "b": b}),
+                        (b, a, {"a": b, "b": [outer, hole]})):
+        r = pc.classify(x, y)
+        assert r.features
+        _check(r.features, rings, 4 * r.tolerance)
