@@ -124,9 +124,7 @@ class Shape:
                 raise
             self._init_repaired(vertices, holes, str(exc))
             return
-        self._input = _input_maps(
-            [vertices, *holes], [not np.array_equal(g, r) for g, r in zip(given, self._loops)]
-        )
+        self._input = _input_maps([vertices, *holes], given, self._loops)
 
     # -- construction -------------------------------------------------------------
     @classmethod
@@ -487,9 +485,21 @@ def _ring_map(raw: np.ndarray, reverse: bool) -> np.ndarray:
     return np.stack([vertex, edge], axis=1)
 
 
-def _input_maps(rings: Sequence[ArrayLike], reversed_: Sequence[bool]) -> tuple:
-    """``(loop map, packed (n, 2) vertex and edge map)`` of loops built from ``rings``."""
-    maps = [_ring_map(np.asarray(r, dtype=np.float64), rev) for r, rev in zip(rings, reversed_)]
+def _input_maps(
+    rings: Sequence[ArrayLike], cleaned: Sequence[np.ndarray], stored: Sequence[np.ndarray]
+) -> tuple:
+    """``(loop map, packed (n, 2) vertex and edge map)`` of the ``stored`` loops built
+    from the caller's ``rings`` through ``cleaned`` (:func:`_clean_ring`); a stored loop
+    that differs from its cleaned ring is its reversal."""
+    maps = []
+    for ring, clean, loop in zip(rings, cleaned, stored):
+        m = _ring_map(np.asarray(ring, dtype=np.float64), not np.array_equal(clean, loop))
+        if len(m) != len(loop) or not np.array_equal(
+            np.asarray(ring, dtype=np.float64).reshape(-1, 2)[m[:, 0]], loop
+        ):
+            raise RuntimeError("internal error: the map to the caller's numbering does not "
+                               "follow _clean_ring")
+        maps.append(m)
     return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
 
 
