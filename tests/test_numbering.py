@@ -119,8 +119,10 @@ def test_map_survives_rigid_motion_and_has_a_public_form():
         assert [shape.input_vertex(1, i) for i in range(3)] == [2, 1, 0]
         assert [shape.input_edge(1, i) for i in range(3)] == [1, 0, 2]
         assert shape.input_loop(1) == 1
-    with pytest.raises(IndexError):
-        s.input_vertex(0, 4)
+    for bad in (lambda: s.input_vertex(0, 4), lambda: s.input_edge(0, -1),
+                lambda: s.input_vertex(2, 0), lambda: s.input_loop(-1)):
+        with pytest.raises(IndexError):
+            bad()
 
 
 def test_repair_keeps_the_callers_numbers_where_it_keeps_the_vertices():

@@ -253,6 +253,7 @@ class Shape:
         >>> Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (2, 1), (2, 2)]]).input_loop(1)
         1
         """
+        self._check_loop(loop)
         k = int(self._input[0][loop])
         return None if k < 0 else k
 
@@ -297,7 +298,12 @@ class Shape:
         return ([None if k < 0 else k for k in loops.tolist()],
                 [None if i < 0 else i for i in index.tolist()])
 
+    def _check_loop(self, loop: int) -> None:
+        if not 0 <= loop < len(self._loops):
+            raise IndexError(f"loop {loop} is out of range for {len(self._loops)} loop(s)")
+
     def _lookup(self, loop: int, i: int, column: int) -> int | None:
+        self._check_loop(loop)
         n = int(self._starts[loop + 1] - self._starts[loop])
         if not 0 <= i < n:
             raise IndexError(f"index {i} is out of range for loop {loop} of {n} vertices")
