@@ -128,7 +128,6 @@ def test_paper_case_1_centroids_as_reported():
         (SQUARE, [HOLE, [(1.5, 1.5), (2.5, 1.5), (2.5, 2.5)]], "hole 0 and hole 1 overlap"),
         (SQUARE, [[(0, 0), (1, 0), (1, 1)]], "crosses the outer loop"),
         ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], (), "expected an array of shape (N, 2)"),
-        ([("a", 0), (1, 0), (0, 1)], (), "not numbers"),
     ],
 )
 def test_bad_input_is_refused_with_what_and_where(vertices, holes, message):

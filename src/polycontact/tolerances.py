@@ -34,7 +34,9 @@ __all__ = [
     "ROUNDING_ULPS",
     "COORDINATE_LIMIT",
     "EXTENT_FLOOR",
+    "VALIDATION_ULPS",
     "tolerance_for",
+    "validation_tolerance",
     "default_tolerance",
     "check_range",
 ]
@@ -57,6 +59,14 @@ COORDINATE_LIMIT = 1e100
 #: Smallest body extent accepted: products of three lengths (1e-300) stay normal floats.
 EXTENT_FLOOR = 1e-100
 
+#: A polygon is refused as invalid (two of its features meet) only when they are
+#: closer than float64 can tell apart: 4 units in the last place of its largest
+#: |coordinate|, about the rounding of a distance computed from such coordinates. This
+#: is far below :func:`tolerance_for` on purpose: a valid polygon (GEOS's "very skinny
+#: polygon", 10 wide and 1e15 long) is accepted, and its features closer than the
+#: classification tolerance are then decided as touching.
+VALIDATION_ULPS = 4.0
+
 _ULP = 2.0**-52
 
 
@@ -75,6 +85,19 @@ def tolerance_for(extent: float, magnitude: float) -> float:
     14.211
     """
     return max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * _ULP * magnitude)
+
+
+def validation_tolerance(magnitude: float) -> float:
+    """Distance below which two features of one polygon whose coordinates reach
+    ``magnitude`` cannot be told apart in float64: ``VALIDATION_ULPS * 2**-52 *
+    magnitude``.
+
+    Examples
+    --------
+    >>> round(validation_tolerance(1e9) / 1e-7, 3)    # 4 float spacings at 1e9
+    8.882
+    """
+    return VALIDATION_ULPS * _ULP * magnitude
 
 
 def default_tolerance(*bodies: np.ndarray) -> float:
