@@ -332,3 +332,32 @@ def test_raw_ring_small_ring_far_from_the_origin():
     n, sign, eps, box = kr._raw_ring(SMALL_FAR_RING, *RING)
     assert (n, sign) == (len(SMALL_FAR_RING), 1.0)
     assert box[1] == SMALL_FAR_RING[:, 0].max() and eps == default_tolerance(SMALL_FAR_RING)
+
+
+@given(st.floats(0.0, 1e100), st.floats(0.0, 1e100))
+def test_kernel_tolerance_is_the_python_formula(extent, magnitude):
+    from polycontact._kernels import tolerance as kt
+    from polycontact.tolerances import tolerance_for
+
+    got = kt.tolerance_for(extent, magnitude, RELATIVE_TOLERANCE, ROUNDING_ULPS)
+    assert got == tolerance_for(extent, magnitude)  # bit for bit
+
+
+@given(pairs(holes=False))
+def test_pair_tolerance_is_default_tolerance(pair):
+    a, b, _ = pair
+    na, _, _, ba = kr._raw_ring(a.exterior, *RING)
+    nb, _, _, bb = kr._raw_ring(b.exterior, *RING)
+    assert na > 0 and nb > 0
+    want = default_tolerance(a.exterior, b.exterior)
+    assert kr.pair_tolerance(ba, bb, RELATIVE_TOLERANCE, ROUNDING_ULPS) == want
+    assert kr.classify_raw(a.exterior, b.exterior, -1.0, *RING)[1] == want
+
+
+def test_raw_ring_refuses_out_of_range_without_overflow():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    with np.errstate(all="raise"):
+        for ring in (sq * 1e200, sq * 1e-300, sq + [np.nan, 0.0], sq + [0.0, np.inf]):
+            assert kr._raw_ring(ring, *RING)[0] == -1
+        assert kr._raw_ring(sq * 1e-90, *RING)[0] == 4
+        assert kr._raw_ring(sq * 1e90, *RING)[0] == 4

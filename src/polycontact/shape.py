@@ -54,6 +54,11 @@ def _real_array(ring: ArrayLike, what: str) -> np.ndarray:
     except (TypeError, ValueError) as exc:
         raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
     kind = arr.dtype.kind
+    if isinstance(ring, (list, tuple)) and kind in "iu":  # NumPy made ints of any bools
+        for row in ring:
+            for x in row if isinstance(row, (list, tuple)) else ():
+                if isinstance(x, (bool, np.bool_)):
+                    raise TypeError(f"{what}: expected real numbers, got an element of type bool")
     if kind == "O":
         for x in arr.ravel():
             if not is_real(x):
@@ -83,6 +88,7 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
         )
     if len(arr) == 0:
         raise InvalidShapeError(f"{what}: no vertices")
+    check_range(arr, what)
     keep = np.ones(len(arr), dtype=bool)
     keep[1:] = np.any(arr[1:] != arr[:-1], axis=1)
     arr = arr[keep]
@@ -92,7 +98,6 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
         raise InvalidShapeError(
             f"{what}: fewer than 3 distinct vertices ({len(np.unique(arr, axis=0))})"
         )
-    check_range(arr, what)
     return arr
 
 

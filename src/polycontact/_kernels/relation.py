@@ -218,7 +218,7 @@ def _cones_overlap(
     If ``swept``, the edge rows are ordered by ``order`` (xmin ascending; ``maxw`` the
     widest edge) and only the rows near p are read; otherwise every row is read.
     ``rays`` (at least 2 cnt rows of 6) and ``rord`` (as many ints) are scratch: rows
-    ``(pseudo-angle, edge length, opening, of A, unit direction)``, and their order.
+    ``(pseudo-angle, length of the edge left from p, opening, of A, unit direction)``, and their order.
     """
     lo = 0
     if swept:
@@ -252,12 +252,14 @@ def _cones_overlap(
             continue
         ex = (wx - ux) / le
         ey = (wy - uy) / le
+        # Each ray's length is what is left of the edge from p: the sliver test below
+        # measures how far apart two rays get before one of them ends.
         if du > eps or dw <= eps:  # ray from p (or from w) back along the edge
             if not (du <= eps and dw <= eps):
-                _put_ray(rays, r, -ex, -ey, le, flip < 0.0, a_side)
+                _put_ray(rays, r, -ex, -ey, du, flip < 0.0, a_side)
                 r += 1
         if dw > eps:  # ray from p (or from u) forward along the edge
-            _put_ray(rays, r, ex, ey, le, flip > 0.0, a_side)
+            _put_ray(rays, r, ex, ey, dw, flip > 0.0, a_side)
             r += 1
     if r == 0:
         return False
