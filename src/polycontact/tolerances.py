@@ -11,7 +11,13 @@ term is what a user means by "the same place" (a shift of 1e-9 of a body's size 
 seen as a shift, at any scale); the second keeps the tolerance above the rounding of
 the few operations that produce and compare coordinates (a translation, a rotation, a
 difference of two coordinates) when small bodies sit far from the origin. Lengths are
-compared with ``eps``; areas with ``eps * length``.
+compared with ``eps``; areas with ``eps * length``. The same formula is compiled for
+the kernels (:mod:`polycontact._kernels.tolerance`), so every path gives a pair the
+same tolerance.
+
+A polygon's own validity is judged on a finer scale: two of its features meet only
+when float64 cannot tell them apart (:func:`validation_tolerance`, 4 float spacings of
+its largest coordinate), so every polygon GEOS calls valid is accepted, at any scale.
 
 Coordinates must lie in ``[-COORDINATE_LIMIT, COORDINATE_LIMIT]`` and every body must
 be larger than ``EXTENT_FLOOR``: the kernels form products of up to three coordinate
