@@ -18,8 +18,8 @@ def _patch(geom: Any, **style: Any) -> Any:
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
 
-    verts = []
-    codes = []
+    verts: list[np.ndarray] = []
+    codes: list[int] = []
     for poly in shapely.get_parts(shapely.orient_polygons(geom)):
         for ring in (poly.exterior, *poly.interiors):
             xy = np.asarray(ring.coords)[:, :2]
