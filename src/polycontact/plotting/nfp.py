@@ -24,7 +24,7 @@ def _patch(geom: Any, **style: Any) -> Any:
         for ring in (poly.exterior, *poly.interiors):
             xy = np.asarray(ring.coords)[:, :2]
             verts.extend(xy)
-            codes.extend([Path.MOVETO] + [Path.LINETO] * (len(xy) - 2) + [Path.CLOSEPOLY])
+            codes.extend(int(c) for c in [Path.MOVETO, *[Path.LINETO] * (len(xy) - 2), Path.CLOSEPOLY])
     return PathPatch(Path(np.asarray(verts), codes), **style)
 
 
