@@ -21,8 +21,8 @@ Examples
 >>> from polycontact import compiling
 >>> sorted(compiling.FAMILIES)
 ['classification', 'entrance block', 'no-fit polygon', 'time of impact']
->>> compiling.cache_directory().name
-'numba'
+>>> compiling.cache_directory().is_absolute()
+True
 """
 
 from __future__ import annotations
