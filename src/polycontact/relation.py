@@ -40,7 +40,7 @@ from .tolerances import (
     tolerance_for,
 )
 
-__all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many", "warmup"]
+__all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many"]
 
 
 class State(str, enum.Enum):
@@ -569,30 +569,3 @@ def classify_many(
     eps = np.concatenate([e for _, e in parts])
     return RelationBatch(states, eps, lambda: (*pa, *pb))
 
-
-def warmup() -> None:
-    """Compile (or load from the cache) the classification and time-of-impact kernels
-    now.
-
-    Numba compiles each kernel on its first call; call this once at start-up to pay
-    that cost up front instead of on the first :func:`classify` or
-    :func:`polycontact.time_of_impact`.
-
-    Examples
-    --------
-    >>> warmup()
-    """
-    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    for d in ((2.0, 0.0), (1.0, 0.0), (0.5, 0.5)):
-        r = classify(sq, sq + d)
-        r.distance, r.features, r.point, r.normal
-        rs = classify(Shape(sq), Shape(sq + d))
-        rs.distance, rs.features
-    classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances
-    from .impact import time_of_impact
-    from .motion import Motion
-
-    for method in ("exact", "sampled"):
-        hit = time_of_impact(Shape(sq), Motion(velocity=(1.0, 0.0)), Shape(sq + (3.0, 0.0)),
-                             Motion(), t_max=5.0, method=method)
-        hit.features

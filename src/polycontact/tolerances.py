@@ -53,12 +53,12 @@ __all__ = [
 RELATIVE_TOLERANCE = 1e-12
 
 #: Relative to the float spacing of the coordinates: 64 units in the last place of the
-#: largest |coordinate| (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
+#: largest absolute coordinate (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
 #: small body far from the origin moves its vertices by rounding errors of a few ulps
 #: of its coordinates; 64 ulps is well above that and still resolves 1e-4 at 1e9.
 ROUNDING_ULPS = 64.0
 
-#: Largest |coordinate| accepted. Products of three coordinate differences (up to
+#: Largest absolute coordinate accepted. Products of three coordinate differences (up to
 #: (2e100)**3 = 8e300) stay finite in float64 (max ~1.8e308).
 COORDINATE_LIMIT = 1e100
 
@@ -136,7 +136,7 @@ def check_range(xy: np.ndarray, what: str) -> None:
     """Refuse coordinates that float64 cannot carry through the kernels.
 
     ``xy`` is a finite float64 (N, 2) array of one body (or loop), ``what`` names it in
-    the error. Raises :class:`polycontact.InvalidShapeError` if some |coordinate|
+    the error. Raises :class:`polycontact.InvalidShapeError` if some absolute coordinate
     exceeds :data:`COORDINATE_LIMIT` or the body's extent is below :data:`EXTENT_FLOOR`
     (and not zero: a zero extent is a degenerate ring, refused elsewhere).
 
