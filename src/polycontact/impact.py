@@ -17,7 +17,6 @@ the penetrating configuration at ``time``, as the paper records it).
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -25,11 +24,11 @@ from typing import Any
 import numpy as np
 
 from ._checks import finite_number
-from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_t_max
+from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
 from .relation import Feature, State, classify
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
 
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
 
@@ -106,6 +105,10 @@ class Impact:
         Number of placements classified.
     searched_to : float
         How far in time the search got (t_max when it finished).
+    time_tolerance : float
+        The time tolerance honoured: the one asked for, or what float64 resolves at
+        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · |t|, when that is
+        larger. ``time`` is within it after the first penetration.
     features : tuple of Feature
         At the touching configuration: which vertex of which body meets which edge of
         the other (0-based indices into ``Shape.loops``, body "a" or "b").
@@ -125,25 +128,27 @@ class Impact:
     time_bracket: tuple[float, float] | None = field(repr=False)
     iterations: int = field(repr=False)
     searched_to: float = field(repr=False)
+    time_tolerance: float = field(repr=False)
     _bodies: tuple = field(repr=False, compare=False, default=())
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
         if self.state is None:
             return (), None, None
-        a, ma, b, mb, eps = self._bodies
+        a, ma, b, mb, eps_rel = self._bodies
         if self.status is ImpactStatus.HIT:
             t_lo, t_hi = self.time_bracket
             if self.method == "exact":
-                t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps)
-            rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
+                t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps_rel)
+            rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi),
+                              tolerance=_eps_at(a, ma, b, mb, t_hi, eps_rel))
             rel = rel_hi
             if self.method == "exact":
                 from ._kernels.impact import speed_bound
 
                 reach = (t_hi - t_lo) * speed_bound(ma.array, a.bounding_radius, mb.array,
                                                     b.bounding_radius, t_lo, t_hi)
-                rel_lo = _relation_at(a, ma, b, mb, t_lo, eps, reach)
+                rel_lo = _relation_at(a, ma, b, mb, t_lo, eps_rel, reach)
                 rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
             # the normal opposes the smallest translation that ends the (tiny) overlap
             # at `time`: at a corner-on-corner or flush touch it is the push direction
@@ -151,10 +156,11 @@ class Impact:
             point = rel.point
             features = rel.features
         elif self.status is ImpactStatus.PENETRATING_AT_START:
-            rel = classify(a.at(ma, 0.0), b.at(mb, 0.0), tolerance=eps)
+            rel = classify(a.at(ma, 0.0), b.at(mb, 0.0),
+                           tolerance=_eps_at(a, ma, b, mb, 0.0, eps_rel))
             features, point, normal = rel.features, rel.point, rel.normal
         else:
-            rel = _relation_at(a, ma, b, mb, self.first_contact, eps)
+            rel = _relation_at(a, ma, b, mb, self.first_contact, eps_rel)
             features, point, normal = rel.features, rel.point, rel.normal
         return (
             tuple(features),
@@ -179,7 +185,7 @@ class Impact:
 
 
 def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi: float,
-                  eps: float) -> tuple[float, float]:
+                  eps_rel: float) -> tuple[float, float]:
     """The exact method's bracket of the first penetration narrowed to the probe length
     λ/S (λ the contact resolution, S the speed bound), so that the features are read
     where the bodies touch: the search brackets it only to ``time_tolerance``. The
@@ -195,25 +201,32 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     (ra, ea), (rb, eb) = body_frame(a), body_frame(b)
     code, hi, lo, *_ = ki._prepared_exact_search(
         ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
-        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps, lam, MAX_ITERATIONS)
+        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, _ULPS, lam, MAX_ITERATIONS)
     return (lo, hi) if code == ki.HIT else (t_lo, t_hi)
 
 
-def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
-    """Largest |coordinate| the body can reach in [0, t_max] (for the tolerance)."""
-    cx, cy = shape.centroid
-    reach = (
-        max(abs(float(cx)), abs(float(cy)))
-        + math.hypot(*motion.velocity) * t_max
-        + 0.5 * math.hypot(*motion.acceleration) * t_max * t_max
-        + shape.bounding_radius
-    )
-    return max(1.0, reach)
+#: The float-spacing part of the distance tolerance (see ``tolerance_for``).
+_ULPS = ROUNDING_ULPS * 2.0**-52
 
 
-def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: float,
+def _extent(shape: Shape) -> float:
+    """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``)."""
+    xy = shape.packed[0]
+    return float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+
+
+def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
+    """The distance tolerance at time t, as the kernels compute it: the size term
+    ``eps_rel`` or the float spacing of the coordinates at t, whichever is larger."""
+    from ._kernels.impact import _eps_at as eps_at
+
+    return float(eps_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
+                        b.bounding_radius, t, eps_rel, _ULPS))
+
+
+def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
                  reach: float = 0.0):
-    """classify at time t, the tolerance widened to the gap and to ``reach``.
+    """classify at time t, the tolerance (local to t) widened to the gap and to ``reach``.
 
     ``reach`` is how far the bodies can still move relative to each other before the
     penetration (speed bound × bracket length): every vertex that can meet an edge by
@@ -224,6 +237,7 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: floa
     pa = a.at(ma, t)
     pb = b.at(mb, t)
     gap = float(boundary_distance(*pa.packed, *pb.packed))
+    eps = _eps_at(a, ma, b, mb, t, eps_rel)
     return classify(pa, pb, tolerance=max(eps, 1.01 * gap, 1.01 * reach))
 
 
@@ -370,22 +384,28 @@ def time_of_impact(
 
     from ._kernels import impact as ki
 
-    eps = RELATIVE_TOLERANCE * max(_path_scale(a, ma, t_max), _path_scale(b, mb, t_max))
+    check_range(a.packed[0], "a")
+    check_range(b.packed[0], "b")
+    check_reach(a, ma, t_max, "motion_a")
+    check_reach(b, mb, t_max, "motion_b")
+    # the size term of the distance tolerance; the kernels add the float spacing of the
+    # coordinates at each time they examine (never a bound over all of [0, t_max])
+    eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
     exact = method == "exact"
     ra, ea = body_frame(a, tables=exact)
     rb, eb = body_frame(b, tables=exact)
     la, lb = a.bounding_radius, b.bounding_radius
     if exact:
         out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
-                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps,
-                             CONTACT_RESOLUTION * (la + lb), int(max_iterations))
+                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol,
+                             eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations))
     else:
         out = ki.sampled_query(ra, a.packed[1], a.centroid, ma.array, la, rb, b.packed[1],
-                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps,
-                               int(samples))
+                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol,
+                               eps_rel, _ULPS, int(samples))
     intervals, code, t_hi, t_lo, t_contact, iters, reached = out
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
-                   float(t_contact), int(iters), float(reached), intervals, t_max, eps)
+                   float(t_contact), int(iters), float(reached), intervals, t_max, eps_rel, tol)
 
 
 def body_frame(shape: Shape, tables: bool = True) -> tuple[np.ndarray, tuple | None]:
@@ -406,7 +426,9 @@ def body_frame(shape: Shape, tables: bool = True) -> tuple[np.ndarray, tuple | N
 
 
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
-            t_max, eps) -> Impact:
+            t_max, eps_rel, tol) -> Impact:
+    from ._kernels.impact import effective_time_tolerance
+
     first_contact = t_contact if t_contact >= 0.0 else None
     state = None
     time = bracket = None
@@ -430,5 +452,6 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         time_bracket=bracket,
         iterations=iters,
         searched_to=reached,
-        _bodies=(a, ma, b, mb, eps),
+        time_tolerance=float(effective_time_tolerance(tol, t_hi if time is not None else reached)),
+        _bodies=(a, ma, b, mb, eps_rel),
     )
