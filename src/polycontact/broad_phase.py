@@ -58,12 +58,12 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
     ...
     ValueError: motion_a: the body's coordinates reach 1e+110 within t_max = 1e+50, beyond ±1e+100: products of coordinates would overflow float64
     """
-    c = np.abs(np.asarray(shape.centroid, dtype=np.float64))
+    cx, cy = shape.centroid
     radius = shape.bounding_radius
     w_max = abs(motion.angular_velocity) + abs(motion.angular_acceleration) * t_max
     v = math.hypot(*motion.velocity)
     acc = math.hypot(*motion.acceleration)
-    reach = float(c.max()) + v * t_max + 0.5 * acc * t_max * t_max + radius
+    reach = max(abs(float(cx)), abs(float(cy))) + v * t_max + 0.5 * acc * t_max * t_max + radius
     speed = v + acc * t_max + w_max * radius
     accel = acc + (abs(motion.angular_acceleration) + w_max * w_max) * radius
     for value, name in ((reach, "coordinates reach"), (speed, "points' speeds reach"),

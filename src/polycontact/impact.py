@@ -210,9 +210,10 @@ _ULPS = ROUNDING_ULPS * 2.0**-52
 
 
 def _extent(shape: Shape) -> float:
-    """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``)."""
-    xy = shape.packed[0]
-    return float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+    """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
+    kept with the shape's body frame (:func:`body_frame`)."""
+    body_frame(shape, tables=False)
+    return shape._frame[2]
 
 
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
@@ -384,16 +385,16 @@ def time_of_impact(
 
     from ._kernels import impact as ki
 
-    check_range(a.packed[0], "a")
-    check_range(b.packed[0], "b")
+    # coordinates (checked once per shape, with its body frame) and motions whose
+    # products would overflow float64 are refused
+    exact = method == "exact"
+    ra, ea = body_frame(a, tables=exact, what="a")
+    rb, eb = body_frame(b, tables=exact, what="b")
     check_reach(a, ma, t_max, "motion_a")
     check_reach(b, mb, t_max, "motion_b")
     # the size term of the distance tolerance; the kernels add the float spacing of the
     # coordinates at each time they examine (never a bound over all of [0, t_max])
     eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
-    exact = method == "exact"
-    ra, ea = body_frame(a, tables=exact)
-    rb, eb = body_frame(b, tables=exact)
     la, lb = a.bounding_radius, b.bounding_radius
     if exact:
         out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
@@ -408,20 +409,26 @@ def time_of_impact(
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps_rel, tol)
 
 
-def body_frame(shape: Shape, tables: bool = True) -> tuple[np.ndarray, tuple | None]:
+def body_frame(shape: Shape, tables: bool = True,
+               what: str = "shape") -> tuple[np.ndarray, tuple | None]:
     """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
     for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
     sampled method does not need it). Built on first use and kept with the shape (it
-    is immutable), so that repeated queries on one shape build them once."""
-    r, tab = shape._frame if shape._frame is not None else (None, None)
+    is immutable), so that repeated queries on one shape build them once. On first
+    use the coordinates are also checked (:func:`polycontact.tolerances.check_range`,
+    the error naming ``what``) and the shape's extent kept (see :func:`_extent`)."""
+    r, tab, extent = shape._frame if shape._frame is not None else (None, None, 0.0)
     if r is None:
-        r = shape.packed[0] - shape.centroid
+        xy = shape.packed[0]
+        check_range(xy, what)
+        extent = float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+        r = xy - shape.centroid
         r.flags.writeable = False
     if tables and tab is None:
         from ._kernels.advance import edge_table
 
         tab = edge_table(r, shape.packed[1])
-    shape._frame = (r, tab)
+    shape._frame = (r, tab, extent)
     return r, tab
 
 

@@ -302,15 +302,15 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
       the time tolerance or than ``GUESS_SHRINK`` times the one before, the bodies are
       classified at ``t + h + 0.99 tol``: penetrating there is the hit, bracketed
       by (t + h, that time). If h is at least the probe
-      length ``tau = min(tol / 2, lam / S)`` it is taken. The pairs are held
+      length ``tau = lam / S`` it is taken. The pairs are held
       ``lam`` apart until the first contact (so that the first time found within
       ``lam`` is at most a probe late) and ``PAIR_GAP · lam`` apart after it, which
       leaves fewer probes to the hit: where the step to ``lam`` is shorter than tau
-      before the first contact, the step to ``PAIR_GAP · lam`` (at most
-      ``tol / 2``) is taken instead;
-    - otherwise the step is ``tau``: a penetration that begins and ends inside it lasts
-      less than ``tol / 2`` with no point moving more than ``lam`` relative to the
-      other body; any other penetration is still penetrating at ``t + tau``.
+      before the first contact, the step to ``PAIR_GAP · lam`` (at most ``tau``) is
+      taken instead;
+    - otherwise the step is ``tau``: a penetration that begins and ends inside it has
+      no point moving more than ``lam`` relative to the other body (it is shallower
+      than ``lam``); any other penetration is still penetrating at ``t + tau``.
 
     - after the first contact the steps hold touching pairs to their edges' turning
       lines (``touch = eps`` in :func:`pair_step`: no penetration beyond ``eps``
@@ -319,7 +319,10 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
       with one of them, up to ``eps``), so a sliding contact is followed by long
       steps, not by probes.
 
-    A penetrating state at the end of a probe is the hit, bracketed by the probe.
+    A penetrating state at the end of a probe is the hit: the probe brackets it, and
+    bisection (:func:`_narrow`) narrows the bracket to the time tolerance. The time
+    tolerance thus decides how precisely ``t_hi`` is reported, never whether a hit is
+    found, nor how many probes are taken.
     """
     return _prepared_exact_search(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
                                   edge_table(rb, sb), intervals, time_tol, eps_rel, ulps, lam,
@@ -408,12 +411,14 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                     return HIT, t_guess, t + h, first_contact if first_contact >= 0.0 else t + h, \
                         it, t_guess
             h_prev = h
-            tau = min(0.5 * tol, lam / s, t_end - t)
+            # the probe length follows the resolution, not the time tolerance: a
+            # penetrating probe end is narrowed to the tolerance by bisection
+            tau = min(lam / s, t_end - t)
             if h < tau and first_contact < 0.0:
-                # about to touch: step the pairs to lam_pair instead, at most
-                # tol / 2 at a time (so the first contact found is no later)
+                # about to touch: step the pairs to lam_pair instead, at most a probe
+                # at a time (so the first contact found is no later)
                 h = min(pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
-                                  stack, stau, 0.0)[1], 0.5 * tol)
+                                  stack, stau, 0.0)[1], tau)
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
                 # touching: a line through the touching features may separate them
                 place(ra, ca, ma, t, xa)
@@ -443,13 +448,34 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new,
                         _eps_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
                         scratch) == _PENETRATING:
-                # the probe is the bracket: t_new − t = tau <= tol / 2, finer than
-                # asked, so no bisection
+                # the probe brackets the first penetration (no point moved more than
+                # lam in it); narrowed to the time tolerance by bisection
                 if first_contact < 0.0 or first_contact > t:
                     first_contact = t
-                return HIT, t_new, t, first_contact, it, t_new
+                lo, hi, it = _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, t, t_new,
+                                     time_tol, eps_rel, ulps, it, scratch)
+                return HIT, hi, lo, first_contact, it, hi
             t = t_new
     return NO_HIT, -1.0, -1.0, first_contact, it, t
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, lo, hi, time_tol, eps_rel, ulps, it,
+            scratch):
+    """Bisect [lo, hi] (no penetration at lo, penetration at hi) until it is no longer
+    than the effective time tolerance at hi; ``(lo, hi, it)``, each classification
+    counted in ``it``."""
+    while hi - lo > effective_time_tolerance(time_tol, hi):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        it += 1
+        if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, mid,
+                    _eps_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps), scratch) == _PENETRATING:
+            hi = mid
+        else:
+            lo = mid
+    return lo, hi, it
 
 
 @njit(cache=True, nogil=True)
