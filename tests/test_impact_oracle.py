@@ -217,16 +217,16 @@ def test_defect3_fast_flush_square_does_not_tunnel(speed):
     assert hit.collides and 2 / speed <= hit.time <= 2 / speed + hit.time_tolerance
 
 
-def test_defect3_oblique_fast_approach_does_not_tunnel():
-    for v in (2e6, 1e9):
-        a = Body(SQ, (0.5, 0.5), (v, 0.4 * v))
-        b = Body(SQ @ np.array([[math.cos(0.3), math.sin(0.3)], [-math.sin(0.3),
-                                                                 math.cos(0.3)]]),
-                 (4.5, 1.9))
-        assert not deep(a, b, 0.0)
-        t_c = 4.0 / v
-        t_deep = bisect_first(lambda t: deep(a, b, t), 0.0, t_c)
-        check_contract(a, b, 5.0, t_deep, 1e-4)
+@pytest.mark.parametrize("speed, vy, by, s_c", [
+    (2e6, 0.5, 0.5, 2.6), (1e8, 0.5, 0.5, 2.6), (1e8, 0.5, 1.0, 2.6), (1e8, 0.1, 0.0, 3.0)])
+def test_defect3_oblique_fast_approach_does_not_tunnel(speed, vy, by, s_c):
+    # flush faces met on a slant: the old search said no hit for all of these
+    a = Body(SQ, (0.5, 0.5), (speed, vy * speed))
+    b = Body(SQ, (3.5, 0.5 + by))
+    t_c = s_c / speed                 # the centroids are nearest: a deep overlap
+    assert not deep(a, b, 0.0) and deep(a, b, t_c)
+    t_deep = bisect_first(lambda t: deep(a, b, t), 0.0, t_c)
+    check_contract(a, b, 5.0, t_deep, 1e-4)
 
 
 def test_defect4_long_travel_to_a_far_body_hits():

@@ -6,10 +6,11 @@ or grazing a corner — is a **contact**, reported by ``first_contact`` while
 ``collides`` stays False. A flush approach (paper Fig. 17) is a collision at the
 moment the edges meet: the interiors overlap right after.
 
-What ``time`` means: the first instant of penetration, located to within
-``time_tolerance`` **from above**: the bodies penetrate at ``time`` (``state`` is
-PENETRATING) and do not at ``time_bracket[0]``, which is less than ``time_tolerance``
-earlier. ``features``, ``point`` and ``normal`` describe the touching configuration at
+What ``time`` means: the first instant of penetration, located to within the time
+tolerance **from above**: the bodies penetrate at ``time`` (``state`` is PENETRATING)
+and do not at ``time_bracket[0]``, which is less than ``Impact.time_tolerance``
+earlier (``time_tolerance``, or the float spacing of t when that is coarser).
+``features``, ``point`` and ``normal`` describe the touching configuration at
 ``time_bracket[0]``, the moment just before the interiors overlap (for ``"sampled"``:
 the penetrating configuration at ``time``, as the paper records it).
 """
@@ -301,20 +302,45 @@ def time_of_impact(
     every vertex–edge pair under it. The step is the least pair time, both ways.
 
     Near contact the steps shrink fast (the bounds converge quadratically). After a
-    step to t + h that is shorter than ``time_tolerance`` or than a fifth of the step
-    before, the bodies are classified at t + h + 0.99 ``time_tolerance``: penetrating
-    there ends the search with ``time_bracket`` = (t + h, that time) — no penetration
-    began before t + h, so ``time`` is within ``time_tolerance`` after the first
-    penetration. Otherwise, below the probe length τ = min(time_tolerance / 2, λ / S),
-    with λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and
-    classifies the end. A penetrating end is the hit, with the non-penetrating start
-    of the probe as ``time_bracket[0]``. Not penetrating at the end means either no
-    penetration began in the step, or one began and ended inside it — lasting under
-    ``time_tolerance``/2 with no point moving more than λ relative to the other body:
-    a penetration shallower than the contact resolution. Every other penetration is
-    found, whatever the rotation speed. ``features``, ``point`` and ``normal`` are
-    computed when first asked for, from the bracket narrowed by the same search to τ,
-    so that they describe the touch and not a configuration up to a tolerance later.
+    step to t + h that is shorter than the time tolerance or than a fifth of the step
+    before, the bodies are classified at t + h + 0.99 × the time tolerance:
+    penetrating there ends the search with ``time_bracket`` = (t + h, that time) — no
+    penetration began before t + h. Otherwise, below the probe length τ = λ / S, the
+    search steps by τ and classifies the end. A penetrating end is the hit: the probe
+    (non-penetrating start, penetrating end) is narrowed by bisection to the time
+    tolerance, which thus decides how precisely ``time`` is reported, never whether a
+    hit is found nor how many probes are taken. Not penetrating at the end means
+    either no penetration began in the probe, or one began and ended inside it with no
+    point moving more than λ relative to the other body: a penetration shallower than
+    the contact resolution λ. ``features``, ``point`` and ``normal`` are computed when
+    first asked for, from the bracket narrowed by the same search to τ, so that they
+    describe the touch and not a configuration up to a tolerance later.
+
+    **Tolerances are local to the time examined**, never scaled by ``t_max`` or by the
+    length of the travel: at time t the distance tolerance is
+    ``tolerance_for(extent, magnitude)`` (:mod:`polycontact.tolerances`) with the
+    bodies' size and a bound of their |coordinates| over the step; the contact
+    resolution is λ = max(:data:`CONTACT_RESOLUTION` · (L_A + L_B), 128 · eps,
+    S · 4 · 2⁻⁵² · |t|) (well above the rounding of the coordinates, and at least the
+    distance moved in one float step of t); the time tolerance used at t is
+    max(``time_tolerance``, 4 · 2⁻⁵² · |t|) — a tolerance float64 cannot resolve at t is
+    clamped there, and :attr:`Impact.time_tolerance` says which one was honoured.
+
+    **Contract** (``method="exact"``): whatever the speed, spin, acceleration, travel
+    length or time tolerance,
+
+    - a penetration inside [0, t_max] deeper than the distance tolerance eps at its
+      time (1e-12 of the bodies' size, or 64 float spacings of their coordinates
+      there) is found, unless it both begins and ends within one probe — then it is
+      shallower than λ (1e-6 of L_A + L_B for bodies near the origin);
+    - ``time`` is within :attr:`Impact.time_tolerance` after the first such
+      penetration (an overlap within eps is contact, as in :func:`classify`);
+    - bodies already penetrating at t = 0 have status ``penetrating-at-start``;
+    - the answer does not depend on ``t_max`` beyond it (up to the time tolerance);
+    - shapes with coordinates beyond ``tolerances.COORDINATE_LIMIT``, and motions that
+      carry coordinates, point speeds or accelerations beyond it within [0, t_max],
+      are refused with an error naming the argument (float64 products would
+      overflow); they are never answered wrongly.
 
     A sliding contact (paper Fig. 16) is followed by long steps, not probes. Once the
     bodies touch, each step holds the touching vertex–edge pairs (those within λ/64)
@@ -347,7 +373,9 @@ def time_of_impact(
         End of the time window (>= 0).
     method : {"exact", "sampled"}
     time_tolerance : float
-        Accuracy of ``time`` (the paper's threshold, 1e-4 s).
+        Accuracy of ``time`` (the paper's threshold, 1e-4 s); any value > 0. Below
+        what float64 resolves at the time examined (4 · 2⁻⁵² · |t|) it is clamped
+        there, and the result's ``time_tolerance`` says so.
     samples : int
         Points per round of the sampled method (>= 2); ignored by "exact".
     max_iterations : int
@@ -368,6 +396,10 @@ def time_of_impact(
     ...                        t_max=1)                     # slides along from t = 0.9
     >>> slide.collides, round(slide.first_contact, 4), slide.state.value
     (False, 0.9, 'contact')
+    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
+    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
+    (True, True)
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
@@ -459,6 +491,6 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         time_bracket=bracket,
         iterations=iters,
         searched_to=reached,
-        time_tolerance=float(effective_time_tolerance(tol, t_hi if time is not None else reached)),
+        time_tolerance=float(effective_time_tolerance(tol, time if time is not None else reached)),
         _bodies=(a, ma, b, mb, eps_rel),
     )

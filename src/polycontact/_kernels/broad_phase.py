@@ -167,7 +167,9 @@ def rounding_allowance(ca, ma, cb, mb, t_max):
 @njit(cache=True, nogil=True)
 def overlap_intervals(ca, ma, ra, cb, mb, rb, t_max, inflate):
     """Closed sub-intervals of [0, t_max] where the bounding circles touch or overlap,
-    their radii enlarged by ``inflate`` (relative) and by the rounding of the positions
-    (:func:`rounding_allowance`), so that no instant of overlap is dropped."""
-    r = (ra + rb) * (1.0 + inflate) + rounding_allowance(ca, ma, cb, mb, t_max)
+    the sum of their radii R enlarged by ``inflate`` (relative), or by the rounding of
+    the positions (:func:`rounding_allowance`) where that is larger (far from the
+    origin, at long travel), so that no instant of overlap is dropped."""
+    big = ra + rb
+    r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, t_max))
     return nonpositive_intervals(relative_motion(ca, ma, cb, mb), r, 0.0, t_max)
