@@ -34,7 +34,8 @@ _LAZY = {
     "classify": "relation",
     "classify_many": "relation",
     "RelationBatch": "relation",
-    "warmup": "relation",
+    # compiling the kernels
+    "warmup": "compiling",
     # entrance block
     "EntranceBlock": "entrance",
     "Component": "entrance",

@@ -10,3 +10,7 @@ Conventions shared by every kernel:
 - Tolerances arrive as arguments, never from module globals.
 - Kernels are compiled on first use (``cache=True``), never at import.
 """
+
+from ..compiling import install_cache_locator
+
+install_cache_locator()

@@ -5,6 +5,9 @@ Each subcommand lives in its own module of this package and provides
 function taking the parsed arguments and returning an exit status. Errors about the
 user's input are raised as :class:`CommandError` (or a :class:`PolycontactError`) and
 printed as one line on stderr with exit status 2, never as a traceback.
+
+Before a command whose kernels are not compiled yet (a first run), a notice and one line
+per kernel family go to stderr, never stdout, so ``--json`` output stays parseable.
 """
 
 from __future__ import annotations
@@ -13,10 +16,19 @@ import argparse
 import importlib
 import sys
 
+from .. import __version__
 from ..errors import PolycontactError
 from ._io import CommandError
 
-_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp")
+_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "warmup")
+
+#: The kernel families (polycontact.compiling.FAMILIES) each command runs.
+_NEEDS = {
+    "classify": ("classification",),
+    "collide": ("classification", "time of impact"),
+    "entrance-block": ("classification", "entrance block"),
+    "nfp": ("no-fit polygon",),
+}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -24,6 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="polycontact",
         description="Contact, time of impact and no-fit polygons of 2D polygons.",
     )
+    parser.add_argument("--version", action="version", version=f"polycontact {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in _SUBCOMMANDS:
         importlib.import_module(f".{name}", __name__).add_parser(sub)
@@ -33,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    _compile_if_cold(_NEEDS.get(args.command, ()))
     try:
         return int(args.func(args) or 0)
     except (CommandError, PolycontactError) as exc:
@@ -40,6 +54,24 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except BrokenPipeError:
         return 0
+
+
+def _compile_if_cold(families: tuple[str, ...]) -> None:
+    """Say on stderr that a first run compiles, and show each family as it compiles."""
+    if not families:
+        return
+    from ..compiling import cache_directory, is_warm, warmup
+    from .warmup import progress_line
+
+    if is_warm(families):
+        return
+    print(
+        "polycontact: compiling kernels, first run only, about a minute "
+        f"(cached in {cache_directory()})",
+        file=sys.stderr,
+        flush=True,
+    )
+    warmup(families, progress=progress_line)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from ._style import LENGTH_LABEL, plural
+
 __all__ = ["plot_entrance_block"]
 
 #: Colour and title of each family (one term of paper Eq. 1).
@@ -63,7 +65,7 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
         _reference(ax, block)
         n = len(block.of_family(family))
         how = f", {block.method}" if family == "A1-B1" else ""
-        ax.set_title(f"{text}\n{n} components{how}", fontsize=10)
+        ax.set_title(f"{text}\n{plural(n, 'component')}{how}", fontsize=10)
     ax = axes[3]
     _bodies(ax, block)
     _union(ax, block)
@@ -74,6 +76,10 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
     handles = _legend_handles(handles)
     figure.legend(handles=handles, loc="outside lower center", ncol=3, fontsize=9,
                   frameon=False)
+    for ax in axes[2:]:
+        ax.set_xlabel(f"x {LENGTH_LABEL}")
+    for ax in axes[::2]:
+        ax.set_ylabel(f"y {LENGTH_LABEL}")
     for ax in axes:
         ax.set_aspect("equal")
         ax.grid(True, linewidth=0.3, alpha=0.5)
@@ -117,17 +123,18 @@ def _union(ax: Any, block: Any) -> None:
 
 def _reference(ax: Any, block: Any) -> list[Any]:
     x, y = block.reference
-    return ax.plot([x], [y], marker="o", color="crimson", markeredgecolor="black",
+    handles: list[Any] = ax.plot([x], [y], marker="o", color="crimson", markeredgecolor="black",
                    markersize=7, linestyle="none", zorder=5,
                    label=f"reference point a0 ({x:.4g}, {y:.4g})")
+    return handles
 
 
 def _legend_handles(reference: list[Any]) -> list[Any]:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    handles = [Patch(facecolor=c, edgecolor=c, alpha=0.4, label=t.split(":")[0])
-               for c, t in FAMILY_STYLE.values()]
+    handles: list[Any] = [Patch(facecolor=c, edgecolor=c, alpha=0.4, label=t.split(":")[0])
+                          for c, t in FAMILY_STYLE.values()]
     handles += [
         Patch(facecolor="tab:red", alpha=0.3, label="E(A, B)"),
         Line2D([], [], color="black", linewidth=1.8, label="outline of E(A, B) = no-fit polygon"),

@@ -9,6 +9,7 @@ import numpy as np
 from ..impact import Impact
 from ..motion import Motion
 from ..shape import Shape, as_shape
+from ._style import label_axes, legend_outside
 
 __all__ = ["plot_impact"]
 
@@ -54,34 +55,42 @@ def plot_impact(
     >>> ma, mb = Motion(velocity=(1, 0)), Motion(angular_velocity=1.0)
     >>> hit = time_of_impact(sq, ma, sq.moved((3, 0)), mb, t_max=5)
     >>> ax = plot_impact(sq, ma, sq.moved((3, 0)), mb, hit)
-    >>> len(ax.patches)
-    4
+    >>> labels = ax.get_legend_handles_labels()[1]
+    >>> len(ax.patches), labels[0], labels[2], labels[-1]
+    (4, 'A at t = 0', "A's centroid path", 'normal, A towards B')
     """
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
     a = as_shape(a, "a")
     b = as_shape(b, "b")
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 5))
+        _, ax = plt.subplots(figsize=(11, 6), layout="constrained")
     t_event = _event_time(impact)
     ts = np.linspace(0.0, t_event, 200)
     for shape, motion, color, name in ((a, motion_a, "tab:red", names[0]),
                                        (b, motion_b, "tab:blue", names[1])):
-        _draw(ax, shape, color, 0.15, None)
-        _draw(ax, shape.at(motion, t_event), color, 0.45, f"{name} at t = {t_event:.6g}")
+        _draw(ax, shape, color, 0.15, f"{name} at t = 0")
+        _draw(ax, shape.at(motion, t_event), color, 0.5, f"{name} at t = {t_event:.6g}")
         path = np.array([shape.centroid + motion.pose(t)[0] for t in ts])
-        ax.plot(path[:, 0], path[:, 1], "--", color=color, lw=1.0)
+        ax.plot(path[:, 0], path[:, 1], "--", color=color, lw=1.0,
+                label=f"{name}'s centroid path")
         ax.plot(*shape.centroid, "o", color=color, ms=3)
     if impact.point is not None:
-        ax.plot(*impact.point, "k*", ms=12, label="contact point")
+        ax.plot(*impact.point, "*", color="gold", markeredgecolor="black", ms=13, zorder=5,
+                label="contact point")
         if impact.normal is not None:
-            size = 0.15 * max(a.bounding_radius, b.bounding_radius)
+            # Long enough to clear the marker, drawn above it.
+            size = 0.3 * max(a.bounding_radius, b.bounding_radius)
             ax.annotate("", xy=impact.point + size * impact.normal, xytext=impact.point,
-                        arrowprops={"arrowstyle": "->", "color": "k"})
+                        arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8},
+                        zorder=6)
+            ax.add_line(Line2D([], [], color="black", lw=1.8, marker=">", markevery=[1],
+                               label=f"normal, {names[0]} towards {names[1]}"))
     what = (f"collision at t = {impact.time:.6g}" if impact.collides
             else f"no collision ({impact.status.value})")
-    ax.set_title(f"{what} — {impact.method} method")
-    ax.set_aspect("equal")
+    ax.set_title(f"{what}, {impact.method} method")
+    label_axes(ax)
     ax.autoscale_view()
-    ax.legend(loc="best", fontsize="small")
+    legend_outside(ax)
     return ax

@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from ._style import label_axes, legend_outside, plural
+
 __all__ = ["plot_nfp"]
 
 
@@ -16,13 +18,13 @@ def _patch(geom: Any, **style: Any) -> Any:
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
 
-    verts = []
-    codes = []
+    verts: list[np.ndarray] = []
+    codes: list[int] = []
     for poly in shapely.get_parts(shapely.orient_polygons(geom)):
         for ring in (poly.exterior, *poly.interiors):
             xy = np.asarray(ring.coords)[:, :2]
             verts.extend(xy)
-            codes.extend([Path.MOVETO] + [Path.LINETO] * (len(xy) - 2) + [Path.CLOSEPOLY])
+            codes.extend(int(c) for c in [Path.MOVETO, *[Path.LINETO] * (len(xy) - 2), Path.CLOSEPOLY])
     return PathPatch(Path(np.asarray(verts), codes), **style)
 
 
@@ -54,13 +56,15 @@ def plot_nfp(nfp: Any, placement: Any = None, ax: Any = None) -> Any:
     >>> ax = plot_nfp(pc.no_fit_polygon(sq, sq.moved((3, 0))))
     >>> ax.get_title()
     'no-fit polygon: area 4, 0 holes, 0 exact fits, 0 slides'
+    >>> ax.get_xlabel()
+    'x (length units)'
     """
     import matplotlib.pyplot as plt
     import shapely
     import shapely.affinity
 
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 7), layout="constrained")
+        _, ax = plt.subplots(figsize=(9, 6.5), layout="constrained")
     region = nfp.region
     if placement is None:
         if len(nfp.exact_fits):
@@ -89,10 +93,11 @@ def plot_nfp(nfp: Any, placement: Any = None, ax: Any = None) -> Any:
     if len(nfp.exact_fits):
         ax.plot(nfp.exact_fits[:, 0], nfp.exact_fits[:, 1], "*", color="black",
                 markersize=12, label="exact fits")
-    ax.plot([p[0]], [p[1]], "o", color="red", label="reference point")
-    ax.set_aspect("equal")
+    ax.plot([p[0]], [p[1]], "o", color="red", label="A's reference point")
+    label_axes(ax)
     ax.autoscale_view()
-    ax.legend(loc="best", fontsize="small")
-    ax.set_title(f"no-fit polygon: area {region.area:.6g}, {holes} holes, "
-                 f"{len(nfp.exact_fits)} exact fits, {len(nfp.slides)} slides")
+    legend_outside(ax)
+    ax.set_title(f"no-fit polygon: area {region.area:.6g}, {plural(holes, 'hole')}, "
+                 f"{plural(len(nfp.exact_fits), 'exact fit')}, "
+                 f"{plural(len(nfp.slides), 'slide')}")
     return ax

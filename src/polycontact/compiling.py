@@ -1,0 +1,205 @@
+"""Compiling the kernels: where Numba's cache goes, whether it is warm, and warm-up.
+
+polycontact's kernels are compiled by Numba on first use and cached on disk. The first
+run on a new machine (or after an upgrade) therefore takes about a minute; every run
+after it loads the compiled code in well under a second.
+
+**Where the cache goes.** Numba's default would write it beside the installed sources
+(``site-packages/polycontact``), where ``pip uninstall`` leaves it behind. polycontact
+puts its own kernels' cache in the per-user cache directory instead
+(``platformdirs.user_cache_dir("polycontact")``, e.g. ``~/.cache/polycontact/numba`` on
+Linux). Setting ``NUMBA_CACHE_DIR`` overrides this for every Numba library, as Numba
+documents; other libraries' caches are never moved by polycontact.
+
+**First run.** :func:`warmup` compiles (or loads) every kernel family and reports each
+stage to a callback; the command line says "compiling kernels, first run only, about a
+minute" on stderr before a command whose kernels are not cached yet, with one line per
+stage (``polycontact warmup`` does it on purpose), so stdout stays parseable.
+
+Examples
+--------
+>>> from polycontact import compiling
+>>> sorted(compiling.FAMILIES)
+['classification', 'entrance block', 'no-fit polygon', 'time of impact']
+>>> compiling.cache_directory().is_absolute()
+True
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+__all__ = ["FAMILIES", "cache_directory", "is_warm", "warmup"]
+
+#: Kernel families, each with the kernels a warm cache must hold for it.
+FAMILIES: dict[str, tuple[str, ...]] = {
+    "classification": ("relation.relate_state", "relation.classify_raw"),
+    "time of impact": ("impact.exact_query", "impact.sampled_query"),
+    "no-fit polygon": ("nfp.entrance_region", "nfp.convex_sums"),
+    "entrance block": ("relation.relate_state",),
+}
+
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def cache_directory() -> Path:
+    """The directory that holds polycontact's compiled kernels.
+
+    ``NUMBA_CACHE_DIR`` when it is set (Numba's own override), else the per-user cache
+    directory of polycontact.
+    """
+    override = os.environ.get("NUMBA_CACHE_DIR")
+    if override:
+        return Path(override)
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("polycontact")) / "numba"
+
+
+def install_cache_locator() -> None:
+    """Make Numba cache polycontact's kernels in :func:`cache_directory`.
+
+    Called by ``polycontact._kernels`` before any kernel is defined. A locator class is
+    put first in Numba's list; it claims only functions whose source lies in this
+    package, and only when ``NUMBA_CACHE_DIR`` is not set (Numba's own locator then
+    applies). If this Numba has no such list, its default applies: the cache stays
+    beside the sources, which is slower to clean up but never wrong.
+    """
+    try:
+        from numba.core import caching, config
+    except ImportError:  # pragma: no cover - numba is a dependency
+        return
+    classes = getattr(getattr(caching, "CacheImpl", None), "_locator_classes", None)
+    base = getattr(caching, "UserProvidedCacheLocator", None)
+    if not isinstance(classes, list) or base is None:  # pragma: no cover - other Numba
+        return
+    if any(getattr(c, "_polycontact", False) for c in classes):
+        return
+
+    class _Locator(base):  # type: ignore[misc, valid-type]
+        _polycontact = True
+
+        def __init__(self, py_func: Any, py_file: str) -> None:
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            sub = self.get_suitable_cache_subpath(py_file)
+            self._cache_path = str(cache_directory() / sub)
+
+        @classmethod
+        def from_function(cls, py_func: Any, py_file: str) -> Any:
+            if getattr(config, "CACHE_DIR", "") or not Path(py_file).resolve().is_relative_to(_PACKAGE):
+                return None
+            locator = cls(py_func, py_file)
+            try:
+                locator.ensure_cache_path()
+            except OSError:
+                return None  # not writable: Numba's next locator decides
+            return locator
+
+    classes.insert(0, _Locator)
+
+
+def _dispatcher(name: str) -> Any:
+    """The compiled kernel (a Numba dispatcher) ``"module.function"`` of ``_kernels``."""
+    import importlib
+
+    module, func = name.split(".")
+    return getattr(importlib.import_module(f"._kernels.{module}", __package__), func)
+
+
+def is_warm(families: Iterable[str] = FAMILIES) -> bool:
+    """Whether the cache holds compiled code, for this Numba and these sources, for the
+    kernels of ``families`` (all by default).
+
+    Reads Numba's cache index of each kernel (a few small files); never compiles.
+    Answers False when it cannot tell, so a cold start is announced rather than hidden.
+    """
+    try:
+        for family in families:
+            for name in FAMILIES[family]:
+                cache = getattr(_dispatcher(name), "_cache", None)
+                index = getattr(cache, "_cache_file", None)
+                if index is None or not index._load_index():
+                    return False
+    except Exception:  # noqa: BLE001 - any doubt means "announce the compile"
+        return False
+    return True
+
+
+def _run(family: str) -> None:
+    """Call the public functions of one family on a tiny input (compiles its kernels)."""
+    import numpy as np
+
+    from .shape import Shape
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    if family == "classification":
+        from .relation import classify, classify_many
+
+        for d in ((2.0, 0.0), (1.0, 0.0), (0.5, 0.5)):
+            r = classify(sq, sq + d)
+            r.distance, r.features, r.point, r.normal  # noqa: B018 - computed on access
+            rs = classify(Shape(sq), Shape(sq + d))
+            rs.distance, rs.features  # noqa: B018
+        classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances  # noqa: B018
+    elif family == "time of impact":
+        from .impact import time_of_impact
+        from .motion import Motion
+
+        for method in ("exact", "sampled"):
+            hit = time_of_impact(Shape(sq), Motion(velocity=(1.0, 0.0)),
+                                 Shape(sq + (3.0, 0.0)), Motion(), t_max=5.0, method=method)
+            hit.features  # noqa: B018
+    elif family == "no-fit polygon":
+        from .nfp import inner_fit_polygon, no_fit_polygon
+
+        ell = Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+        no_fit_polygon(ell, Shape(sq)).region  # noqa: B018
+        inner_fit_polygon(Shape(sq), Shape(sq * 4.0))
+    elif family == "entrance block":
+        from .entrance import entrance_block
+
+        entrance_block(Shape(sq), Shape(sq + 0.5)).to_shapely()
+    else:
+        raise ValueError(f"family: expected one of {', '.join(FAMILIES)}, got {family!r}")
+
+
+def warmup(
+    families: Iterable[str] = FAMILIES,
+    *,
+    progress: Callable[[str, int, int, float | None], None] | None = None,
+) -> None:
+    """Compile (or load from the cache) the kernels now.
+
+    Numba compiles each kernel on its first call; call this once at start-up to pay
+    that cost up front instead of on the first :func:`polycontact.classify`,
+    :func:`polycontact.time_of_impact`, :func:`polycontact.no_fit_polygon` or
+    :func:`polycontact.entrance_block`.
+
+    Parameters
+    ----------
+    families : iterable of str, optional
+        Which kernel families (keys of :data:`FAMILIES`); all by default.
+    progress : callable, optional
+        Called as ``progress(family, k, n, seconds)`` before stage ``k`` of ``n``
+        (``seconds`` None) and after it (``seconds`` it took).
+
+    Examples
+    --------
+    >>> warmup(["classification"])
+    """
+    chosen = list(families)
+    for family in chosen:
+        if family not in FAMILIES:
+            raise ValueError(f"families: expected names from {', '.join(FAMILIES)}, got {family!r}")
+    for k, family in enumerate(chosen, 1):
+        if progress is not None:
+            progress(family, k, len(chosen), None)
+        t0 = time.perf_counter()
+        _run(family)
+        if progress is not None:
+            progress(family, k, len(chosen), time.perf_counter() - t0)

@@ -1,0 +1,94 @@
+"""The first run: where the compiled kernels go, and the notice a cold cache gives.
+
+Each test runs polycontact in a subprocess with an empty cache of its own, so nothing
+here depends on what the rest of the suite has compiled.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import polycontact
+from polycontact import compiling
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+PACKAGE = Path(polycontact.__file__).resolve().parent
+
+
+def _run(args: list[str], env: dict[str, str]) -> subprocess.CompletedProcess:
+    full = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    full.update(env)
+    return subprocess.run(args, capture_output=True, text=True, env=full, timeout=600)
+
+
+def test_cache_goes_to_the_user_cache_directory_not_site_packages(tmp_path):
+    code = (
+        "import numpy as np\n"
+        "from polycontact._kernels.advance import traversal_stack\n"
+        "traversal_stack()\n"
+        "from polycontact import compiling\n"
+        "print(compiling.cache_directory())\n"
+    )
+    before = set(PACKAGE.rglob("*.nbi"))
+    out = _run([sys.executable, "-c", code], {"XDG_CACHE_HOME": str(tmp_path)})
+    assert out.returncode == 0, out.stderr
+    where = Path(out.stdout.strip())
+    assert where == tmp_path / "polycontact" / "numba"
+    assert any(where.rglob("advance.traversal_stack*.nbi"))
+    assert set(PACKAGE.rglob("*.nbi")) == before
+
+
+def test_numba_cache_dir_overrides_the_location(tmp_path):
+    out = _run(
+        [sys.executable, "-c", "from polycontact import compiling; print(compiling.cache_directory())"],
+        {"NUMBA_CACHE_DIR": str(tmp_path)},
+    )
+    assert Path(out.stdout.strip()) == tmp_path
+
+
+def test_cold_cache_notice_goes_to_stderr_and_json_stays_parseable(tmp_path):
+    """A real first run: a fresh cache compiles the classification kernels (tens of
+    seconds), says so on stderr with one line per family, and stdout is the JSON alone."""
+    out = _run(
+        [sys.executable, "-m", "polycontact", "classify", str(EXAMPLES / "body-ell.json"),
+         str(EXAMPLES / "body-frame.json"), "--json"],
+        {"NUMBA_CACHE_DIR": str(tmp_path)},
+    )
+    assert out.returncode == 0, out.stderr
+    assert "compiling kernels, first run only, about a minute" in out.stderr
+    assert "[1/1] classification" in out.stderr
+    assert "compiling" not in out.stdout
+    assert json.loads(out.stdout)["state"] == "contact"
+    again = _run(
+        [sys.executable, "-m", "polycontact", "classify", str(EXAMPLES / "body-ell.json"),
+         str(EXAMPLES / "body-frame.json"), "--json"],
+        {"NUMBA_CACHE_DIR": str(tmp_path)},
+    )
+    assert again.returncode == 0 and again.stderr == ""
+    assert json.loads(again.stdout) == json.loads(out.stdout)
+
+
+def test_warmup_command_reports_every_family(tmp_path):
+    # Without the JIT the "compilation" is instant; the reporting is the same.
+    out = _run([sys.executable, "-m", "polycontact", "warmup"],
+               {"NUMBA_CACHE_DIR": str(tmp_path), "NUMBA_DISABLE_JIT": "1"})
+    assert out.returncode == 0, out.stderr
+    for k, family in enumerate(compiling.FAMILIES, 1):
+        assert f"[{k}/{len(compiling.FAMILIES)}] {family}" in out.stderr
+    assert out.stdout.startswith("kernels ready in")
+
+
+def test_version():
+    out = _run([sys.executable, "-m", "polycontact", "--version"], {})
+    assert out.stdout.strip() == f"polycontact {polycontact.__version__}"
+
+
+def test_warmup_refuses_an_unknown_family():
+    with pytest.raises(ValueError, match="families: expected names from"):
+        compiling.warmup(["classfication"])
