@@ -28,6 +28,7 @@ from .tolerances import (
     EXTENT_FLOOR,
     VALIDATION_ULPS,
     check_range,
+    default_tolerance,
     validation_tolerance,
 )
 
