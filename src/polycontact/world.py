@@ -536,12 +536,13 @@ class World:
         pos = np.ascontiguousarray(positions, dtype=np.float64)
         if pos.ndim != 2 or pos.shape[1] != 2:
             raise ValueError(f"positions: expected an array of shape (P, 2), got {pos.shape}")
-        ang = np.ascontiguousarray(np.broadcast_to(np.asarray(angles, dtype=np.float64),
-                                                   (len(pos),))) if np.ndim(angles) else \
-            np.full(len(pos), _angle(angles))
-        if ang.shape != (len(pos),):
-            raise ValueError(f"angles: expected a number or {len(pos)} numbers, got shape "
-                             f"{np.shape(angles)}")
+        if np.ndim(angles) == 0:
+            ang = np.full(len(pos), _angle(angles))
+        else:
+            ang = np.ascontiguousarray(angles, dtype=np.float64)
+            if ang.shape != (len(pos),):
+                raise ValueError(f"angles: expected a number or {len(pos)} numbers, got "
+                                 f"shape {ang.shape}")
         if not (np.isfinite(pos).all() and np.isfinite(ang).all()):
             raise ValueError("positions, angles: expected finite numbers")
         tol = self._tol(tolerance)
@@ -604,17 +605,31 @@ class World:
             slides.append(hit[2] + rec.position)
         if not regions:
             return ifp
-        blocked = shapely.union_all(regions)
-        keep = [ifp.difference(blocked)]
-        # Exact fits: kept where the exact query says the shape fits there.
-        keep += [shapely.Point(p) for p in fits if self.query(base, p, ang).fits]
-        # Slides: the parts inside the inner-fit polygon and outside the other regions.
-        for k, segs in enumerate(slides):
-            if not len(segs):
-                continue
-            others = shapely.union_all(regions[:k] + regions[k + 1:])
-            for s in segs:
-                piece = shapely.LineString(s).intersection(ifp).difference(others)
-                keep.append(piece)
-        keep = [g for g in keep if not g.is_empty]
+        free = ifp.difference(shapely.union_all(regions))
+        # Exact fits and slides: positions where the shape touches without overlapping
+        # but every neighbourhood overlaps. They lie on the regions' boundaries (two
+        # regions meeting), on their own fits and slides, or on the lower-dimensional
+        # parts of the inner-fit polygon. Every such piece not already in ``free`` is
+        # cut at its crossings and kept where the exact query says the shape fits.
+        lines = [r.boundary for r in regions] + [shapely.LineString(s) for s in
+                                                  np.concatenate(slides) if len(s)]
+        lines += [g for g in shapely.get_parts(ifp) if g.geom_type == "LineString"]
+        cand = shapely.union_all(lines).intersection(ifp).difference(free)
+        segs = []
+        for g in shapely.get_parts(cand):
+            if g.geom_type == "LineString":
+                xy = np.asarray(g.coords)
+                segs.extend(np.stack([xy[:-1], xy[1:]], axis=1))
+        pts = [np.asarray(g.coords)[0] for g in shapely.get_parts(ifp)
+               if g.geom_type == "Point"]
+        pts += list(fits) + [s[0] for s in segs] + [s[1] for s in segs]
+        keep = [free] if not free.is_empty else []
+        if segs:
+            segs = np.array(segs)
+            ok = self.query_many(base, segs.mean(axis=1), ang) < 2
+            keep += [shapely.LineString(s) for s in segs[ok]]
+        if pts:
+            pts = np.unique(np.array(pts), axis=0)
+            ok = self.query_many(base, pts, ang) < 2
+            keep += [shapely.Point(p) for p in pts[ok]]
         return shapely.union_all(keep) if keep else shapely.Polygon()
