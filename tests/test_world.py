@@ -308,3 +308,31 @@ def test_published_layouts_are_feasible(path):
     got = world.contacts()
     assert not (got.states == 2).any(), got.penetrating.tolist()
     assert not (got.container_states == 2).any(), got.container_ids.tolist()
+
+
+def test_add_many_equals_add_one_by_one():
+    rng = np.random.default_rng(11)
+    rings = [TEMPLATES[int(rng.integers(5))].exterior + rng.integers(0, 30, 2) / 2
+             for _ in range(200)]
+    rings += [r[::-1].copy() for r in rings[:20]]  # clockwise raw rings
+    shapes = [TEMPLATES[2].moved((3.0, 4.0)), TEMPLATES[2].moved((5.0, 4.0))]
+    one = pc.World()
+    for r in rings + shapes:
+        one.add(r)
+    many = pc.World()
+    ids = many.add_many(rings + shapes, names=[str(k) for k in range(len(rings) + 2)])
+    assert ids.tolist() == list(range(len(rings) + 2)) and many.body(5).name == "5"
+    a, b = one.contacts(), many.contacts()
+    assert a.pairs.tolist() == b.pairs.tolist() and a.states.tolist() == b.states.tolist()
+    assert (a.tolerances == b.tolerances).all()
+    pairs, states = brute_contacts(many)
+    assert b.pairs.tolist() == [list(p) for p in pairs] and b.states.tolist() == states
+
+
+def test_a_contacts_answer_keeps_the_poses_it_was_computed_at():
+    world = pc.World()
+    world.add_many(np.stack([TEMPLATES[3].exterior, TEMPLATES[3].exterior + (1.0, 0.0)]))
+    c = world.contacts()
+    world.move(1, (9.0, 9.0))
+    assert c.relation(0).state == pc.State.CONTACT
+    assert len(world.contacts()) == 0

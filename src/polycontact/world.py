@@ -54,9 +54,10 @@ def _k() -> Any:
 
 
 def _chunks(count: int) -> int:
+    """Parallel chunks for ``count`` items: 1 (serial, no thread start) below 4096."""
     import numba
 
-    return max(1, min(count, 4 * numba.get_num_threads()))
+    return 1 if count < 4096 else 4 * numba.get_num_threads()
 
 
 @dataclass(frozen=True)
@@ -112,7 +113,7 @@ class Contacts:
     tolerances: np.ndarray
     container_ids: np.ndarray
     container_states: np.ndarray
-    _shapes: dict = field(repr=False)
+    _store: tuple = field(repr=False)  # the coordinates as they were
     _tolerance: float | None = field(repr=False)
 
     def __len__(self) -> int:
@@ -124,7 +125,10 @@ class Contacts:
         if not 0 <= k < len(self.states):
             raise IndexError(f"k: pair {k} out of range (0..{len(self.states) - 1})")
         i, j = (int(v) for v in self.pairs[k])
-        return classify(self._shapes[i], self._shapes[j], tolerance=self._tolerance)
+        xy, ls, lo, nl = self._store
+        a = _stored_shape(xy, ls, int(lo[i]), int(nl[i]))
+        b = _stored_shape(xy, ls, int(lo[j]), int(nl[j]))
+        return classify(a, b, tolerance=self._tolerance)
 
     @property
     def penetrating(self) -> np.ndarray:
@@ -184,6 +188,21 @@ def _place(base: Shape, position: np.ndarray | None, angle: float, what: str) ->
     )
 
 
+def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """:func:`polycontact.default_tolerance` of each body alone, from its box corners
+    (B, 2), vectorised with the same operations. A pair's default tolerance is the larger
+    of its two bodies' (a maximum of per-body terms), which the kernels take."""
+    extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
+    magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
+    return np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude)
+
+
+def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int) -> Shape:
+    """The Shape of a body stored at loop-start row ``lo`` with ``nl`` loops (a copy)."""
+    st = ls[lo : lo + nl + 1]
+    return Shape._trusted([xy[st[k] : st[k + 1]].copy() for k in range(nl)])
+
+
 def _pow2(n: int) -> int:
     return 1 << max(6, (n - 1).bit_length())
 
@@ -209,7 +228,10 @@ class World:
     """
 
     def __init__(self, container: Any = None) -> None:
-        self._records: dict[int, WorldBody] = {}
+        # id -> [name, base, position, angle, motion, shape]; base, position and shape
+        # are None until asked for (bodies added by add_many are kept as coordinates).
+        self._records: dict[int, list] = {}
+        self._shared = False  # a Contacts holds self._xy: copy it before writing in place
         self._next = 0
         cap = 64
         self._box = np.zeros((cap, 4))
@@ -284,14 +306,21 @@ class World:
 
     def bodies(self) -> tuple[WorldBody, ...]:
         """Every body (read-only records), by id."""
-        return tuple(self._records[i] for i in sorted(self._records))
+        return tuple(self.body(i) for i in sorted(self._records))
 
     def body(self, id: int) -> WorldBody:
         """The body with this id (a read-only record)."""
         try:
-            return self._records[id]
+            rec = self._records[id]
         except (KeyError, TypeError):
             raise KeyError(f"id: no body {id!r} in this world (never added, or removed)") from None
+        if rec[5] is None:
+            rec[5] = _stored_shape(self._xy, self._ls, int(self._lo[id]), int(self._nl[id]))
+        if rec[1] is None:
+            rec[1] = rec[5]
+        if rec[2] is None:
+            rec[2] = rec[1].centroid.copy()
+        return WorldBody(int(id), rec[0], rec[5], rec[1], rec[2], rec[3], rec[4])
 
     def add(self, shape: Any, position: Any = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
@@ -319,17 +348,71 @@ class World:
         b = self._next
         self._next += 1
         self._grow_bodies(b + 1)
-        self._store(b, placed)
+        self._store_many(np.array([b]), [placed.packed])
         self._index(b)
-        self._records[b] = WorldBody(b, name, placed, base, (base.centroid if pos is None else pos).copy(), ang,
-                                     motion)
+        self._records[b] = [name, base, None if pos is None else pos.copy(), ang, motion, placed]
         return b
+
+    def add_many(self, shapes: Any, *, names: Any = None) -> np.ndarray:
+        """Add many bodies where their coordinates are; returns their ids.
+
+        Raw rings are validated together in one compiled call (as
+        :func:`polycontact.classify_many` does) and the broad phase takes them in one
+        pass, so this is much faster than :meth:`add` in a loop; the answers are the
+        same.
+
+        Parameters
+        ----------
+        shapes : sequence of bodies, or ndarray of shape (P, N, 2)
+            As for :func:`polycontact.classify_many`.
+        names : sequence of str, optional
+
+        Examples
+        --------
+        >>> import numpy as np, polycontact as pc
+        >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+        >>> w = pc.World()
+        >>> w.add_many(np.stack([sq, sq + 1, sq + 3])).tolist()
+        [0, 1, 2]
+        >>> w.contacts().pairs.tolist()
+        [[0, 1]]
+        """
+        from .relation import _pack
+
+        xy, ls, bs, sign = _pack(shapes, "shapes")
+        count = len(sign)
+        if names is not None:
+            names = list(names)
+            if len(names) != count or not all(isinstance(n, str) for n in names):
+                raise ValueError(f"names: expected {count} strings")
+        loops = []
+        for p in range(count):
+            st = ls[bs[p] : bs[p + 1]]
+            rows = xy[st[0] : st[-1]]
+            if sign[p] < 0:  # a clockwise raw ring: stored counter-clockwise, as Shape does
+                rows = rows[::-1]
+            loops.append((rows, st - st[0]))
+        xy_all = np.concatenate([r for r, _ in loops]) if loops else np.empty((0, 2))
+        check_range(xy_all, "shapes")
+        first = self._next
+        self._next += count
+        self._grow_bodies(self._next)
+        ids = np.arange(first, first + count, dtype=np.int64)
+        self._store_many(ids, loops)
+        for k, b in enumerate(ids.tolist()):
+            self._records[b] = [None if names is None else names[k], None, None, 0.0, None,
+                                None]
+        self._index_many(ids)
+        return ids
 
     def move(self, id: int, position: Any = None, angle: float | None = None) -> None:
         """Put body ``id`` at a new pose (None keeps the current position or angle); the
         pose applies to the shape as added."""
         rec = self.body(id)
         pos = rec.position if position is None else point_arg(position, "position")
+        if self._shared:
+            self._xy = self._xy.copy()
+            self._shared = False
         ang = rec.angle if angle is None else _angle(angle)
         placed = _place(rec.base, pos, ang, "body placed at position")
         self._unindex(id)
@@ -339,14 +422,14 @@ class World:
         self._xy[first : first + len(xy)] = xy  # same vertex count: in place
         self._set_box(id, xy)
         self._index(id)
-        self._records[id] = WorldBody(id, rec.name, placed, rec.base, pos.copy(), ang,
-                                      rec.motion)
+        self._records[id] = [rec.name, rec.base, pos.copy(), ang, rec.motion, placed]
 
     def remove(self, id: int) -> None:
         """Take body ``id`` out of the world."""
-        rec = self.body(id)
+        self.body(id)
         self._unindex(id)
-        self._garbage += rec.shape.n_vertices
+        lo, nl = self._lo[id], self._nl[id]
+        self._garbage += int(self._ls[lo + nl] - self._ls[lo])
         del self._records[id]
         if self._garbage > 1024 and self._garbage > self._vtop // 2:
             self._compact()
@@ -364,38 +447,54 @@ class World:
             arr[:cap] = old
             setattr(self, name, arr)
 
-    def _store(self, b: int, placed: Shape) -> None:
-        xy, starts = placed.packed
-        nv, nl = len(xy), len(starts) - 1
-        if self._vtop + nv > len(self._xy):
-            self._xy = np.concatenate([self._xy, np.zeros((max(nv, len(self._xy)), 2))])
-        if self._ltop + nl + 1 > len(self._ls):
-            self._ls = np.concatenate([self._ls, np.zeros(max(nl + 1, len(self._ls)),
-                                                          np.int64)])
-        self._xy[self._vtop : self._vtop + nv] = xy
-        self._ls[self._ltop : self._ltop + nl + 1] = starts + self._vtop
-        self._lo[b] = self._ltop
-        self._nl[b] = nl
-        self._vtop += nv
-        self._ltop += nl + 1
-        self._vmax = max(self._vmax, nv)
-        self._lmax = max(self._lmax, nl)
-        self._set_box(b, xy)
-
     def _set_box(self, b: int, xy: np.ndarray) -> None:
         lo = xy.min(axis=0)
         hi = xy.max(axis=0)
         self._box[b] = (lo[0], hi[0], lo[1], hi[1])
-        self._eps[b] = default_tolerance(xy)
+        self._eps[b] = _body_tolerances(lo[None, :], hi[None, :])[0]
 
     def _compact(self) -> None:
         """Drop the coordinates of removed bodies (moves overwrite in place)."""
-        ids = sorted(self._records)
+        ids = np.array(sorted(self._records), np.int64)
+        old_xy, old_ls, old_lo, old_nl = self._xy, self._ls, self._lo.copy(), self._nl.copy()
         self._vtop = self._ltop = self._garbage = 0
-        self._xy = np.zeros((max(1024, 2 * sum(r.shape.n_vertices for r in self._records.values())), 2))
-        self._ls = np.zeros(max(256, 2 * sum(len(r.shape.packed[1]) for r in self._records.values())), np.int64)
-        for b in ids:
-            self._store(b, self._records[b].shape)
+        self._xy = np.zeros((max(1024, 2 * len(old_xy) // 2), 2))
+        self._ls = np.zeros(max(256, len(old_ls)), np.int64)
+        self._shared = False
+        loops = []
+        for b in ids.tolist():
+            st = old_ls[old_lo[b] : old_lo[b] + old_nl[b] + 1]
+            loops.append((old_xy[st[0] : st[-1]], st - st[0]))
+        self._store_many(ids, loops)
+
+    def _store_many(self, ids: np.ndarray, loops: list) -> None:
+        """Append bodies given as (rows, local loop starts), and set boxes and tolerances."""
+        if not loops:
+            return
+        nv = np.array([len(r) for r, _ in loops], np.int64)
+        nl = np.array([len(st) - 1 for _, st in loops], np.int64)
+        v_need, l_need = int(nv.sum()), int((nl + 1).sum())
+        if self._vtop + v_need > len(self._xy):
+            self._xy = np.concatenate([self._xy, np.zeros((max(v_need, len(self._xy)), 2))])
+        if self._ltop + l_need > len(self._ls):
+            self._ls = np.concatenate([self._ls, np.zeros(max(l_need, len(self._ls)),
+                                                          np.int64)])
+        voff = self._vtop + np.concatenate([[0], np.cumsum(nv)[:-1]])
+        loff = self._ltop + np.concatenate([[0], np.cumsum(nl + 1)[:-1]])
+        rows = np.concatenate([r for r, _ in loops])
+        self._xy[self._vtop : self._vtop + v_need] = rows
+        self._ls[self._ltop : self._ltop + l_need] = np.concatenate(
+            [st + o for (_, st), o in zip(loops, voff.tolist())])
+        self._lo[ids] = loff
+        self._nl[ids] = nl
+        self._vtop += v_need
+        self._ltop += l_need
+        self._vmax = max(self._vmax, int(nv.max()))
+        self._lmax = max(self._lmax, int(nl.max()))
+        lo = np.minimum.reduceat(rows, voff - voff[0])
+        hi = np.maximum.reduceat(rows, voff - voff[0])
+        self._box[ids] = np.c_[lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1]]
+        self._eps[ids] = _body_tolerances(lo, hi)
 
     def _index(self, b: int) -> None:
         if self._origin is None:
@@ -408,14 +507,31 @@ class World:
                                          self._slot, self._level, self._lvl_count, self._box,
                                          self._origin, b)
 
+    def _index_many(self, ids: np.ndarray) -> None:
+        if self._origin is None and len(ids):
+            self._origin = np.array([0.5 * (self._box[ids[0], 0] + self._box[ids[0], 1]),
+                                     0.5 * (self._box[ids[0], 2] + self._box[ids[0], 3])])
+        todo = ids
+        while len(todo):
+            made, done = _k().grid_insert_many(self._keys, self._heads, self._nxt, self._prv,
+                                               self._slot, self._level, self._lvl_count,
+                                               self._box, self._origin, todo, self._filled)
+            self._filled += made
+            todo = todo[done:]
+            if len(todo):
+                self._rebuild(extra=int(todo[0]), pending=todo)
+                todo = todo[1:]
+
     def _unindex(self, b: int) -> None:
         _k().grid_remove(self._heads, self._nxt, self._prv, self._slot, self._level,
                          self._lvl_count, b)
 
-    def _rebuild(self, extra: int) -> None:
-        """A new table, twice the live cells (amortised: happens when it is half full)."""
-        alive = np.array(sorted({*self._records, extra}), np.int64)
-        cap = _pow2(4 * len(alive) + 16)
+    def _rebuild(self, extra: int, pending: np.ndarray | None = None) -> None:
+        """A new table, four times the live bodies (amortised: when it is half full).
+        ``extra`` is indexed too; ``pending`` (not yet indexed) is left out."""
+        skip = set() if pending is None else set(pending.tolist())
+        alive = np.array(sorted({*(set(self._records) - skip), extra}), np.int64)
+        cap = _pow2(4 * (len(alive) + len(skip)) + 16)
         self._keys = np.full(cap, -1, np.int64)
         self._heads = np.full(cap, -1, np.int64)
         self._filled = _k().grid_rebuild(self._keys, self._heads, self._nxt, self._prv,
@@ -482,8 +598,9 @@ class World:
             c_ids, c_states = alive[cst > 0], cst[cst > 0]
         else:
             c_ids, c_states = np.empty(0, np.int64), np.empty(0, np.int8)
-        shapes = {int(i): self._records[int(i)].shape for i in np.unique(pairs)}
-        return Contacts(pairs, states, used, c_ids, c_states, shapes,
+        self._shared = True
+        store = (self._xy, self._ls, self._lo.copy(), self._nl.copy())
+        return Contacts(pairs, states, used, c_ids, c_states, store,
                         None if tolerance is None else tol)
 
     def query(self, shape: Any, position: Any = None, angle: float = 0.0, *,
@@ -590,7 +707,7 @@ class World:
         a = _place(base, None, ang, "shape")
         ifp = inner_fit_polygon(a, self._container)
         regions, fits, slides = [], [], []
-        for rec in self._records.values():
+        for rec in self.bodies():
             # The NFP around the body with its centroid at the origin, kept per pair of
             # (shape, angle): bodies added from one Shape share it, translated.
             key = (id(base), ang, id(rec.base), rec.angle)

@@ -127,6 +127,22 @@ def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
 
 
 @njit(cache=True, nogil=True)
+def grid_insert_many(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, bodies,
+                     filled):
+    """:func:`grid_insert` of each body in ``bodies`` into a table holding ``filled``
+    cells; stops before it would be more than half full and returns (cells made,
+    bodies inserted)."""
+    made = 0
+    limit = keys.shape[0] // 2
+    for k in range(bodies.shape[0]):
+        if filled + made + 1 > limit:
+            return made, k
+        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin,
+                            bodies[k])
+    return made, bodies.shape[0]
+
+
+@njit(cache=True, nogil=True)
 def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, alive):
     """Fill an emptied table (``keys`` all -1) with the bodies in ``alive``."""
     lvl_count[:] = 0
@@ -235,24 +251,35 @@ def _view(xy, ls, lo, nl, b, buf):
     return xy[first : ls[lo[b] + m]], buf[: m + 1]
 
 
+@njit(cache=True, nogil=True)
+def _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, k0, k1, states, used):
+    box, ids, touch, rays, rord = _scratch(2 * vmax)
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    for k in range(k0, k1):
+        i = pi[k]
+        j = pj[k]
+        ya, sa = _view(xy, ls, lo, nl, i, ba)
+        yb, sb = _view(xy, ls, lo, nl, j, bb)
+        e = tol if tol >= 0.0 else max(eps[i], eps[j])
+        used[k] = e
+        states[k] = _state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def classify_pairs(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, chunks):
-    """States (int8) and tolerances of the pairs (pi[k], pj[k]), in parallel chunks."""
+    """States (int8) and tolerances of the pairs (pi[k], pj[k]), in parallel chunks
+    (``chunks`` = 1: serial, no thread start)."""
     k_count = pi.shape[0]
     states = np.empty(k_count, np.int8)
     used = np.empty(k_count)
+    if chunks == 1:
+        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, 0, k_count, states,
+                        used)
+        return states, used
     for c in prange(chunks):
-        box, ids, touch, rays, rord = _scratch(2 * vmax)
-        ba = np.empty(lmax + 1, np.int64)
-        bb = np.empty(lmax + 1, np.int64)
-        for k in range(k_count * c // chunks, k_count * (c + 1) // chunks):
-            i = pi[k]
-            j = pj[k]
-            ya, sa = _view(xy, ls, lo, nl, i, ba)
-            yb, sb = _view(xy, ls, lo, nl, j, bb)
-            e = tol if tol >= 0.0 else max(eps[i], eps[j])
-            used[k] = e
-            states[k] = _state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
+        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax,
+                        k_count * c // chunks, k_count * (c + 1) // chunks, states, used)
     return states, used
 
 
@@ -280,7 +307,7 @@ def container_states(xy, ls, lo, nl, box, eps, tol, alive, hxy, hls, hlo, hnl, c
     """Container state (0, 1, 2) of every live body, in parallel chunks."""
     n = alive.shape[0]
     out = np.empty(n, np.int8)
-    for c in prange(chunks):
+    for c in prange(chunks):  # few bodies: chunks = 1, one thread
         bx, ids, touch, rays, rord = _scratch(vmax + hmax)
         ba = np.empty(lmax + 1, np.int64)
         hb = np.empty(hnl.max() + 1, np.int64)
@@ -340,46 +367,62 @@ def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
                             touch, rays, rord)
 
 
+@njit(cache=True, nogil=True)
+def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                 level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax,
+                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, p0, p1, out):
+    n = ss[ss.shape[0] - 1]
+    qxy = np.empty((n, 2))
+    cand = np.empty(n_ids, np.int64)
+    bx, ids, touch, rays, rord = _scratch(n + max(vmax, hmax))
+    buf = np.empty(lmax + 1, np.int64)
+    hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
+    for p in range(p0, p1):
+        place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
+        x0, x1, y0, y1 = _bbox(qxy, n)
+        mag = max(max(-x0, x1), max(-y0, y1))
+        qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
+        worst = 0
+        if has_container:
+            e = tol if tol >= 0.0 else max(qeps, ceps)
+            worst = _container_state(qxy, ss, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox,
+                                     hb, bx, ids, touch, rays, rord)
+        if worst < 2:
+            e0 = tol if tol >= 0.0 else qeps
+            d = e0 + (tol if tol >= 0.0 else emax)
+            m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d,
+                        y0 - d, y1 + d, 0, n_ids, cand)
+            for t in range(m):
+                j = cand[t]
+                e = tol if tol >= 0.0 else max(qeps, eps[j])
+                if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
+                    continue
+                yb, sb = _view(xy, ls, lo, nl, j, buf)
+                s = _state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+                if s > worst:
+                    worst = s
+                    if worst == 2:
+                        break
+        out[p] = worst
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def query_many(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt, level,
                lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax, lmax,
                has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, chunks):
     """Worst state (int8) of the shape (sxy, ss) placed at each (px[p], py[p], angles[p])
-    over every body and the container (outside counts as 2)."""
+    over every body and the container (outside counts as 2); ``chunks`` = 1: serial."""
     p_count = px.shape[0]
-    n = ss[ss.shape[0] - 1]
     out = np.empty(p_count, np.int8)
+    if chunks == 1:
+        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, 0,
+                     p_count, out)
+        return out
     for c in prange(chunks):
-        qxy = np.empty((n, 2))
-        cand = np.empty(n_ids, np.int64)
-        bx, ids, touch, rays, rord = _scratch(n + max(vmax, hmax))
-        buf = np.empty(lmax + 1, np.int64)
-        hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
-        for p in range(p_count * c // chunks, p_count * (c + 1) // chunks):
-            place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
-            x0, x1, y0, y1 = _bbox(qxy, n)
-            mag = max(max(-x0, x1), max(-y0, y1))
-            qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
-            worst = 0
-            if has_container:
-                e = tol if tol >= 0.0 else max(qeps, ceps)
-                worst = _container_state(qxy, ss, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox,
-                                         hb, bx, ids, touch, rays, rord)
-            if worst < 2:
-                e0 = tol if tol >= 0.0 else qeps
-                d = e0 + (tol if tol >= 0.0 else emax)
-                m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d,
-                            y0 - d, y1 + d, 0, n_ids, cand)
-                for t in range(m):
-                    j = cand[t]
-                    e = tol if tol >= 0.0 else max(qeps, eps[j])
-                    if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
-                        continue
-                    yb, sb = _view(xy, ls, lo, nl, j, buf)
-                    s = _state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
-                    if s > worst:
-                        worst = s
-                        if worst == 2:
-                            break
-            out[p] = worst
+        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax,
+                     p_count * c // chunks, p_count * (c + 1) // chunks, out)
     return out
