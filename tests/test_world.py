@@ -336,3 +336,58 @@ def test_a_contacts_answer_keeps_the_poses_it_was_computed_at():
     world.move(1, (9.0, 9.0))
     assert c.relation(0).state == pc.State.CONTACT
     assert len(world.contacts()) == 0
+
+
+def _write(tmp_path, data, name="layout.json"):
+    path = tmp_path / name
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+SQ = [[0, 0], [1, 0], [1, 1], [0, 1]]
+
+
+def _layout():
+    return {"container": [[0, 0], [4, 0], [4, 2], [0, 2]],
+            "placed": [{"item": 0, "vertices": SQ},
+                       {"item": 0, "vertices": [[x + 1, y] for x, y in SQ]},
+                       {"item": 1, "vertices": [[x + 1.5, y + 0.5] for x, y in SQ]},
+                       {"item": 1, "vertices": [[x + 3.5, y] for x, y in SQ]}]}
+
+
+def test_cli_contacts_lists_pairs_and_container(tmp_path, capsys):
+    from polycontact.cli import main
+
+    assert main(["contacts", _write(tmp_path, _layout()), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    got = [(p["a"], p["b"], p["state"]) for p in rep["contacts"]]
+    assert got == [(0, 1, "contact"), (1, 2, "penetrating")]
+    assert [(c["body"], c["state"]) for c in rep["container_contacts"]] == [
+        (0, "contact"), (1, "contact"), (3, "outside")]
+    assert main(["contacts", _write(tmp_path, _layout())]) == 0
+    out = capsys.readouterr().out
+    assert "pairs: 2 (1 in contact, 1 penetrating)" in out and "3 (1): outside" in out
+
+
+def test_cli_contacts_without_container_and_plot(tmp_path, capsys):
+    from polycontact.cli import main
+
+    data = {"bodies": [{"name": "a", "vertices": SQ}, {"name": "b", "vertices": SQ}]}
+    png = tmp_path / "c.png"
+    assert main(["contacts", _write(tmp_path, data), "--plot", str(png)]) == 0
+    assert "0 (a) and 1 (b): penetrating" in capsys.readouterr().out
+    assert png.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("data, message", [
+    ({"items": {}}, "expected an object with 'placed' or 'bodies'"),
+    ({"placed": [{"item": 0}]}, "body 0: expected an object with 'vertices'"),
+    ({"placed": [{"vertices": [[0, 0], [1, 1], [1, 0], [0, 1]]}]}, "body 0: outer loop: self"),
+    ({"container": [[0, 0], [1, 1]], "placed": []}, "container: "),
+])
+def test_cli_contacts_refuses_bad_layouts(tmp_path, capsys, data, message):
+    from polycontact.cli import main
+
+    assert main(["contacts", _write(tmp_path, data)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "layout.json" in err
