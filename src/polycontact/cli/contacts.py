@@ -143,10 +143,11 @@ def plot(world: Any, rep: dict, path: str) -> None:
     deep = [p["point"] for p in rep["contacts"] if p["state"] == "penetrating" and p["point"]]
     if touch:
         xs, ys = zip(*touch)
-        ax.plot(xs, ys, "o", ms=5, mfc="none", mec="k", label=plural(len(touch), "contact"))
+        ax.plot(xs, ys, "o", ms=9, mfc="none", mec="#2ca02c", mew=2, zorder=5,
+                label=plural(len(touch), "contact"))
     if deep:
         xs, ys = zip(*deep)
-        ax.plot(xs, ys, "x", ms=8, mew=2, color="k",
+        ax.plot(xs, ys, "x", ms=9, mew=2, color="k", zorder=5,
                 label=plural(len(deep), "penetration"))
     ax.autoscale_view()
     label_axes(ax)
