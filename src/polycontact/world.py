@@ -249,6 +249,7 @@ class World:
         self._garbage = 0
         self._vmax = 0
         self._lmax = 1
+        self._emax = 0.0  # an upper bound of the bodies' tolerances (never lowered)
         self._origin: np.ndarray | None = None
         self._keys = np.full(64, -1, np.int64)
         self._heads = np.full(64, -1, np.int64)
@@ -452,6 +453,7 @@ class World:
         hi = xy.max(axis=0)
         self._box[b] = (lo[0], hi[0], lo[1], hi[1])
         self._eps[b] = _body_tolerances(lo[None, :], hi[None, :])[0]
+        self._emax = max(self._emax, float(self._eps[b]))
 
     def _compact(self) -> None:
         """Drop the coordinates of removed bodies (moves overwrite in place)."""
@@ -495,6 +497,7 @@ class World:
         hi = np.maximum.reduceat(rows, voff - voff[0])
         self._box[ids] = np.c_[lo[:, 0], hi[:, 0], lo[:, 1], hi[:, 1]]
         self._eps[ids] = _body_tolerances(lo, hi)
+        self._emax = max(self._emax, float(self._eps[ids].max()))
 
     def _index(self, b: int) -> None:
         if self._origin is None:
@@ -621,9 +624,9 @@ class World:
         qeps = default_tolerance(qxy)
         k = _k()
         if self._records:
-            emax = float(self._eps[self._alive()].max())
             ids, states = k.query_states(qxy, qs, qeps, *self._grid(), self._xy, self._ls,
-                                         self._lo, self._nl, self._box, self._eps, tol, emax,
+                                         self._lo, self._nl, self._box, self._eps, tol,
+                                         self._emax,
                                          self._next, self._vmax, self._lmax)
         else:
             ids, states = np.empty(0, np.int64), np.empty(0, np.int8)
@@ -665,8 +668,6 @@ class World:
         tol = self._tol(tolerance)
         sxy, ss = base.packed
         c = base.centroid
-        alive = self._alive()
-        emax = float(self._eps[alive].max()) if len(alive) else 0.0
         has_c = self._container is not None
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
@@ -674,7 +675,7 @@ class World:
         return _k().query_many(
             sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
             RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
-            self._nl, self._box, self._eps, emax, self._next, self._vmax, self._lmax, has_c,
+            self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
             *hz, self._hmax if has_c else 0, _chunks(len(pos)),
         )
 
