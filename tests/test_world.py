@@ -64,12 +64,15 @@ def scaled(t, scale, offset):
     return pc.Shape(s.exterior * scale + offset, [h * scale + offset for h in s.holes])
 
 
+CODES = {"separate": 0, "contact": 1, "penetrating": 2}
+
+
 def brute_contacts(world, tolerance=None):
     bodies = world.bodies()
     pairs, states = [], []
     for a, b in itertools.combinations(bodies, 2):
         s = pc.classify(a.shape, b.shape, tolerance=tolerance).state
-        code = ["separate", "contact", "penetrating"].index(s.value)
+        code = CODES[s.value]
         if code:
             pairs.append((a.id, b.id))
             states.append(code)
@@ -123,7 +126,7 @@ def test_query_and_query_many_equal_brute_force(op_list, probes):
         q = world.query(TEMPLATES[t], p, a)
         expect = {}
         for body in world.bodies():
-            s = ["separate", "contact", "penetrating"].index(pc.classify(q.shape, body.shape).state.value)
+            s = CODES[pc.classify(q.shape, body.shape).state.value]
             if s:
                 expect[body.id] = s
         assert q.ids.tolist() == sorted(expect)
