@@ -79,7 +79,7 @@ def _key(idx, ix, iy):
 def _slot(keys, key):
     """The slot holding ``key``, or the empty slot where it goes (linear probing)."""
     mask = keys.shape[0] - 1
-    h = key * 6364136223846793005
+    h = int(key) * 6364136223846793005  # wraps in int64 when compiled
     h = (h ^ (h >> 29)) & mask
     while keys[h] != key and keys[h] != -1:
         h = (h + 1) & mask
@@ -90,7 +90,7 @@ def _slot(keys, key):
 def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
     """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
     idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
-    c = math.ldexp(1.0, idx - _LEVEL_OFFSET)
+    c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
     ix = _cell(0.5 * (box[b, 0] + box[b, 1]) - origin[0], c)
     iy = _cell(0.5 * (box[b, 2] + box[b, 3]) - origin[1], c)
     key = _key(idx, ix, iy)
@@ -164,7 +164,7 @@ def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, 
         idx = levels[li]
         if idx < low:
             continue
-        c = math.ldexp(1.0, idx - _LEVEL_OFFSET)
+        c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
         ix0 = _cell(q0 - origin[0] - 1.51 * c, c)
         ix1 = _cell(q1 - origin[0] + 0.51 * c, c)
         iy0 = _cell(q2 - origin[1] - 1.51 * c, c)
