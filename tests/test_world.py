@@ -394,3 +394,14 @@ def test_cli_contacts_refuses_bad_layouts(tmp_path, capsys, data, message):
     assert main(["contacts", _write(tmp_path, data)]) == 2
     err = capsys.readouterr().err
     assert message in err and "layout.json" in err
+
+
+def test_feasible_region_avoids_the_container_holes():
+    world = pc.World(CONTAINER)
+    region = world.feasible_region(TEMPLATES[3].exterior)  # an array: not cached
+    assert not region.contains(shapely.Point(6, 5))        # the hole (5..7, 4..6)
+    assert region.distance(shapely.Point(6, 3.5)) < 1e-9   # touching the hole from below
+    assert world.query(TEMPLATES[3], (6, 3.5)).fits and not world._nfp_cache
+    world.add(TEMPLATES[0], (2, 2))
+    region = world.feasible_region(TEMPLATES[3])
+    assert not region.contains(shapely.Point(2, 2)) and len(world._nfp_cache) == 1

@@ -703,6 +703,7 @@ class World:
         if self._container is None:
             raise ValueError("feasible_region: the world has no container, the free "
                              "region would be unbounded")
+        cache = isinstance(shape, Shape)
         base = as_shape(shape, "shape")
         ang = _angle(angle)
         a = _place(base, None, ang, "shape")
@@ -711,12 +712,15 @@ class World:
         for rec in self.bodies():
             # The NFP around the body with its centroid at the origin, kept per pair of
             # (shape, angle): bodies added from one Shape share it, translated.
+            # (Only for a Shape the caller holds: a new Shape made from an array on each
+            # call would never be found again.)
             key = (id(base), ang, id(rec.base), rec.angle)
-            hit = self._nfp_cache.get(key)
+            hit = self._nfp_cache.get(key) if cache else None
             if hit is None:
                 nfp = no_fit_polygon(a, _place(rec.base, np.zeros(2), rec.angle, "body"))
                 hit = (nfp.region, nfp.exact_fits, nfp.slides, base, rec.base)
-                self._nfp_cache[key] = hit
+                if cache:
+                    self._nfp_cache[key] = hit
             dx, dy = (float(v) for v in rec.position)
             regions.append(affinity.translate(hit[0], dx, dy))
             fits.extend(hit[1] + rec.position)
