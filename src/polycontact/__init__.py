@@ -53,6 +53,10 @@ _LAZY = {
     "NoFitPolygon": "nfp",
     "no_fit_polygon": "nfp",
     "inner_fit_polygon": "nfp",
+    # many bodies
+    "World": "world",
+    "Contacts": "world",
+    "Query": "world",
 }
 
 __all__ = [

@@ -1,0 +1,428 @@
+"""Kernels of :class:`polycontact.World`: placing shapes, the broad phase, and the
+classification of candidate pairs with the pairwise state kernel.
+
+Bodies are stored packed: ``xy`` (V, 2) float64 holds every body's loops; body ``b``
+has ``nl[b]`` loops whose start rows are ``ls[lo[b]:lo[b] + nl[b]]`` and whose end row
+is ``ls[lo[b] + nl[b]]`` (loops oriented interior-left, as in ``Shape.packed``).
+``box`` (B, 4) holds each body's bounding box ``x0, x1, y0, y1`` and ``eps`` (B,) its
+own default tolerance; the tolerance of a pair is the larger of the two, which is
+:func:`polycontact.default_tolerance` of both bodies (a maximum of per-body terms).
+
+The broad phase is a loose hierarchical grid kept in one open-addressing hash table.
+A body of box side ``s`` lives on level ``L`` (cells of side ``2**L >= s``) in the one
+cell that holds its box centre, so its box lies within that cell widened by half a cell;
+adding, moving or removing a body touches one cell list (doubly linked through ``nxt``
+and ``prv``). A box query visits, on every non-empty level, the cells whose widened
+bounds meet the box. Cell indices are clamped to ±2**25 about ``origin``: far cells
+merge (more candidates), never lose one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .relation import _bbox, _scratch, _state_in
+
+#: Levels L = idx - 512, idx in [0, 1024): cells from 2**-512 to 2**511.
+_LEVEL_OFFSET = 512
+_CELL_LIMIT = 33554432.0  # 2**25
+
+
+@njit(cache=True, nogil=True)
+def place(xy, cx, cy, px, py, angle, out):
+    """Rotate ``xy`` by ``angle`` about (cx, cy), then move (cx, cy) to (px, py), into
+    ``out``. Element by element (no matrix product), so every caller gets the same bits.
+    """
+    cs = math.cos(angle)
+    sn = math.sin(angle)
+    for k in range(xy.shape[0]):
+        dx = xy[k, 0] - cx
+        dy = xy[k, 1] - cy
+        out[k, 0] = px + (dx * cs - dy * sn)
+        out[k, 1] = py + (dx * sn + dy * cs)
+
+
+@njit(cache=True, nogil=True)
+def _tolerance(xy, n, rel, ulp_factor):
+    """:func:`polycontact.tolerances.default_tolerance` of one body's rows ``xy[:n]``."""
+    x0, x1, y0, y1 = _bbox(xy, n)
+    mag = max(max(-x0, x1), max(-y0, y1))
+    return max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
+
+
+@njit(cache=True, nogil=True)
+def _level(x0, x1, y0, y1):
+    """Level index of a box: the smallest L with 2**L >= its larger side."""
+    s = max(x1 - x0, y1 - y0)
+    if not s > 0.0:
+        return 0
+    m, e = math.frexp(s)
+    lev = e - 1 if m == 0.5 else e
+    return min(max(lev, -_LEVEL_OFFSET), _LEVEL_OFFSET - 1) + _LEVEL_OFFSET
+
+
+@njit(cache=True, nogil=True)
+def _cell(v, c):
+    f = math.floor(v / c)
+    return int(min(max(f, -_CELL_LIMIT), _CELL_LIMIT - 1.0))
+
+
+@njit(cache=True, nogil=True)
+def _key(idx, ix, iy):
+    return (idx << 52) | ((ix + 33554432) << 26) | (iy + 33554432)
+
+
+@njit(cache=True, nogil=True)
+def _slot(keys, key):
+    """The slot holding ``key``, or the empty slot where it goes (linear probing)."""
+    mask = keys.shape[0] - 1
+    h = int(key) * 6364136223846793005  # wraps in int64 when compiled
+    h = (h ^ (h >> 29)) & mask
+    while keys[h] != key and keys[h] != -1:
+        h = (h + 1) & mask
+    return h
+
+
+@njit(cache=True, nogil=True)
+def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
+    """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
+    idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
+    c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
+    ix = _cell(0.5 * (box[b, 0] + box[b, 1]) - origin[0], c)
+    iy = _cell(0.5 * (box[b, 2] + box[b, 3]) - origin[1], c)
+    key = _key(idx, ix, iy)
+    h = _slot(keys, key)
+    made = 0
+    if keys[h] == -1:
+        keys[h] = key
+        heads[h] = -1
+        made = 1
+    nxt[b] = heads[h]
+    prv[b] = -1
+    if heads[h] >= 0:
+        prv[heads[h]] = b
+    heads[h] = b
+    slot[b] = h
+    level[b] = idx
+    lvl_count[idx] += 1
+    return made
+
+
+@njit(cache=True, nogil=True)
+def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
+    """Take body ``b`` out of its cell list."""
+    h = slot[b]
+    if prv[b] >= 0:
+        nxt[prv[b]] = nxt[b]
+    else:
+        heads[h] = nxt[b]
+    if nxt[b] >= 0:
+        prv[nxt[b]] = prv[b]
+    slot[b] = -1
+    lvl_count[level[b]] -= 1
+    level[b] = -1
+
+
+@njit(cache=True, nogil=True)
+def grid_insert_many(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, bodies,
+                     filled):
+    """:func:`grid_insert` of each body in ``bodies`` into a table holding ``filled``
+    cells; stops before it would be more than half full and returns (cells made,
+    bodies inserted)."""
+    made = 0
+    limit = keys.shape[0] // 2
+    for k in range(bodies.shape[0]):
+        if filled + made + 1 > limit:
+            return made, k
+        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin,
+                            bodies[k])
+    return made, bodies.shape[0]
+
+
+@njit(cache=True, nogil=True)
+def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, alive):
+    """Fill an emptied table (``keys`` all -1) with the bodies in ``alive``."""
+    lvl_count[:] = 0
+    made = 0
+    for k in range(alive.shape[0]):
+        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin,
+                            alive[k])
+    return made
+
+
+@njit(cache=True, nogil=True)
+def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, low, n_ids,
+            cand):
+    """Bodies whose cell may hold a box meeting [q0, q1] x [q2, q3], on levels >= ``low``,
+    written into ``cand``; returns how many. A level whose cell range is larger than its
+    population is scanned body by body instead."""
+    n = 0
+    for li in range(levels.shape[0]):
+        idx = levels[li]
+        if idx < low:
+            continue
+        c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
+        ix0 = _cell(q0 - origin[0] - 1.51 * c, c)
+        ix1 = _cell(q1 - origin[0] + 0.51 * c, c)
+        iy0 = _cell(q2 - origin[1] - 1.51 * c, c)
+        iy1 = _cell(q3 - origin[1] + 0.51 * c, c)
+        if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 2 * lvl_count[idx] + 16:
+            for b in range(n_ids):
+                if level[b] == idx:
+                    cand[n] = b
+                    n += 1
+            continue
+        for ix in range(ix0, ix1 + 1):
+            for iy in range(iy0, iy1 + 1):
+                key = _key(idx, ix, iy)
+                h = _slot(keys, key)
+                if keys[h] != key:
+                    continue
+                b = heads[h]
+                while b >= 0:
+                    cand[n] = b
+                    n += 1
+                    b = nxt[b]
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _meet(box, b, q0, q1, q2, q3):
+    return not (box[b, 0] > q1 or box[b, 1] < q0 or box[b, 2] > q3 or box[b, 3] < q2)
+
+
+@njit(cache=True, nogil=True)
+def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps, tol, alive,
+                    n_ids):
+    """Pairs (i, j) of live bodies whose boxes come within their tolerance: i < j on a
+    shared level, else i on the lower level. Returns (pi, pj)."""
+    cap = 4 * alive.shape[0] + 16
+    pi = np.empty(cap, np.int64)
+    pj = np.empty(cap, np.int64)
+    cand = np.empty(n_ids, np.int64)
+    emax = tol
+    if tol < 0.0:
+        emax = 0.0
+        for k in range(alive.shape[0]):
+            emax = max(emax, eps[alive[k]])
+    n = 0
+    for k in range(alive.shape[0]):
+        i = alive[k]
+        ei = tol if tol >= 0.0 else eps[i]
+        d = ei + emax
+        q0 = box[i, 0] - d
+        q1 = box[i, 1] + d
+        q2 = box[i, 2] - d
+        q3 = box[i, 3] + d
+        m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3,
+                    level[i], n_ids, cand)
+        for t in range(m):
+            j = cand[t]
+            if j == i or (level[j] == level[i] and j < i):
+                continue
+            dj = ei + (tol if tol >= 0.0 else eps[j])
+            if not _meet(box, j, box[i, 0] - dj, box[i, 1] + dj, box[i, 2] - dj,
+                         box[i, 3] + dj):
+                continue
+            if n == cap:
+                cap *= 2
+                pi2 = np.empty(cap, np.int64)
+                pj2 = np.empty(cap, np.int64)
+                pi2[:n] = pi[:n]
+                pj2[:n] = pj[:n]
+                pi = pi2
+                pj = pj2
+            pi[n] = min(i, j)
+            pj[n] = max(i, j)
+            n += 1
+    return pi[:n], pj[:n]
+
+
+@njit(cache=True, nogil=True)
+def _view(xy, ls, lo, nl, b, buf):
+    """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
+    first = ls[lo[b]]
+    m = nl[b]
+    for k in range(m + 1):
+        buf[k] = ls[lo[b] + k] - first
+    return xy[first : ls[lo[b] + m]], buf[: m + 1]
+
+
+@njit(cache=True, nogil=True)
+def _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, k0, k1, states, used):
+    box, ids, touch, rays, rord = _scratch(2 * vmax)
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    for k in range(k0, k1):
+        i = pi[k]
+        j = pj[k]
+        ya, sa = _view(xy, ls, lo, nl, i, ba)
+        yb, sb = _view(xy, ls, lo, nl, j, bb)
+        e = tol if tol >= 0.0 else max(eps[i], eps[j])
+        used[k] = e
+        states[k] = _state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def classify_pairs(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, chunks):
+    """States (int8) and tolerances of the pairs (pi[k], pj[k]), in parallel chunks
+    (``chunks`` = 1: serial, no thread start)."""
+    k_count = pi.shape[0]
+    states = np.empty(k_count, np.int8)
+    used = np.empty(k_count)
+    if chunks == 1:
+        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, 0, k_count, states,
+                        used)
+        return states, used
+    for c in prange(chunks):
+        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax,
+                        k_count * c // chunks, k_count * (c + 1) // chunks, states, used)
+    return states, used
+
+
+@njit(cache=True, nogil=True)
+def _container_state(ya, sa, bx0, bx1, by0, by1, e, hxy, hls, hlo, hnl, cbox, hbuf, box,
+                     ids, touch, rays, rord):
+    """0 inside, 1 touching the boundary, 2 outside or crossing: A (box bx0..by1) against
+    the hazards (the frame around the container's outer loop, and its holes)."""
+    if bx0 < cbox[0] - e or bx1 > cbox[1] + e or by0 < cbox[2] - e or by1 > cbox[3] + e:
+        return 2
+    worst = 0
+    for h in range(hnl.shape[0]):
+        yh, sh = _view(hxy, hls, hlo, hnl, h, hbuf)
+        s = _state_in(ya, sa, 1.0, yh, sh, 1.0, e, box, ids, touch, rays, rord)
+        if s > worst:
+            worst = s
+            if worst == 2:
+                break
+    return worst
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def container_states(xy, ls, lo, nl, box, eps, tol, alive, hxy, hls, hlo, hnl, cbox, ceps,
+                     vmax, lmax, hmax, chunks):
+    """Container state (0, 1, 2) of every live body, in parallel chunks."""
+    n = alive.shape[0]
+    out = np.empty(n, np.int8)
+    for c in prange(chunks):  # few bodies: chunks = 1, one thread
+        bx, ids, touch, rays, rord = _scratch(vmax + hmax)
+        ba = np.empty(lmax + 1, np.int64)
+        hb = np.empty(hnl.max() + 1, np.int64)
+        for k in range(n * c // chunks, n * (c + 1) // chunks):
+            b = alive[k]
+            ya, sa = _view(xy, ls, lo, nl, b, ba)
+            e = tol if tol >= 0.0 else max(eps[b], ceps)
+            out[k] = _container_state(ya, sa, box[b, 0], box[b, 1], box[b, 2], box[b, 3], e,
+                                      hxy, hls, hlo, hnl, cbox, hb, bx, ids, touch, rays,
+                                      rord)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, origin, xy, ls,
+                 lo, nl, box, eps, tol, emax, n_ids, vmax, lmax):
+    """Ids and states of the bodies the placed shape (qxy, qs) touches or penetrates."""
+    n = qs[qs.shape[0] - 1]
+    x0, x1, y0, y1 = _bbox(qxy, n)
+    cand = np.empty(n_ids, np.int64)
+    e0 = tol if tol >= 0.0 else qeps
+    d = e0 + (tol if tol >= 0.0 else emax)
+    m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d, y0 - d,
+                y1 + d, 0, n_ids, cand)
+    bx, ids, touch, rays, rord = _scratch(n + vmax)
+    buf = np.empty(lmax + 1, np.int64)
+    out_ids = np.empty(m, np.int64)
+    out_st = np.empty(m, np.int8)
+    k = 0
+    for t in range(m):
+        j = cand[t]
+        e = tol if tol >= 0.0 else max(qeps, eps[j])
+        if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
+            continue
+        yb, sb = _view(xy, ls, lo, nl, j, buf)
+        s = _state_in(qxy, qs, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+        if s > 0:
+            out_ids[k] = j
+            out_st[k] = s
+            k += 1
+    order = np.argsort(out_ids[:k])
+    return out_ids[:k][order], out_st[:k][order]
+
+
+@njit(cache=True, nogil=True)
+def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
+    """Container state of one placed shape (see :func:`_container_state`)."""
+    n = qs[qs.shape[0] - 1]
+    x0, x1, y0, y1 = _bbox(qxy, n)
+    hmax = 0
+    for h in range(hnl.shape[0]):
+        hmax = max(hmax, hls[hlo[h] + hnl[h]] - hls[hlo[h]])
+    bx, ids, touch, rays, rord = _scratch(n + hmax)
+    hb = np.empty(hnl.max() + 1, np.int64)
+    e = tol if tol >= 0.0 else max(qeps, ceps)
+    return _container_state(qxy, qs, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox, hb, bx, ids,
+                            touch, rays, rord)
+
+
+@njit(cache=True, nogil=True)
+def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                 level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax,
+                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, p0, p1, out):
+    n = ss[ss.shape[0] - 1]
+    qxy = np.empty((n, 2))
+    cand = np.empty(n_ids, np.int64)
+    bx, ids, touch, rays, rord = _scratch(n + max(vmax, hmax))
+    buf = np.empty(lmax + 1, np.int64)
+    hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
+    for p in range(p0, p1):
+        place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
+        x0, x1, y0, y1 = _bbox(qxy, n)
+        mag = max(max(-x0, x1), max(-y0, y1))
+        qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
+        worst = 0
+        if has_container:
+            e = tol if tol >= 0.0 else max(qeps, ceps)
+            worst = _container_state(qxy, ss, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox,
+                                     hb, bx, ids, touch, rays, rord)
+        if worst < 2:
+            e0 = tol if tol >= 0.0 else qeps
+            d = e0 + (tol if tol >= 0.0 else emax)
+            m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d,
+                        y0 - d, y1 + d, 0, n_ids, cand)
+            for t in range(m):
+                j = cand[t]
+                e = tol if tol >= 0.0 else max(qeps, eps[j])
+                if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
+                    continue
+                yb, sb = _view(xy, ls, lo, nl, j, buf)
+                s = _state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+                if s > worst:
+                    worst = s
+                    if worst == 2:
+                        break
+        out[p] = worst
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def query_many(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt, level,
+               lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax, lmax,
+               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, chunks):
+    """Worst state (int8) of the shape (sxy, ss) placed at each (px[p], py[p], angles[p])
+    over every body and the container (outside counts as 2); ``chunks`` = 1: serial."""
+    p_count = px.shape[0]
+    out = np.empty(p_count, np.int8)
+    if chunks == 1:
+        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, 0,
+                     p_count, out)
+        return out
+    for c in prange(chunks):
+        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
+                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax,
+                     p_count * c // chunks, p_count * (c + 1) // chunks, out)
+    return out
