@@ -53,6 +53,11 @@ _LAZY = {
     "NoFitPolygon": "nfp",
     "no_fit_polygon": "nfp",
     "inner_fit_polygon": "nfp",
+    # nesting instances and NFP tables
+    "Instance": "esicup",
+    "read_esicup": "esicup",
+    "NfpTable": "nfp_tables",
+    "nfp_table": "nfp_tables",
 }
 
 __all__ = [

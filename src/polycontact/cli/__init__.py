@@ -20,7 +20,7 @@ from .. import __version__
 from ..errors import PolycontactError
 from ._io import CommandError
 
-_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "warmup")
+_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "warmup")
 
 #: The kernel families (polycontact.compiling.FAMILIES) each command runs.
 _NEEDS = {
@@ -28,6 +28,7 @@ _NEEDS = {
     "collide": ("classification", "time of impact"),
     "entrance-block": ("classification", "entrance block"),
     "nfp": ("no-fit polygon",),
+    "nfp-table": ("no-fit polygon",),
 }
 
 
