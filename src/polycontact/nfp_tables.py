@@ -420,13 +420,35 @@ def _pair_key(da: bytes, db: bytes) -> str:
     return hashlib.blake2b(da + db, digest_size=16).hexdigest()
 
 
-def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -> list[tuple]:
-    """Compute the NFPs of ``pairs`` (rows of indices into ``shapes``), encoded."""
-    out = []
+def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -> tuple:
+    """Compute the NFPs of ``pairs`` (rows of indices into ``shapes``), packed in a few
+    flat arrays (a task's result crosses the network quicker so than as many small
+    objects): the regions' WKB one after the other, their ends, the exact fits and
+    slides with their ends per entry, the references and the tolerances."""
+    wkbs, fits, slides, refs, tols = [], [], [], [], []
     for ia, ib in pairs.tolist():
         nfp = no_fit_polygon(shapes[ia], shapes[ib], reference)
-        out.append((shapely.to_wkb(nfp.region, byte_order=1, include_srid=False),
-                    nfp.exact_fits, nfp.slides, nfp.reference, float(nfp.tolerance)))
+        wkbs.append(shapely.to_wkb(nfp.region, byte_order=1, include_srid=False))
+        fits.append(nfp.exact_fits.reshape(-1, 2))
+        slides.append(nfp.slides.reshape(-1, 2, 2))
+        refs.append(nfp.reference)
+        tols.append(float(nfp.tolerance))
+    return (b"".join(wkbs), np.cumsum([len(w) for w in wkbs], dtype=np.int64),
+            np.concatenate(fits), np.cumsum([len(f) for f in fits], dtype=np.int64),
+            np.concatenate(slides), np.cumsum([len(x) for x in slides], dtype=np.int64),
+            np.array(refs, dtype=np.float64).reshape(-1, 2), np.array(tols, dtype=np.float64))
+
+
+def _unpack_chunk(packed: tuple) -> list[_Record]:
+    """The records of a result of :func:`_compute_chunk`."""
+    blob, wkb_ends, fits, fit_ends, slides, slide_ends, refs, tols = packed
+    out = []
+    w0 = f0 = s0 = 0
+    for k in range(len(tols)):
+        w1, f1, s1 = int(wkb_ends[k]), int(fit_ends[k]), int(slide_ends[k])
+        out.append(_Record(blob[w0:w1], fits[f0:f1].copy(), slides[s0:s1].copy(),
+                           refs[k].copy(), float(tols[k])))
+        w0, f0, s0 = w1, f1, s1
     return out
 
 
@@ -473,12 +495,9 @@ def _compute_missing(
     done = 0
     try:
         with closing(results):
-            for k, encoded in results:
+            for k, packed in results:
                 p0, p1 = spans[k]
-                recs = [(key, _Record(w, np.asarray(f, dtype=np.float64).reshape(-1, 2),
-                                      np.asarray(s, dtype=np.float64).reshape(-1, 2, 2),
-                                      np.asarray(r, dtype=np.float64), t))
-                        for key, (w, f, s, r, t) in zip(keys[p0:p1], encoded)]
+                recs = list(zip(keys[p0:p1], _unpack_chunk(packed)))
                 if cache_dir is not None:
                     _write_shard(cache_dir, recs)
                 table._records.update(recs)
@@ -513,13 +532,13 @@ def _init_process(shapes: list[Shape]) -> None:
     _WORKER_SHAPES[:] = shapes
 
 
-def _process_task(pairs: np.ndarray, reference: str) -> list[tuple]:
+def _process_task(pairs: np.ndarray, reference: str) -> tuple:
     return _compute_chunk(_WORKER_SHAPES, pairs, reference)
 
 
 def _run_processes(
     n: int, shapes: list[Shape], tasks: list[np.ndarray], reference: str
-) -> Iterator[tuple[int, list[tuple]]]:
+) -> Iterator[tuple[int, tuple]]:
     """Run the tasks on ``n`` spawned processes; yield (task index, result) as they end."""
     pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_init_process, initargs=(shapes,))
