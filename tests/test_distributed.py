@@ -127,3 +127,24 @@ async def _exit() -> None:
 
     await asyncio.sleep(0.05)  # after the reply that the call started
     os._exit(1)
+
+
+def test_cli_on_a_scheduler_builds_the_same_table(client, tmp_path, capsys):
+    # last in this file: the command's own client replaces the default client
+    from polycontact.cli import main
+
+    path = tmp_path / "three.json"
+    items = [{"id": k, "demand": 1, "allowed_orientations": a,
+              "shape": {"type": "simple_polygon", "data": p.exterior.tolist()}}
+             for k, (p, a) in enumerate(zip(PIECES, ANGLES))]
+    path.write_text(__import__("json").dumps({"strip_height": 9, "items": items}))
+    out = tmp_path / "table"
+    assert main(["nfp-table", str(path), "--out", str(out), "--no-progress",
+                 "--scheduler", client.scheduler.address, "--chunk-size", "30"]) == 0
+    captured = capsys.readouterr()
+    assert "2 workers" in captured.err
+    assert captured.out.startswith("three: 100 entries (")
+    local = pc.nfp_table(PIECES, ANGLES, progress=False)
+    loaded = pc.NfpTable.load(out)
+    for key in local:
+        assert same_entry(local[key], loaded[key])

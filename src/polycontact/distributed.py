@@ -49,7 +49,7 @@ __all__ = [
 
 #: Default pairs per task of :func:`map_batches` (classification: about 10 ms of work
 #: per task, well above a Dask task's overhead of about 1 ms), unless that would make
-#: fewer than four tasks per worker.
+#: fewer than four tasks per worker thread.
 DEFAULT_BATCH = 20_000
 
 #: Name under which :class:`WarmupPlugin` is registered with a client.
@@ -160,7 +160,7 @@ def map_batches(
     client : dask.distributed.Client, optional
     chunk_size : int, optional
         Items per task; default :data:`DEFAULT_BATCH`, fewer if that would give less
-        than four tasks per worker.
+        than four tasks per worker thread.
     families : iterable of str, optional
         Kernel families the workers warm up (default all).
     **kwargs
@@ -187,7 +187,7 @@ def map_batches(
         raise ValueError(f"chunk_size: expected a positive integer, got {chunk_size!r}")
     client = current_client(client)
     if chunk_size is None:
-        n_workers = 1 if client is None else max(1, len(client.scheduler_info()["workers"]))
+        n_workers = 1 if client is None else max(1, sum(client.nthreads().values()))
         chunk_size = max(1, min(DEFAULT_BATCH, math.ceil(count / (4 * n_workers))))
     spans = [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
     if client is None:

@@ -310,7 +310,7 @@ def nfp_table(
         process).
     chunk_size : int, optional
         Entries per task (and per cache shard); default about a quarter of each
-        worker's share, between 64 and 4096.
+        worker's share, between 64 and 1024.
 
     Returns
     -------
@@ -454,7 +454,7 @@ def _unpack_chunk(packed: tuple) -> list[_Record]:
 
 def _chunks(count: int, workers: int, chunk_size: int | None) -> list[tuple[int, int]]:
     if chunk_size is None:
-        chunk_size = min(4096, max(64, math.ceil(count / (4 * workers))))
+        chunk_size = min(1024, max(64, math.ceil(count / (4 * workers))))
     return [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
 
 
@@ -476,7 +476,7 @@ def _compute_missing(
     keys = list(todo)
     pairs = np.array([(index[sa], index[sb]) for sa, sb in todo.values()], dtype=np.int64)
     if client is not None:
-        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
+        n_workers = max(1, sum(client.nthreads().values()))  # every thread of every worker
     else:
         n_workers = workers or os.cpu_count() or 1
         if workers is None and len(keys) < PROCESS_POOL_MIN_ENTRIES:

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
         except OSError as exc:
             raise CommandError(f"--scheduler: cannot reach {args.scheduler}: {exc}") from None
         print(f"polycontact nfp-table: on {args.scheduler} "
-              f"({len(client.scheduler_info()['workers'])} workers; dashboard "
+              f"({len(client.nthreads())} workers; dashboard "
               f"{client.dashboard_link})", file=sys.stderr)
     try:
         table = nfp_table(instance, args.orientations, cache=args.out, client=client,
