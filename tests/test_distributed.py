@@ -53,20 +53,23 @@ def test_the_default_client_is_used(client):
                          progress=lambda d, n: seen.append(d))
     assert pd.current_client() is client
     assert len(seen) == 4 and table.computed == 16  # four tasks of 4 entries, on the cluster
-    assert client.run(pd._has_plugin)  # which the warm-up plugin shows
+    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd._plugins).values())
 
 
 def test_kernels_are_warmed_once_per_worker(client):
     pc.nfp_table(PIECES[:1], progress=False, client=client)
-    assert all(client.run(pd._has_plugin).values())
-    before = client.run(_setups)
-    pd.ensure_warm(client)
+    name = pd.plugin_name("no-fit polygon")
+    assert all(name in p for p in client.run(pd._plugins).values())
+    before = client.run(_setup_id, name)
+    pd.ensure_warm(client, ["no-fit polygon"])
     pc.nfp_table(PIECES[:2], progress=False, client=client)
-    assert client.run(_setups) == before  # no new registration, no warm-up per task
+    assert client.run(_setup_id, name) == before  # no new registration, no warm-up per task
+    # a batch warms only its own family
+    assert pd.plugin_name("time of impact") not in next(iter(client.run(pd._plugins).values()))
 
 
-def _setups(dask_worker) -> int:
-    return id(dask_worker.plugins[pd.PLUGIN_NAME])
+def _setup_id(name, dask_worker=None) -> int:
+    return id(dask_worker.plugins[name])
 
 
 def test_classify_many_on_the_cluster_is_identical(client):

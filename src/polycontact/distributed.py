@@ -52,7 +52,7 @@ __all__ = [
 #: fewer than four tasks per worker thread.
 DEFAULT_BATCH = 20_000
 
-#: Name under which :class:`WarmupPlugin` is registered with a client.
+#: Prefix of the names under which ``WarmupPlugin`` is registered (one per family).
 PLUGIN_NAME = "polycontact-warmup"
 
 
@@ -89,21 +89,34 @@ def __getattr__(name: str) -> Any:
 
 
 def ensure_warm(client: Any, families: Iterable[str] | None = None) -> None:
-    """Register :class:`WarmupPlugin` with ``client`` unless every worker has it.
+    """Register a ``WarmupPlugin`` with ``client`` for each kernel family (all by
+    default) that some worker lacks.
 
-    Workers that join later get it from the scheduler. Returns when the current
-    workers have loaded their kernels.
+    One plugin per family, named ``polycontact-warmup:FAMILY``, so a batch warms only
+    the kernels it runs. Workers that join later get the plugins from the scheduler.
+    Returns when the current workers have loaded the kernels.
     """
-    have = client.run(_has_plugin)
-    if have and all(have.values()):
+    from .compiling import FAMILIES
+
+    wanted = list(FAMILIES if families is None else families)
+    have = client.run(_plugins)
+    missing = [f for f in wanted
+               if not have or not all(plugin_name(f) in names for names in have.values())]
+    if not missing:
         return
     from ._dask_plugin import WarmupPlugin
 
-    client.register_plugin(WarmupPlugin(families), name=PLUGIN_NAME)
+    for family in missing:
+        client.register_plugin(WarmupPlugin([family]), name=plugin_name(family))
 
 
-def _has_plugin(dask_worker: Any) -> bool:
-    return PLUGIN_NAME in dask_worker.plugins
+def plugin_name(family: str) -> str:
+    """The name of the warm-up plugin of one kernel family."""
+    return f"{PLUGIN_NAME}:{family}"
+
+
+def _plugins(dask_worker: Any) -> list[str]:
+    return sorted(dask_worker.plugins)
 
 
 def run_tasks(

@@ -486,7 +486,8 @@ def _compute_missing(
     if client is not None:
         from .distributed import run_tasks
 
-        results = run_tasks(client, _compute_chunk, shapes, tasks, table.reference)
+        results = run_tasks(client, _compute_chunk, shapes, tasks, table.reference,
+                            families=["no-fit polygon"])
     elif n_workers > 1:
         results = _run_processes(n_workers, shapes, tasks, table.reference)
     else:
