@@ -172,6 +172,17 @@ def test_cache_round_trip_keeps_regions_exact_fits_and_slides(instance, tmp_path
     assert shapely.from_wkb(blob[e["offset"]:e["offset"] + e["length"]]).is_valid
 
 
+def test_a_table_built_without_cache_saves_and_loads(instance, tmp_path):
+    table = pc.nfp_table(instance, progress=False)
+    table.save(tmp_path / "saved")
+    loaded = NfpTable.load(tmp_path / "saved")
+    assert loaded.loaded == table.computed
+    for index in table:
+        assert same_entry(table[index], loaded[index])
+    with pytest.raises(ValueError, match="table.json"):
+        NfpTable.load(tmp_path / "nothing")
+
+
 def test_rebuild_with_a_new_orientation_computes_only_its_entries(instance, tmp_path):
     cache = tmp_path / "cache"
     pc.nfp_table(instance, cache=cache, progress=False)
