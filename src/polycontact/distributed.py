@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
 from typing import Any
 
 import numpy as np
@@ -122,15 +122,16 @@ def _plugins(dask_worker: Any) -> list[str]:
 def run_tasks(
     client: Any, fn: Callable[..., Any], shared: Any, tasks: Sequence[Any], *args: Any,
     families: Iterable[str] | None = None,
-) -> Iterator[tuple[int, Any]]:
+) -> Generator[tuple[int, Any], None, None]:
     """Run ``fn(shared, task, *args)`` for each task on the cluster; yield
     ``(task index, result)`` as tasks finish.
 
     ``shared`` is sent once to every worker. Closing the generator early (an error, or
     Ctrl-C in the caller) cancels the tasks not yet finished.
     """
-    from distributed import as_completed
+    import distributed
 
+    as_completed: Any = distributed.as_completed
     ensure_warm(client, families)
     [shared_future] = client.scatter([shared], broadcast=True, hash=False)
     futures = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
@@ -146,7 +147,9 @@ def run_tasks(
         client.cancel([shared_future])
 
 
-def _call_on_slices(_: Any, task: tuple, fn: Callable[..., Any], kwargs: dict) -> Any:
+def _call_on_slices(
+    _: Any, task: tuple[Any, ...], fn: Callable[..., Any], kwargs: dict[str, Any]
+) -> Any:
     return fn(*task, **kwargs)
 
 

@@ -60,7 +60,7 @@ import sys
 import time
 import uuid
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import closing
@@ -94,6 +94,11 @@ PROCESS_POOL_MIN_ENTRIES = 50_000
 ANGLE_MATCH = 1e-9
 
 Progress = bool | Callable[[int, int], None]
+
+#: A task's result: the regions' WKB and their ends, exact fits and their ends, slides
+#: and their ends, references, tolerances (see :func:`_compute_chunk`).
+Packed = tuple[bytes, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+               np.ndarray, np.ndarray]
 
 
 class CacheWarning(UserWarning):
@@ -357,7 +362,9 @@ def nfp_table(
 # -- building ----------------------------------------------------------------------------
 
 
-def _pieces_and_orientations(pieces: Any, orientations: Any) -> tuple[tuple, tuple]:
+def _pieces_and_orientations(
+    pieces: Any, orientations: Any
+) -> tuple[tuple[Shape, ...], tuple[tuple[float, ...], ...]]:
     if isinstance(pieces, Instance):
         if orientations is None:
             orientations = pieces.orientations
@@ -399,7 +406,8 @@ def _is_number(a: Any) -> bool:
         a, bool) and math.isfinite(float(a))
 
 
-def _prepare(pieces: tuple, orientations: tuple, reference: str) -> NfpTable:
+def _prepare(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],
+             reference: str) -> NfpTable:
     """A table without entries: the turned pieces and their digests."""
     shapes: dict[tuple[int, int], Shape] = {}
     digests: dict[tuple[int, int], bytes] = {}
@@ -420,7 +428,7 @@ def _pair_key(da: bytes, db: bytes) -> str:
     return hashlib.blake2b(da + db, digest_size=16).hexdigest()
 
 
-def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -> tuple:
+def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -> Packed:
     """Compute the NFPs of ``pairs`` (rows of indices into ``shapes``), packed in a few
     flat arrays (a task's result crosses the network quicker so than as many small
     objects): the regions' WKB one after the other, their ends, the exact fits and
@@ -439,7 +447,7 @@ def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -
             np.array(refs, dtype=np.float64).reshape(-1, 2), np.array(tols, dtype=np.float64))
 
 
-def _unpack_chunk(packed: tuple) -> list[_Record]:
+def _unpack_chunk(packed: Packed) -> list[_Record]:
     """The records of a result of :func:`_compute_chunk`."""
     blob, wkb_ends, fits, fit_ends, slides, slide_ends, refs, tols = packed
     out = []
@@ -459,7 +467,8 @@ def _chunks(count: int, workers: int, chunk_size: int | None) -> list[tuple[int,
 
 
 def _compute_missing(
-    table: NfpTable, todo: dict, cache_dir: Path | None, client: Any, progress: Progress,
+    table: NfpTable, todo: dict[str, tuple[tuple[int, int], tuple[int, int]]],
+    cache_dir: Path | None, client: Any, progress: Progress,
     workers: int | None, chunk_size: int | None,
 ) -> None:
     from .distributed import current_client
@@ -470,9 +479,7 @@ def _compute_missing(
     for sa, sb in todo.values():
         index.setdefault(sa, len(index))
         index.setdefault(sb, len(index))
-    shapes = [None] * len(index)
-    for slot, n in index.items():
-        shapes[n] = table._shapes[slot]
+    shapes = [table._shapes[slot] for slot in index]  # numbered in insertion order
     keys = list(todo)
     pairs = np.array([(index[sa], index[sb]) for sa, sb in todo.values()], dtype=np.int64)
     if client is not None:
@@ -483,6 +490,7 @@ def _compute_missing(
             n_workers = 1
     spans = _chunks(len(keys), n_workers, chunk_size)
     tasks = [pairs[p0:p1] for p0, p1 in spans]
+    results: Generator[tuple[int, Packed], None, None]
     if client is not None:
         from .distributed import run_tasks
 
@@ -533,13 +541,13 @@ def _init_process(shapes: list[Shape]) -> None:
     _WORKER_SHAPES[:] = shapes
 
 
-def _process_task(pairs: np.ndarray, reference: str) -> tuple:
+def _process_task(pairs: np.ndarray, reference: str) -> Packed:
     return _compute_chunk(_WORKER_SHAPES, pairs, reference)
 
 
 def _run_processes(
     n: int, shapes: list[Shape], tasks: list[np.ndarray], reference: str
-) -> Iterator[tuple[int, tuple]]:
+) -> Generator[tuple[int, Packed], None, None]:
     """Run the tasks on ``n`` spawned processes; yield (task index, result) as they end."""
     pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_init_process, initargs=(shapes,))
@@ -579,7 +587,8 @@ def _atomic_write(path: Path, data: bytes) -> None:
             tmp.unlink()
 
 
-def _write_manifest(cache: Path, pieces: tuple, orientations: tuple, reference: str) -> None:
+def _write_manifest(cache: Path, pieces: tuple[Shape, ...],
+                    orientations: tuple[tuple[float, ...], ...], reference: str) -> None:
     (cache / SHARDS).mkdir(parents=True, exist_ok=True)
     doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "polycontact": __version__,
            "reference": reference,

@@ -62,15 +62,15 @@ def run(args: argparse.Namespace) -> int:
     from ..nfp_tables import nfp_table
 
     instance = read_esicup(args.instance)
-    client = None
+    client: Any = None
     if args.scheduler is not None:
         try:
-            from distributed import Client
+            import distributed
         except ImportError:
             raise CommandError("--scheduler needs Dask: pip install 'polycontact[dask]'"
                                ) from None
         try:
-            client = Client(args.scheduler, timeout="20s")
+            client = getattr(distributed, "Client")(args.scheduler, timeout="20s")
         except OSError as exc:
             raise CommandError(f"--scheduler: cannot reach {args.scheduler}: {exc}") from None
         print(f"polycontact nfp-table: on {args.scheduler} "
