@@ -11,7 +11,13 @@ term is what a user means by "the same place" (a shift of 1e-9 of a body's size 
 seen as a shift, at any scale); the second keeps the tolerance above the rounding of
 the few operations that produce and compare coordinates (a translation, a rotation, a
 difference of two coordinates) when small bodies sit far from the origin. Lengths are
-compared with ``eps``; areas with ``eps * length``.
+compared with ``eps``; areas with ``eps * length``. The same formula is compiled for
+the kernels (:mod:`polycontact._kernels.tolerance`), so every path gives a pair the
+same tolerance.
+
+A polygon's own validity is judged on a finer scale: two of its features meet only
+when float64 cannot tell them apart (:func:`validation_tolerance`, 4 float spacings of
+its largest coordinate), so every polygon GEOS calls valid is accepted, at any scale.
 
 Coordinates must lie in ``[-COORDINATE_LIMIT, COORDINATE_LIMIT]`` and every body must
 be larger than ``EXTENT_FLOOR``: the kernels form products of up to three coordinate
@@ -34,7 +40,9 @@ __all__ = [
     "ROUNDING_ULPS",
     "COORDINATE_LIMIT",
     "EXTENT_FLOOR",
+    "VALIDATION_ULPS",
     "tolerance_for",
+    "validation_tolerance",
     "default_tolerance",
     "check_range",
 ]
@@ -57,6 +65,14 @@ COORDINATE_LIMIT = 1e100
 #: Smallest body extent accepted: products of three lengths (1e-300) stay normal floats.
 EXTENT_FLOOR = 1e-100
 
+#: A polygon is refused as invalid (two of its features meet) only when they are
+#: closer than float64 can tell apart: 4 units in the last place of its largest
+#: |coordinate|, about the rounding of a distance computed from such coordinates. This
+#: is far below :func:`tolerance_for` on purpose: a valid polygon (GEOS's "very skinny
+#: polygon", 10 wide and 1e15 long) is accepted, and its features closer than the
+#: classification tolerance are then decided as touching.
+VALIDATION_ULPS = 4.0
+
 _ULP = 2.0**-52
 
 
@@ -75,6 +91,19 @@ def tolerance_for(extent: float, magnitude: float) -> float:
     14.211
     """
     return max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * _ULP * magnitude)
+
+
+def validation_tolerance(magnitude: float) -> float:
+    """Distance below which two features of one polygon whose coordinates reach
+    ``magnitude`` cannot be told apart in float64: ``VALIDATION_ULPS * 2**-52 *
+    magnitude``.
+
+    Examples
+    --------
+    >>> round(validation_tolerance(1e9) / 1e-7, 3)    # 4 float spacings at 1e9
+    8.882
+    """
+    return VALIDATION_ULPS * _ULP * magnitude
 
 
 def default_tolerance(*bodies: np.ndarray) -> float:
