@@ -57,6 +57,11 @@ _LAZY = {
     "World": "world",
     "Contacts": "world",
     "Query": "world",
+    # nesting instances and NFP tables
+    "Instance": "esicup",
+    "read_esicup": "esicup",
+    "NfpTable": "nfp_tables",
+    "nfp_table": "nfp_tables",
 }
 
 __all__ = [

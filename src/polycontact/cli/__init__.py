@@ -20,7 +20,8 @@ from .. import __version__
 from ..errors import PolycontactError
 from ._io import CommandError
 
-_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "contacts", "warmup")
+_SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "contacts",
+                "warmup")
 
 #: The kernel families (polycontact.compiling.FAMILIES) each command runs.
 _NEEDS = {
@@ -29,6 +30,7 @@ _NEEDS = {
     "entrance-block": ("classification", "entrance block"),
     "nfp": ("no-fit polygon",),
     "contacts": ("classification",),
+    "nfp-table": ("no-fit polygon",),
 }
 
 

@@ -1,0 +1,266 @@
+"""Running polycontact's batches on a Dask cluster.
+
+Dask is an optional extra (``pip install "polycontact[dask]"``): this module imports
+``distributed`` only inside its functions, and nothing else in polycontact imports this
+module unless a Dask client is given or is already the default.
+
+- :func:`current_client` is the client a batch runs on: the one given, else the
+  default client of this process when ``distributed`` is already imported and one is
+  set (``Client(...)`` or ``with Client(...)``), never one inside a Dask task.
+- ``WarmupPlugin`` (registered by :func:`ensure_warm`) compiles or loads the
+  kernels once per worker, when the worker starts or joins, not once per task.
+- :func:`map_batches` splits aligned sequences into slices, calls a function on each
+  slice as one task, and returns the results in order; :func:`classify_many` is
+  :func:`polycontact.classify_many` split this way, with results identical to the
+  local run. :func:`polycontact.nfp_table` with ``client=`` runs its tasks through
+  :func:`run_tasks`.
+
+Examples
+--------
+Without a client everything runs locally:
+
+>>> import numpy as np
+>>> from polycontact import distributed
+>>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+>>> distributed.classify_many(np.stack([sq, sq]), np.stack([sq + 2, sq + 1])).states.tolist()
+[0, 1]
+>>> distributed.map_batches(len, list(range(10)), chunk_size=4)
+[4, 4, 2]
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "WarmupPlugin",
+    "classify_many",
+    "current_client",
+    "ensure_warm",
+    "map_batches",
+    "run_tasks",
+    "DEFAULT_BATCH",
+]
+
+#: Default pairs per task of :func:`map_batches` (classification: about 10 ms of work
+#: per task, well above a Dask task's overhead of about 1 ms), unless that would make
+#: fewer than four tasks per worker thread.
+DEFAULT_BATCH = 20_000
+
+#: Prefix of the names under which ``WarmupPlugin`` is registered (one per family).
+PLUGIN_NAME = "polycontact-warmup"
+
+
+def current_client(client: Any = None) -> Any:
+    """The Dask client a batch should run on, or None to run locally.
+
+    ``client`` if given; else, when ``distributed`` is already imported (this never
+    imports it), the default client, except inside a Dask task (a batch called from
+    a task runs in that task rather than submitting more).
+    """
+    if client is not None:
+        return client
+    dist = sys.modules.get("distributed")
+    if dist is None:
+        return None
+    try:
+        dist.get_worker()
+        return None  # inside a task
+    except ValueError:
+        pass
+    try:
+        return dist.default_client()
+    except ValueError:
+        return None
+
+
+def __getattr__(name: str) -> Any:
+    # WarmupPlugin subclasses distributed.WorkerPlugin: loaded (with Dask) on first use
+    if name == "WarmupPlugin":
+        from ._dask_plugin import WarmupPlugin
+
+        return WarmupPlugin
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def ensure_warm(client: Any, families: Iterable[str] | None = None) -> None:
+    """Register a ``WarmupPlugin`` with ``client`` for each kernel family (all by
+    default) that some worker lacks.
+
+    One plugin per family, named ``polycontact-warmup:FAMILY``, so a batch warms only
+    the kernels it runs. Workers that join later get the plugins from the scheduler.
+    Returns when the current workers have loaded the kernels.
+    """
+    from .compiling import FAMILIES
+
+    wanted = list(FAMILIES if families is None else families)
+    have = client.run(_plugins)
+    missing = [f for f in wanted
+               if not have or not all(plugin_name(f) in names for names in have.values())]
+    if not missing:
+        return
+    from ._dask_plugin import WarmupPlugin
+
+    for family in missing:
+        client.register_plugin(WarmupPlugin([family]), name=plugin_name(family))
+
+
+def plugin_name(family: str) -> str:
+    """The name of the warm-up plugin of one kernel family."""
+    return f"{PLUGIN_NAME}:{family}"
+
+
+def _plugins(dask_worker: Any) -> list[str]:
+    return sorted(dask_worker.plugins)
+
+
+def run_tasks(
+    client: Any, fn: Callable[..., Any], shared: Any, tasks: Sequence[Any], *args: Any,
+    families: Iterable[str] | None = None,
+) -> Generator[tuple[int, Any], None, None]:
+    """Run ``fn(shared, task, *args)`` for each task on the cluster; yield
+    ``(task index, result)`` as tasks finish.
+
+    ``shared`` is sent once to every worker. Closing the generator early (an error, or
+    Ctrl-C in the caller) cancels the tasks not yet finished.
+    """
+    import distributed
+
+    as_completed: Any = distributed.as_completed
+    ensure_warm(client, families)
+    [shared_future] = client.scatter([shared], broadcast=True, hash=False)
+    futures = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
+    index = {f.key: k for k, f in enumerate(futures)}
+    try:
+        for f in as_completed(futures):
+            result = f.result()
+            k = index[f.key]
+            f.release()
+            yield k, result
+    finally:
+        client.cancel(futures)
+        client.cancel([shared_future])
+
+
+def _call_on_slices(
+    _: Any, task: tuple[Any, ...], fn: Callable[..., Any], kwargs: dict[str, Any]
+) -> Any:
+    return fn(*task, **kwargs)
+
+
+def map_batches(
+    fn: Callable[..., Any],
+    *sequences: Any,
+    client: Any = None,
+    chunk_size: int | None = None,
+    families: Iterable[str] | None = None,
+    **kwargs: Any,
+) -> list[Any]:
+    """``[fn(*slices, **kwargs) for each slice]`` over aligned sequences, on Dask.
+
+    The sequences (lists, arrays: anything sliceable, all of one length) are cut into
+    consecutive slices of ``chunk_size`` items; each call is one task. Without a client
+    (see :func:`current_client`) the calls run here, one after the other.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (it is pickled to the workers).
+    *sequences : sliceable
+        Aligned inputs, e.g. shapes_a, shapes_b.
+    client : dask.distributed.Client, optional
+    chunk_size : int, optional
+        Items per task; default :data:`DEFAULT_BATCH`, fewer if that would give less
+        than four tasks per worker thread.
+    families : iterable of str, optional
+        Kernel families the workers warm up (default all).
+    **kwargs
+        Passed to every call.
+
+    Returns
+    -------
+    list
+        The results of the calls, in the order of the slices.
+
+    Examples
+    --------
+    >>> map_batches(sum, [1, 2, 3, 4, 5], chunk_size=2)
+    [3, 7, 5]
+    """
+    if not sequences:
+        raise ValueError("sequences: expected at least one sequence to split")
+    count = len(sequences[0])
+    for k, s in enumerate(sequences[1:], 1):
+        if len(s) != count:
+            raise ValueError(f"sequences: argument {k} has {len(s)} items, the first {count}")
+    if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(
+            chunk_size, int) or chunk_size < 1):
+        raise ValueError(f"chunk_size: expected a positive integer, got {chunk_size!r}")
+    client = current_client(client)
+    if chunk_size is None:
+        n_workers = 1 if client is None else max(1, sum(client.nthreads().values()))
+        chunk_size = max(1, min(DEFAULT_BATCH, math.ceil(count / (4 * n_workers))))
+    spans = [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
+    if client is None:
+        return [fn(*(s[p0:p1] for s in sequences), **kwargs) for p0, p1 in spans]
+    tasks = [tuple(s[p0:p1] for s in sequences) for p0, p1 in spans]
+    out: list[Any] = [None] * len(tasks)
+    with _closing(run_tasks(client, _call_on_slices, None, tasks, fn, kwargs,
+                            families=families)) as results:
+        for k, r in results:
+            out[k] = r
+    return out
+
+
+def _closing(gen: Iterator[Any]) -> Any:
+    from contextlib import closing
+
+    return closing(gen)
+
+
+def classify_many(
+    shapes_a: Any,
+    shapes_b: Any,
+    *,
+    tolerance: float | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
+) -> Any:
+    """:func:`polycontact.classify_many` split into tasks on a Dask cluster.
+
+    Same arguments and result (a :class:`~polycontact.RelationBatch`, identical to the
+    local call: each pair's tolerance depends on that pair only), plus ``client`` and
+    ``chunk_size`` as in :func:`map_batches`. Without a client it is the local call.
+    ``distances``, on first access, are computed locally.
+
+    Examples
+    --------
+    See the module's example.
+    """
+    from .relation import RelationBatch, _pack
+    from .relation import classify_many as local
+
+    client = current_client(client)
+    if client is None:
+        return local(shapes_a, shapes_b, tolerance=tolerance)
+    if len(shapes_a) != len(shapes_b):
+        raise ValueError(
+            f"shapes_a and shapes_b differ in length ({len(shapes_a)} and {len(shapes_b)})")
+    parts = map_batches(_states, shapes_a, shapes_b, client=client, chunk_size=chunk_size,
+                        families=["classification"], tolerance=tolerance)
+    states = np.concatenate([p[0] for p in parts]) if parts else np.empty(0, np.int8)
+    tols = np.concatenate([p[1] for p in parts]) if parts else np.empty(0)
+    return RelationBatch(states, tols,
+                         lambda: (*_pack(shapes_a, "shapes_a"), *_pack(shapes_b, "shapes_b")))
+
+
+def _states(a: Any, b: Any, tolerance: float | None) -> tuple[np.ndarray, np.ndarray]:
+    from .relation import classify_many as local
+
+    batch = local(a, b, tolerance=tolerance)
+    return batch.states, batch.tolerances
