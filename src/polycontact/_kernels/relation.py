@@ -753,10 +753,13 @@ def _star_ring_is_simple(xy, n, eps):
             changes += 1
         ex = wx - ux
         ey = wy - uy
-        c2 = cr * cr
-        h2 = min(h2, c2 / (ex * ex + ey * ey))
+        # ratios before squares: a squared cross product of coordinates near the
+        # limits (1e100, 1e-100) would overflow or underflow float64
+        h = cr / np.sqrt(ex * ex + ey * ey)
+        h2 = min(h2, h * h)
         if ux * wx + uy * wy > 0.0:
-            s2 = min(s2, c2 / (u2 * w2))
+            sn = cr / (np.sqrt(u2) * np.sqrt(w2))
+            s2 = min(s2, sn * sn)
         ux = wx
         uy = wy
         u2 = w2
