@@ -64,30 +64,41 @@ def motions(draw, grid: bool) -> Motion:
 
 @st.composite
 def scenes(draw, n_max: int = 5):
-    """2..n_max concave bodies (some with holes) in a 40 x 40 field, on the integer grid
+    """2..n_max concave bodies (some with holes) in slots along a row, on the integer grid
     or not: apart, touching (a vertex placed on another's vertex), penetrating at the
-    start, heading for each other."""
+    start, or aimed at another body (where it will be at a chosen time, give or take
+    their radii: hits, grazes and near misses)."""
     grid = draw(st.booleans())
     n = draw(st.integers(2, n_max))
-    bodies = []
-    for k in range(n):
+    t_max = float(draw(st.sampled_from([0.0, 0.5, 1.0, 2.0, 3.0]) if grid else st.floats(0, 3)))
+    bodies, moves = [], []
+    for _ in range(n):
         s = draw(star_shapes(grid=grid, n_max=8))
-        how = draw(st.sampled_from(["random", "random", "vertex", "overlap"]))
+        m = draw(motions(grid))
+        how = draw(st.sampled_from(["random", "aim", "aim", "aim", "vertex", "overlap"]))
         if how != "random" and bodies:
-            other = bodies[draw(st.integers(0, len(bodies) - 1))]
+            k = draw(st.integers(0, len(bodies) - 1))
+            other, mo = bodies[k], moves[k]
             if how == "vertex":
                 va = other.loops[0][draw(st.integers(0, len(other.loops[0]) - 1))]
                 vb = s.loops[0][draw(st.integers(0, len(s.loops[0]) - 1))]
                 d = va - vb
-            else:
+            elif how == "overlap":
                 d = other.centroid - s.centroid + np.round(draw(st.floats(-2, 2)))
-        elif grid:
-            d = np.array(draw(st.lists(st.integers(-20, 20), min_size=2, max_size=2)), float)
-        else:
-            d = np.array(draw(st.lists(st.floats(-20, 20), min_size=2, max_size=2)))
+            else:
+                tau = t_max * draw(st.floats(0, 1))
+                reach = other.bounding_radius + s.bounding_radius
+                off = reach * draw(st.floats(0.7, 1.3)) * np.array(
+                    [math.cos(draw(st.floats(0, 6.3))), math.sin(draw(st.floats(0, 6.3)))])
+                d = other.centroid + mo.pose(tau)[0] - m.pose(tau)[0] + off - s.centroid
+                if grid:
+                    d = np.round(d)
+        else:   # spread out along a row of slots 25 apart, with some play
+            d = np.array([25.0 * len(bodies), 0.0]) + (
+                np.array(draw(st.lists(st.integers(-8, 8), min_size=2, max_size=2)), float)
+                if grid else np.array(draw(st.lists(st.floats(-8, 8), min_size=2, max_size=2))))
         bodies.append(translated(s, d))
-    moves = [draw(motions(grid)) for _ in range(n)]
-    t_max = float(draw(st.sampled_from([0.0, 0.5, 1.0, 2.0, 3.0]) if grid else st.floats(0, 3)))
+        moves.append(m)
     return bodies, moves, t_max
 
 

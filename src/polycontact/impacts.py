@@ -312,7 +312,7 @@ def time_of_impact_many(
     >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
     ...                             [sq.moved((3, 0)), sq.moved((0, 5))], [Motion()] * 2,
     ...                             t_max=5)
-    >>> batch.collides.tolist(), batch.times.round(4).tolist(), batch.status.tolist()
+    >>> batch.collides.tolist(), batch.times.round(3).tolist(), batch.status.tolist()
     ([True, False], [2.0, nan], [1, 0])
     >>> batch.impact(0).status.value
     'hit'
@@ -385,7 +385,7 @@ def event_time(impact: Impact) -> float:
     >>> from polycontact import Motion, Shape, time_of_impact
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> round(event_time(time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)),
-    ...                                 Motion(), t_max=5)), 4)
+    ...                                 Motion(), t_max=5)), 3)
     2.0
     """
     if impact.status is ImpactStatus.PENETRATING_AT_START:
@@ -450,7 +450,7 @@ def first_impacts(
     >>> shapes = [sq, sq.moved((3, 0)), sq.moved((1.5, 1)), sq.moved((0, 30))]
     >>> motions = [Motion(velocity=(1, 0)), Motion(), Motion(), Motion()]
     >>> for i, j, imp in first_impacts(shapes, motions, t_max=5):
-    ...     print(i, j, imp.status.value, imp.state.value, round(event_time(imp), 4))
+    ...     print(i, j, imp.status.value, imp.state.value, round(event_time(imp), 3))
     0 2 no-hit contact 0.5
     0 1 hit penetrating 2.0
     """
@@ -504,7 +504,7 @@ def first_impact(
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> shapes = [sq, sq.moved((3, 0)), sq.moved((1.5, 1))]
     >>> i, j, imp = first_impact(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5)
-    >>> i, j, round(imp.time, 4)
+    >>> i, j, round(imp.time, 3)
     (0, 1, 2.0)
     """
     events = first_impacts(shapes, motions, t_max, **options)
