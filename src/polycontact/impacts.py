@@ -247,7 +247,9 @@ def _unique(shapes: list[Shape]) -> tuple[list[Shape], np.ndarray]:
 
 
 def _motion_array(motions: list[Motion]) -> np.ndarray:
-    return np.array([m.array for m in motions], dtype=np.float64).reshape(len(motions), 6)
+    """The rows ``Motion.array`` of every motion, in one NumPy call."""
+    return np.array([(*m.velocity, *m.acceleration, m.angular_velocity, m.angular_acceleration)
+                     for m in motions], dtype=np.float64).reshape(len(motions), 6)
 
 
 def _path_scales(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.ndarray:
@@ -461,13 +463,20 @@ def first_impacts(
     pairs = _candidates(shapes, motions, t_max)
     if len(pairs) == 0:
         return []
-    uniq, index = _unique(shapes)
-    m = _motion_array(motions)
-    scale = _path_scales(shapes, motions, t_max)
-    i, j = pairs[:, 0], pairs[:, 1]
+    # only the bodies of candidate pairs are packed and searched
+    used = np.unique(pairs)
+    local = np.empty(len(shapes), np.int64)
+    local[used] = np.arange(len(used))
+    sub_shapes = [shapes[k] for k in used]
+    sub_motions = [motions[k] for k in used]
+    uniq, index = _unique(sub_shapes)
+    m = _motion_array(sub_motions)
+    scale = _path_scales(sub_shapes, sub_motions, t_max)
+    i, j = local[pairs[:, 0]], local[pairs[:, 1]]
     eps = RELATIVE_TOLERANCE * np.maximum(scale[i], scale[j])
     raw = _search(uniq, index[i], index[j], m[i], m[j], eps, t_max, method, tol, samples,
                   max_iterations, threads)
+    i, j = pairs[:, 0], pairs[:, 1]
     code, _, _, contact, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
                   t_max, method, eps)
