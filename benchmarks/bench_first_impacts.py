@@ -14,7 +14,9 @@ pass. Printed, in one run:
   ``time_of_impact`` calls) and, to check every answer, a plain double loop of
   ``time_of_impact`` whose events must equal those of ``first_impacts`` (same pairs,
   equal ``Impact`` objects);
-- medians over R runs of each, and the ratio.
+- medians over R runs of each, and the ratio;
+- ``time_of_impact_many`` on the candidate pairs (a user's own pair list) on one thread
+  and on all CPUs, against a loop of ``time_of_impact`` over them.
 
 Timings are wall-clock medians; the machine may be shared, so compare the ratio
 measured in one run rather than absolute figures.
@@ -113,6 +115,21 @@ def main() -> None:
     print(f"speed-up (medians of {args.repeat} runs): first_impacts vs Scene.first_impact "
           f"{t_scene / t_fast:.0f}x, vs the double loop {t_brute / t_fast:.0f}x "
           f"(target >= 50x)")
+
+    # the candidate pairs as a user's own pair list
+    ia, ib = cand[:, 0].tolist(), cand[:, 1].tolist()
+    sa, ma = [shapes[i] for i in ia], [motions[i] for i in ia]
+    sb, mb = [shapes[j] for j in ib], [motions[j] for j in ib]
+    print(f"== time_of_impact_many on those {len(cand)} candidate pairs ==")
+    t_loop, loop = median_time(lambda: [pc.time_of_impact(a, m1, b, m2, t_max=t_max)
+                                        for a, m1, b, m2 in zip(sa, ma, sb, mb)], args.repeat)
+    print(f"loop of time_of_impact:        {1e3 * t_loop:8.1f} ms")
+    for threads in sorted({1, os.cpu_count() or 1}):
+        t_many, batch = median_time(lambda: pc.time_of_impact_many(
+            sa, ma, sb, mb, t_max=t_max, threads=threads), args.repeat)
+        print(f"time_of_impact_many, {threads} thread{'s' if threads > 1 else ' '}: "
+              f"{1e3 * t_many:8.1f} ms ({t_loop / t_many:.1f}x the loop; equal answers: "
+              f"{list(batch) == loop})")
 
 
 if __name__ == "__main__":

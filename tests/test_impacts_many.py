@@ -320,3 +320,29 @@ def test_swept_bounds_keep_a_grazing_pass_and_drop_far_pairs():
     far = a.moved((0, 50))
     pairs = candidate_pairs([a, b, far], [Motion(velocity=(1, 0)), Motion(), Motion()], 10)
     assert pairs.tolist() == [[0, 1]]
+
+
+def test_swept_bounds_keep_pairs_whose_paths_overflow_float64():
+    # v t and a t²/2 overflow to +inf and -inf: their sum is NaN, the box the whole plane
+    wild = Motion(velocity=(1e300, 0), acceleration=(-1e300, 0))
+    pairs = candidate_pairs([SQ, SQ.moved((50, 0)), SQ.moved((0, 1e6))],
+                            [wild, Motion(), Motion()], 1e10)
+    assert pairs.tolist() == [[0, 1], [0, 2]]
+
+
+@pytest.mark.parametrize("scale, offset", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e9), (1e-3, 1e6)])
+def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset):
+    rng = np.random.default_rng(7)
+    ring = np.array([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)], float)
+    hole = np.array([(1.5, 0.3), (2.5, 0.3), (2.5, 0.7), (1.5, 0.7)])
+    shapes, moves = [], []
+    for k in range(8):
+        d = np.array([5.0 * (k % 4), 4.0 * (k // 4)]) + rng.uniform(-1, 1, 2)
+        shapes.append(Shape((ring + d) * scale + offset, [(hole + d) * scale + offset]))
+        moves.append(Motion(velocity=rng.uniform(-3, 3, 2) * scale,
+                            acceleration=rng.uniform(-1, 1, 2) * scale,
+                            angular_velocity=rng.uniform(-1, 1)))
+    want = brute(shapes, moves, 1.5, max_iterations=BUDGET)
+    events = first_impacts(shapes, moves, 1.5, max_iterations=BUDGET)
+    assert {(e.i, e.j): e.impact for e in events} == want
+    assert any(e.impact.collides for e in events)

@@ -86,6 +86,13 @@ def swept_boxes(c, m, radius, t_max, max_slices, margin):
             boxes[b, 1] = xhi + grow
             boxes[b, 2] = ylo - grow
             boxes[b, 3] = yhi + grow
+            if not (boxes[b, 0] <= boxes[b, 1] and boxes[b, 2] <= boxes[b, 3]):
+                # the path overflowed float64 (inf − inf): the box is the whole plane,
+                # so that the pair goes on to the search, which says what it can
+                boxes[b, 0] = -np.inf
+                boxes[b, 1] = np.inf
+                boxes[b, 2] = -np.inf
+                boxes[b, 3] = np.inf
             boxes[b, 4] = t0
             boxes[b, 5] = t1
             owner[b] = i
