@@ -327,11 +327,25 @@ def time_of_impact_many(
     mb = _motions(motions_b, "motions_b", len(b), "shapes_b")
     t_max, tol, samples, max_iterations, threads = _options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
-    uniq, index = _unique(a + b)
+    # a body (the same shape and motion objects) in many pairs is prepared once
     p_count = len(a)
-    eps = RELATIVE_TOLERANCE * np.maximum(_path_scales(a, ma, t_max), _path_scales(b, mb, t_max))
-    raw = _search(uniq, index[:p_count], index[p_count:], _motion_array(ma), _motion_array(mb),
-                  eps, t_max, method, tol, samples, max_iterations, threads)
+    seen: dict[tuple[int, int], int] = {}
+    body = np.empty(2 * p_count, np.int64)
+    b_shapes: list[Shape] = []
+    b_motions: list[Motion] = []
+    for k, (s, m) in enumerate(zip(a + b, ma + mb)):
+        u = seen.setdefault((id(s), id(m)), len(b_shapes))
+        if u == len(b_shapes):
+            b_shapes.append(s)
+            b_motions.append(m)
+        body[k] = u
+    uniq, index = _unique(b_shapes)
+    scale = _path_scales(b_shapes, b_motions, t_max)
+    rows = _motion_array(b_motions)
+    ba, bb = body[:p_count], body[p_count:]
+    eps = RELATIVE_TOLERANCE * np.maximum(scale[ba], scale[bb])
+    raw = _search(uniq, index[ba], index[bb], rows[ba], rows[bb], eps, t_max, method, tol,
+                  samples, max_iterations, threads)
     code, t_hi, _, contact, *_ = raw
     collides = code == 1
     pairs = (a, b)
