@@ -36,9 +36,9 @@ def test_box_pairs_equal_all_pairs_of_overlapping_boxes(n_boxes, n_bodies, seed)
     want = set()
     for a in range(n_boxes):
         for b in range(n_boxes):
-            if owner[a] < owner[b] and all(
-                    boxes[a, 2 * k] <= boxes[b, 2 * k + 1] and boxes[b, 2 * k] <= boxes[a, 2 * k + 1]
-                    for k in range(3)):
+            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
+            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
+            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
                 want.add((int(owner[a]), int(owner[b])))
     got = box_pairs(boxes, owner, n_bodies)
     assert got.tolist() == sorted(map(list, want))
