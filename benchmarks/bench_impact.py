@@ -32,7 +32,8 @@ import polycontact as pc
 from polycontact import Motion, Shape
 from polycontact._kernels import impact as ki
 from polycontact.broad_phase import BROAD_PHASE_INFLATION
-from polycontact.impact import CONTACT_RESOLUTION, body_frame
+from polycontact.impact import _ULPS, CONTACT_RESOLUTION, _extent, body_frame
+from polycontact.tolerances import RELATIVE_TOLERANCE
 
 ROOT = Path(__file__).resolve().parent.parent
 TOL = 1e-4
@@ -100,17 +101,17 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10):
     rb, eb = body_frame(b)
     va, vb = ma.array, mb.array
     lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
-    eps = 1e-12 * max(1.0, float(np.abs(a.packed[0]).max()), float(np.abs(b.packed[0]).max()))
+    eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
     la, lb = a.bounding_radius, b.bounding_radius
 
     def run_exact():
         return ki.exact_query(ra, a.packed[1], a.centroid, va, la, ea, rb, b.packed[1],
-                              b.centroid, vb, lb, eb, t_max, BROAD_PHASE_INFLATION, TOL, eps, lam,
-                              1_000_000)
+                              b.centroid, vb, lb, eb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel,
+                              _ULPS, lam, 1_000_000)
 
     def run_sampled():
         return ki.sampled_query(ra, a.packed[1], a.centroid, va, la, rb, b.packed[1], b.centroid,
-                                vb, lb, t_max, BROAD_PHASE_INFLATION, TOL, eps, samples)
+                                vb, lb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples)
 
     run = run_exact if method == "exact" else run_sampled
     return run

@@ -10,7 +10,14 @@ Shapely oracle :func:`shapely_state`.
 The shapes: unit squares, a U-shaped socket with a rectangular tab, a dovetail socket
 and its piece (the overhangs hold the piece: it cannot move up, down or sideways), a
 frame with a square hole, a square with a triangular hole whose tip touches the outer
-boundary, crossing bars, triangles on edges and corners.
+boundary, crossing bars, triangles on edges and corners, and the hard cases of a
+tolerance: a thin sliver whose tip dips 2**-20 .. 2**-33 into an edge, edges that
+leave a touch point nearly collinear with the other body's edge (2**-20 .. 2**-40 rad,
+into it or away from it). Their offsets are powers of two, so they stay exact too.
+
+:func:`agrees_with_shapely` is the strict oracle comparison for inputs Shapely decides
+on floats that are not exact: the same state, except that where Shapely's answer
+differs from ours only within the tolerance, ours must be ``contact``.
 """
 
 from __future__ import annotations
@@ -64,6 +71,18 @@ BAR_V = _shape(_sq(1, 0, 2, 4))
 TRIANGLE_UP = _shape([(0, 0), (2, 0), (1, 1)])
 
 
+def _sliver(d: float) -> Shape:
+    """The issue's sliver: a kite over the unit square's top edge, its lower tip ``d``
+    below that edge (into the square)."""
+    return _shape([(0.5, 2), (0.2, 1), (0.5, 1 - d), (0.8, 1)])
+
+
+def _tilted(slope: float) -> Shape:
+    """A triangle touching the unit square's top edge at (0.5, 1), its lower edge
+    leaving that point to the right with the given slope (negative: into the square)."""
+    return _shape([(0.5, 1), (1.5, 1 + slope), (1.5, 2)])
+
+
 def _moved(s: Shape, dx: float, dy: float) -> Shape:
     d = np.array([dx, dy])
     return _shape(s.exterior + d, [h + d for h in s.holes])
@@ -103,6 +122,18 @@ CASES: tuple[Case, ...] = (
     Case("bar end flush on a bar side", BAR_H, _shape(_sq(1, 2, 2, 4)), "contact"),
     Case("triangle on an edge, base flush", UNIT, _moved(TRIANGLE_UP, -0.5, 1), "contact"),
     Case("triangles tip to tip", TRIANGLE_UP, _shape([(1, 1), (2, 2), (0, 2)]), "contact"),
+    # A sliver's tip: penetrating as soon as the depth is above the tolerance (1e-12
+    # here), whatever the thinness of the sliver; on the edge, contact.
+    Case("sliver tip 2**-20 into an edge", UNIT, _sliver(2.0**-20), "penetrating"),
+    Case("sliver tip 2**-33 into an edge", UNIT, _sliver(2.0**-33), "penetrating"),
+    Case("sliver tip on an edge", UNIT, _sliver(0.0), "contact"),
+    # Nearly collinear edges at a touch point: the lower edge of B leaves (0.5, 1) at a
+    # tiny angle into A (a sliver of overlap 0.5 long, 2**-21 .. 2**-37 thick at A's
+    # corner: penetrating) or away from it (contact only at the point).
+    Case("edge 2**-20 rad into a flush edge", UNIT, _tilted(-(2.0**-20)), "penetrating"),
+    Case("edge 2**-36 rad into a flush edge", UNIT, _tilted(-(2.0**-36)), "penetrating"),
+    Case("edge 2**-20 rad away from a flush edge", UNIT, _tilted(2.0**-20), "contact"),
+    Case("edge 2**-40 rad away from a flush edge", UNIT, _tilted(2.0**-40), "contact"),
 )
 
 
@@ -192,3 +223,75 @@ SMALL_FAR_RING = np.array([
     [81.99583853163453, 70.41534297426826], [81.99198856384453, 70.41223472144104],
     [81.990100075034, 70.4076612000806], [81.99346356379137, 70.39868197504693],
 ])
+
+
+def feature_separation(a: Shape, b: Shape) -> float:
+    """Smallest positive distance between a vertex and an edge of the two bodies (of
+    either body, the same body included): below a few tolerances, float64 rounding of
+    a scaled or offset copy may change the answer, so the scale tests skip there.
+    Distances below 1e-14 of the bodies' extent are the rounding of this computation
+    (a vertex on an edge, or the edge's own end) and count as zero."""
+    loops = list(a.loops) + list(b.loops)
+    pts = np.vstack(loops)
+    floor = 1e-14 * float(np.ptp(pts, axis=0).max())
+    p = pts[:, None, :]
+    best = np.inf
+    for loop in loops:
+        u = loop
+        w = np.roll(loop, -1, axis=0)
+        d = (w - u)[None]
+        den = np.maximum((d * d).sum(-1), 1e-300)
+        t = np.clip(((p - u[None]) * d).sum(-1) / den, 0.0, 1.0)
+        dist = np.hypot(*np.moveaxis(p - (u[None] + t[..., None] * d), -1, 0))
+        pos = dist[dist > floor]
+        if pos.size:
+            best = min(best, float(pos.min()))
+    return best
+
+
+def agrees_with_shapely(a: Shape, b: Shape, ours: str, tolerance: float) -> bool:
+    """``ours`` is Shapely's state, or ``contact`` where Shapely's answer differs only
+    within the tolerance: a gap of at most ``2 * tolerance`` (Shapely: separate), an
+    overlap thinner than ``4 * tolerance`` (Shapely: penetrating, and the overlap eroded
+    by ``2 * tolerance`` is empty). Nothing else is accepted."""
+    want = shapely_state(a, b)
+    if ours == want:
+        return True
+    if ours != "contact":
+        return False
+    pa, pb = a.to_shapely(), b.to_shapely()
+    if want == "separate":
+        return float(shapely.distance(pa, pb)) <= 2.0 * tolerance
+    overlap = shapely.intersection(pa, pb)
+    return bool(shapely.buffer(overlap, -2.0 * tolerance).is_empty)
+
+
+@st.composite
+def touching_slivers(draw, holes: bool | None = None):
+    """A random body A and a triangle B that touches an edge of A at a point p, B's
+    first edge leaving p nearly collinear with A's edge: at an angle of 1e-12 .. 1e-6
+    rad into A or away from it; B's opening angle at p is 1e-6 .. 1 rad (thin slivers
+    included). Off the grid: Shapely decides on the rounded floats, so compare with
+    :func:`agrees_with_shapely`."""
+    a = draw(shapes(grid=False, holes=holes))
+    ring = a.loops[0]
+    k = draw(st.integers(0, len(ring) - 1))
+    u, w = ring[k], ring[(k + 1) % len(ring)]
+    length = float(np.hypot(*(w - u)))
+    e = (w - u) / length
+    out = np.array([e[1], -e[0]])              # A's interior is on the left of u -> w
+    p = u + draw(st.floats(0.2, 0.8)) * (w - u)
+    theta = 10.0 ** draw(st.floats(-12, -6)) * draw(st.sampled_from([1.0, -1.0]))
+    beta = 10.0 ** draw(st.floats(-6, 0))
+    span = draw(st.floats(0.1, 2.0)) * length
+    backwards = draw(st.booleans())            # leave p towards u instead of w
+    e1 = -e if backwards else e
+    o1 = np.cos(theta) * e1 + np.sin(theta) * out   # theta > 0: away from A
+    o2 = np.cos(theta + beta) * e1 + np.sin(theta + beta) * out
+    b_ring = np.array([p, p + span * o1, p + span * o2])
+    try:
+        b = Shape(b_ring)
+    except InvalidShapeError:
+        assume(False)
+        raise
+    return a, b

@@ -89,3 +89,54 @@ def test_intervals_match_dense_sampling(va, aa, vb, ab, offset):
             assert covered(out, t)
         elif d > R2 + 1e-7:
             assert not covered(out, t)
+
+
+def test_defect4_intervals_stay_right_at_long_travel():
+    # a unit square 1e9 away (0.3 off the line) closing at 1 unit/s: the expanded
+    # quartic (|d0|² = 1e18 swallowing R² = 2) gave the single instant (1e9, 1e9)
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    half = math.sqrt(2 - 0.09)               # radii sqrt(0.5) each: R = sqrt(2)
+    for offset in (0.0, 1e9):
+        out = broad_phase_intervals(sq.moved((offset, 0)), Motion(velocity=(1, 0)),
+                                    sq.moved((offset + 1e9, 0.3)), Motion(), t_max=2e9)
+        assert len(out) == 1
+        (s, e), = out
+        assert 1e9 - half - 1e-4 <= s <= 1e9 - half and 1e9 + half <= e <= 1e9 + half + 1e-4
+
+
+def _exact_distance(d0, dv, acc, t):
+    """|D(t)| in exact rational arithmetic (then rounded once)."""
+    from fractions import Fraction as F
+
+    t = F(t)
+    d = [F(d0[k]) + F(dv[k]) * t + F(acc[k]) * t * t / 2 for k in range(2)]
+    return math.sqrt(float(d[0] * d[0] + d[1] * d[1]))
+
+
+@given(st.floats(-1e9, 1e9), st.floats(0.0, 1e9), st.floats(1e-6, 1e12),
+       st.floats(-1.5, 1.5), st.floats(-1e-3, 1e-3), st.sampled_from([0.0, 1.0, 1e3]))
+@examples(60)
+def test_intervals_right_far_away_at_long_travel(offset, travel, speed, lateral, acc_rel,
+                                                 stretch):
+    """Far from the origin, at long travel and any speed, with acceleration: every
+    sampled instant at which the circles (radii sqrt(2) each, R2 in all) overlap, by exact
+    arithmetic, is covered, and every interval end is where they touch (to the
+    rounding of positions of that size)."""
+    gap = R2 + travel
+    t_hit = gap / speed
+    t_max = t_hit * (1 + stretch) + 1.0 / speed
+    acc = acc_rel * speed / t_max               # bends the path by <= 1e-3 of the travel
+    a = SQ.moved((offset, offset))
+    b = SQ.moved((offset + gap, offset + lateral * R2))
+    ma = Motion(velocity=(speed, 0.0), acceleration=(acc, -acc))
+    out = broad_phase_intervals(a, ma, b, Motion(), t_max=t_max)
+    d0 = (a.centroid[0] - b.centroid[0], a.centroid[1] - b.centroid[1])
+    dist = lambda t: _exact_distance(d0, (speed, 0.0), (acc, -acc), t)
+    slack = 64 * 2.0**-52 * (abs(offset) + 2 * gap + speed * t_max) + 1e-12 * R2
+    for t in np.linspace(0.0, t_max, 400):
+        if dist(t) <= R2:
+            assert any(s <= t <= e for s, e in out), t
+    for s, e in out:
+        for end in (s, e):
+            if 0.0 < end < t_max:
+                assert abs(dist(end) - R2) <= slack, (end, dist(end))

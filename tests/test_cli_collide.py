@@ -5,13 +5,15 @@ import re
 
 import pytest
 
-from polycontact import cli
+from polycontact import cli, compiling
 
 
 @pytest.fixture
 def run(monkeypatch, capsys):
     # only this subcommand: the test does not depend on the other subcommands' modules
     monkeypatch.setattr(cli, "_SUBCOMMANDS", ("collide",))
+    # a cold cache adds the first-run notice to stderr (tested in test_compiling.py)
+    compiling.warmup(["classification", "time of impact"])
 
     def _run(*argv):
         code = cli.main(["collide", *map(str, argv)])

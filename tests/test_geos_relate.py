@@ -7,6 +7,11 @@ contact; otherwise separate. A MultiPolygon is classified part by part: its part
 only at points, so the interiors of the union overlap B's exactly when some part's do,
 and the worst state over the part pairs is the state of the union. Every case is run in
 both argument orders. Skipped in a clone without ``shared/`` beside it.
+
+Our states are decided within a tolerance and GEOS's predicates are exact, so where
+GEOS finds an overlap thinner than our tolerance (the width of its minimum rotated
+rectangle; the "very skinny polygon" cases A/A-6-18 and 6-24) we expect ``contact``, and the test
+checks that this is the only kind of disagreement.
 """
 
 from __future__ import annotations
@@ -36,9 +41,16 @@ def _cases() -> list:
     return out
 
 
-def _expected(matrix: str) -> int:
+def _expected(matrix: str, a: shapely.Geometry, b: shapely.Geometry) -> int:
     if matrix[0] != "F":
-        return 2
+        # the overlap's width: the shorter side of its minimum rotated rectangle
+        box = shapely.get_coordinates(shapely.minimum_rotated_rectangle(
+            shapely.intersection(a, b)))
+        thickness = min(shapely.LineString(box[0:2]).length,
+                        shapely.LineString(box[1:3]).length)
+        eps = max(pc.classify(pa, pb).tolerance
+                  for pa in shapely.get_parts(a) for pb in shapely.get_parts(b))
+        return 1 if thickness < eps else 2
     return 1 if any(matrix[k] != "F" for k in (1, 3, 4)) else 0
 
 
@@ -56,10 +68,13 @@ CASES = _cases() if GEOS.is_dir() else []
 @pytest.mark.skipif(not GEOS.is_dir(), reason="no ../shared/datasets/geos beside the clone")
 def test_geos_suite_is_there():
     assert len(CASES) == 123
+    thin = [p.id for p in CASES if p.values[2][0] != "F" and _expected(*p.values[2:], *p.values[:2]) == 1]
+    assert sorted(thin) == ["validate_TestRelateAA-big:A/A-6-18: a polygon overlapping a very skinny polygon",
+                            "validate_TestRelateAA-big:A/A-6-24: a polygon overlapping a very skinny polygon"]
 
 
 @pytest.mark.parametrize(("a", "b", "matrix"), CASES)
 def test_geos_relate_case(a, b, matrix):
-    want = _expected(matrix)
+    want = _expected(matrix, a, b)
     assert _state(a, b) == want
     assert _state(b, a) == want

@@ -15,58 +15,118 @@ from polycontact._kernels import broad_phase as kb
 from polycontact._kernels import impact as ki
 from polycontact._kernels.advance import edge_table, pair_step, traversal_stack, window_kinematics
 
-coef = st.floats(-10, 10, allow_nan=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
+ULPS = 64 * 2.0**-52
+vec = st.tuples(st.floats(-3, 3), st.floats(-3, 3))
+small = st.floats(-10, 10, allow_nan=False).map(lambda x: 0.0 if abs(x) < 1e-3 else x)
 
 
-def _reference_nonpositive(c, lo, hi):
-    """Where the polynomial is <= 0, from numpy.roots and the sign between roots."""
+def _motion_pair(d0, dv, acc):
+    """Centroids and motion vectors with relative motion D(t) = d0 + dv t + acc t²/2."""
+    ca, cb = np.array(d0, float), np.zeros(2)
+    ma = np.array([dv[0], dv[1], acc[0], acc[1], 0.0, 0.0])
+    return ca, ma, cb, np.zeros(6)
+
+
+def _reference_nonpositive(d0, dv, acc, r, lo, hi):
+    """Where |D(t)| <= r, from numpy.roots of the expanded quartic and the sign between
+    roots (fine for coordinates of order 1)."""
+    d0, dv, h = np.array(d0, float), np.array(dv, float), 0.5 * np.array(acc, float)
+    c = np.array([d0 @ d0 - r * r, 2 * d0 @ dv, dv @ dv + 2 * h @ d0, 2 * h @ dv, h @ h])
     roots = np.roots(c[::-1]) if np.any(c[1:]) else np.array([])
-    real = sorted(r.real for r in roots if abs(r.imag) < 1e-9 and lo < r.real < hi)
+    real = sorted(x.real for x in roots if abs(x.imag) < 1e-9 and lo < x.real < hi)
     pts = [lo, *real, hi]
-    val = lambda t: np.polyval(c[::-1], t)
-    return [(s, e) for s, e in zip(pts, pts[1:]) if val(0.5 * (s + e)) <= 0]
+    val = lambda t: np.hypot(*(d0 + dv * t + h * t * t)) - r
+    return [(s, e) for s, e in zip(pts, pts[1:]) if val(0.5 * (s + e)) <= 0], val
 
 
-@given(st.lists(coef, min_size=5, max_size=5))
-def test_nonpositive_intervals_match_numpy_roots(c):
-    c = np.array(c)
-    out = kb.nonpositive_intervals(c, 0.0, 3.0)
-    val = lambda t: np.polyval(c[::-1], t)
+@given(st.tuples(small, small), st.tuples(small, small), st.tuples(small, small),
+       st.floats(0.1, 5))
+def test_nonpositive_intervals_match_numpy_roots(d0, dv, acc, r):
+    ca, ma, cb, mb = _motion_pair(d0, dv, acc)
+    p = kb.relative_motion(ca, ma, cb, mb)
+    out = kb.nonpositive_intervals(p, r, 0.0, 3.0)
+    ref, val = _reference_nonpositive(d0, dv, acc, r, 0.0, 3.0)
     for s, e in out:
         assert 0.0 <= s <= e <= 3.0
-        m = 0.5 * (s + e)
-        assert val(m) <= 1e-9 * max(1.0, np.abs(c).sum() * 81)
-    for s, e in _reference_nonpositive(c, 0.0, 3.0):
+        assert val(0.5 * (s + e)) <= 1e-9 * (1 + np.abs(d0).sum() + 9 * np.abs(acc).sum())
+    for s, e in ref:
         m = 0.5 * (s + e)
         if val(m) < -1e-6:
             assert any(a - 1e-9 <= m <= b + 1e-9 for a, b in out)
 
 
-@given(st.lists(coef, min_size=5, max_size=5))
-def test_polynomial_is_monotone_between_breakpoints(c):
-    c = np.array(c)
-    pts = kb.monotone_breakpoints(c, -2.0, 2.0)
+@given(st.tuples(small, small), st.tuples(small, small), st.tuples(small, small))
+def test_distance_is_monotone_between_breakpoints(d0, dv, acc):
+    ca, ma, cb, mb = _motion_pair(d0, dv, acc)
+    p = kb.relative_motion(ca, ma, cb, mb)
+    pts = kb.monotone_breakpoints(p, -2.0, 2.0)
     assert pts[0] == -2.0 and pts[-1] == 2.0 and np.all(np.diff(pts) >= 0)
-    der = np.polyder(c[::-1])
     for s, e in zip(pts, pts[1:]):
-        d = np.polyval(der, np.linspace(s, e, 9)[1:-1])
-        scale = 1e-7 * max(1.0, np.abs(c).sum() * 32)
+        ts = np.linspace(s, e, 9)
+        d = np.diff([np.hypot(*(np.array(d0) + np.array(dv) * t + 0.5 * np.array(acc) * t * t))
+                     for t in ts])
+        scale = 1e-9 * (1 + np.abs(d0).sum() + np.abs(dv).sum() * 4 + np.abs(acc).sum() * 8)
         assert np.all(d >= -scale) or np.all(d <= scale)
 
 
-def test_double_root_is_a_point_interval():
-    c = np.array([1.0, -2.0, 1.0, 0.0, 0.0])        # (t - 1)²
-    out = kb.nonpositive_intervals(c, 0.0, 3.0)
+def test_grazing_is_a_point_interval():
+    # |D(t)| = |(t - 1, 1)| touches r = 1 at t = 1 only
+    p = kb.relative_motion(np.array([-1.0, 1.0]), np.array([1.0, 0, 0, 0, 0, 0]),
+                           np.zeros(2), np.zeros(6))
+    out = kb.nonpositive_intervals(p, 1.0, 0.0, 3.0)
     assert out.shape == (1, 2) and abs(out[0, 0] - 1) < 1e-7 and abs(out[0, 1] - 1) < 1e-7
 
 
-def test_constant_polynomials():
-    assert kb.nonpositive_intervals(np.array([-1.0, 0, 0, 0, 0]), 0.0, 2.0).tolist() == [
-        [0.0, 2.0]]
-    assert kb.nonpositive_intervals(np.array([1.0, 0, 0, 0, 0]), 0.0, 2.0).shape == (0, 2)
+def test_no_relative_motion():
+    still = np.zeros(6)
+    p = kb.relative_motion(np.array([1.0, 0.0]), still, np.zeros(2), still)
+    assert kb.nonpositive_intervals(p, 2.0, 0.0, 2.0).tolist() == [[0.0, 2.0]]
+    assert kb.nonpositive_intervals(p, 0.5, 0.0, 2.0).shape == (0, 2)
 
 
-vec = st.tuples(st.floats(-3, 3), st.floats(-3, 3))
+def test_defect4_intervals_stay_right_at_long_travel():
+    # unit circles 1e9 apart (0.3 off the line), closing at 1 unit/s: the expanded
+    # quartic (d0² = 1e18) lost R² and gave a single instant; relative coordinates keep
+    # the roots to the float spacing of the positions (1.2e-7 at 1e9)
+    r = 2 * math.sqrt(0.5)
+    half = math.sqrt(r * r - 0.09)
+    for offset in (0.0, 1e9):
+        ca, cb = np.array([offset, 0.0]), np.array([offset + 1e9, 0.3])
+        ma = np.array([1.0, 0, 0, 0, 0, 0])
+        out = kb.overlap_intervals(ca, ma, r / 2, cb, np.zeros(6), r / 2, 2e9, 1e-12)
+        slack = 2 * kb.rounding_allowance(ca, ma, cb, np.zeros(6), 2e9) + 1e-6  # ~ 4e-5
+        assert out.shape == (1, 2)
+        assert 1e9 - half - slack <= out[0, 0] <= 1e9 - half
+        assert 1e9 + half <= out[0, 1] <= 1e9 + half + slack
+
+
+@given(st.floats(0, 1e9), st.floats(-1e9, 1e9), st.floats(1e-6, 1e12),
+       st.floats(-1.0, 1.0), st.floats(0.0, 1e3))
+def test_intervals_hold_every_overlap_far_away(gap, offset, speed, lateral, acc):
+    """Long travel, far offsets, any speed, with acceleration: the circles of radius 1
+    overlap exactly while |D(t)| <= 2; the intervals contain every such instant (checked
+    at the true entry and exit, computed in closed form without acceleration, and at
+    dense samples with it) and are no wider than the rounding allowance."""
+    r = 1.0
+    ca = np.array([offset, offset])
+    cb = np.array([offset + 2 * r + gap, offset + lateral])
+    ma = np.array([speed, 0.0, acc, 0.0, 0.0, 0.0])
+    t_max = 4 * (2 * r + gap) / speed + 1.0
+    out = kb.overlap_intervals(ca, ma, r, cb, np.zeros(6), r, t_max, 1e-12)
+    allowance = kb.rounding_allowance(ca, ma, cb, np.zeros(6), t_max) + 4e-12
+    d0 = ca - cb
+
+    def dist(t):
+        return math.hypot(d0[0] + speed * t + 0.5 * acc * t * t, d0[1])
+
+    inside = lambda t: any(s <= t <= e for s, e in out)
+    for t in np.linspace(0.0, t_max, 2001):
+        if dist(t) <= 2 * r:
+            assert inside(t)
+        elif dist(t) > 2 * r + 2 * allowance + 1e-9 * dist(t):
+            assert not inside(t)
+
+
 
 
 @given(vec, vec, st.floats(-4, 4), st.floats(-4, 4), st.floats(0, 3))
@@ -106,7 +166,7 @@ def test_exact_search_on_flush_squares():
     iv = np.array([[0.0, 5.0]])
     code, hi, lo, contact, its, reached = ki.exact_search(
         ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb, b.bounding_radius, iv,
-        1e-4, 1e-12, 1e-6, 10000)
+        1e-4, 1e-12, ULPS, 1e-6, 10000)
     assert code == ki.HIT and lo < hi and hi - lo <= 1e-4 and abs(hi - 2.0) <= 1e-4
     assert lo <= 2.0 <= hi and contact <= hi
 
@@ -120,7 +180,7 @@ def test_exact_search_reports_the_budget():
     spin = Motion(angular_velocity=1.0)
     ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, spin, b, spin)
     out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
+                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
     assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0 and out[5] < 1.0
 
 
@@ -132,7 +192,7 @@ def test_exact_search_follows_a_slide_under_an_overhang():
     b = Shape([(0.5, 1), (1.8, 1), (1.8, 0), (2.1, 0), (2.1, 2), (0.5, 2)])
     ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
     out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, 1e-3, 50)
+                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
     # (an overlap up to the tolerance eps = 1e-12 is contact, so the first penetration
     # beyond it is at 0.8 + eps / v)
     assert out[0] == ki.HIT and out[2] <= 0.8 + 1e-12 <= out[1] and out[1] - out[2] <= 1e-4
@@ -144,7 +204,7 @@ def test_exact_search_follows_a_slide_in_few_steps():
     b = Shape([(0.5, 1), (9, 1), (9, 2), (0.5, 2)])   # sliding contact from t = 0
     ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
     out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 12.0]]), 1e-4, 1e-12, 1e-3, 50)
+                          b.bounding_radius, np.array([[0.0, 12.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
     assert out[0] == ki.NO_HIT and out[3] == 0.0 and out[4] < 50
 
 
@@ -194,9 +254,10 @@ def test_sampled_search_follows_the_paper_steps():
     b = Shape([(3, 0.5), (4, 0), (4, 1)])
     for n in (2, 3, 10):
         m_a = Motion(velocity=(1, 0.1), angular_velocity=0.3)
-        args = _kernel_args(sq, m_a, b, Motion())
-        code, hi, lo, contact, evals = ki.sampled_search(*args, np.array([[0.5, 4.0]]), 1e-3,
-                                                         n, 1e-12)
+        ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, m_a, b, Motion())
+        code, hi, lo, contact, evals = ki.sampled_search(
+            ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb, b.bounding_radius,
+            np.array([[0.5, 4.0]]), 1e-3, n, 1e-12, ULPS)
         expected = _paper_sampled(sq, m_a, b, Motion(), 0.5, 4.0, n, 1e-3)
         assert code == ki.HIT and math.isclose(hi, expected, abs_tol=1e-12)
 

@@ -119,7 +119,7 @@ def test_convex_pieces_tile_the_polygon(poly):
     tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
     vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
-    xy, starts = decompose.convex_pieces(vxy, idx.reshape(-1, 3), 1e-12)
+    xy, starts = decompose.convex_pieces(vxy, idx.reshape(-1, 3), 1e-12, 64.0)
     pieces = [shapely.Polygon(p) for p in _split(xy, starts)]
     assert len(pieces) <= len(tris)
     for p, ring in zip(pieces, _split(xy, starts)):
@@ -146,7 +146,7 @@ def test_ear_triangles_tile_a_simple_polygon(poly):
     assert all(t.area > 0 for t in tris)
     assert abs(sum(t.area for t in tris) - poly.area) < 1e-9  # no overlaps
     assert shapely.symmetric_difference(shapely.union_all(tris), poly).area < 1e-9
-    xy, starts = decompose.convex_pieces(ring, tri, 1e-12)
+    xy, starts = decompose.convex_pieces(ring, tri, 1e-12, 64.0)
     pieces = [shapely.Polygon(p) for p in _split(xy, starts)]
     assert all(decompose.is_convex(p) for p in _split(xy, starts))
     assert abs(sum(p.area for p in pieces) - poly.area) < 1e-9
@@ -188,13 +188,13 @@ def test_merge_collinear():
 
 def test_ring_pieces_convex_small_and_too_big():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
-    ok, xy, starts = decompose.ring_pieces(sq, 1e-12, 64)
+    ok, xy, starts = decompose.ring_pieces(sq, 1e-12, 64.0, 64)
     assert ok and xy.tolist() == sq.tolist() and starts.tolist() == [0, 4]
     ell = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
-    ok, xy, starts = decompose.ring_pieces(ell, 1e-12, 64)
+    ok, xy, starts = decompose.ring_pieces(ell, 1e-12, 64.0, 64)
     assert ok and len(starts) == 3
     assert sum(shapely.Polygon(p).area for p in _split(xy, starts)) == 3.0
-    ok, _, _ = decompose.ring_pieces(ell, 1e-12, 5)  # too many vertices for ear clipping
+    ok, _, _ = decompose.ring_pieces(ell, 1e-12, 64.0, 5)  # too many vertices for ear clipping
     assert not ok
 
 

@@ -16,9 +16,17 @@ from polycontact import Shape
 from polycontact._kernels import relation as kr
 from polycontact._kernels import relation_many as km
 from polycontact.errors import InvalidShapeError
-from polycontact.tolerances import RELATIVE_TOLERANCE, default_tolerance
+from polycontact.tolerances import (
+    COORDINATE_LIMIT,
+    EXTENT_FLOOR,
+    RELATIVE_TOLERANCE,
+    ROUNDING_ULPS,
+    default_tolerance,
+)
 
 STATE_NAMES = ("separate", "contact", "penetrating")
+#: The default-tolerance rule and the coordinate range, as the ring kernels take them.
+RING = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
 def _eps(a: Shape, b: Shape) -> float:
@@ -146,7 +154,7 @@ def test_long_ring_sweep_agrees_with_all_pairs(radii, snap, swap):
     i, j = swap[0] % len(ring), swap[1] % len(ring)
     ring[[i, j]] = ring[[j, i]]
     n = len(ring)
-    eps = 1e-12 * max(1.0, np.abs(ring).max())
+    eps = default_tolerance(ring)
     folds = any(
         kr._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n)
     )
@@ -182,7 +190,7 @@ def test_star_certificate_is_never_wrong(steps, turns, shift, scale, clockwise):
     ring = np.c_[np.cos(ang) * rad + shift, np.sin(ang) * rad] * scale
     if clockwise:
         ring = ring[::-1].copy()
-    eps = RELATIVE_TOLERANCE * max(1.0, np.abs(ring).max())
+    eps = default_tolerance(ring)
     if kr._star_ring_is_simple(ring, len(ring), eps):
         assert _full_ring_check(ring, eps)
         assert shapely.Polygon(ring).is_valid
@@ -197,7 +205,7 @@ def test_star_certificate_fires_on_convex_and_star_rings():
     comb = np.array([[0, 0], [3, 0], [3, 1], [2, 1], [2, 0.2], [1, 0.2], [1, 1], [0, 1.0]])
     for ring, certified in ((convex, True), (star, True), (convex[::-1], True),
                             (pentagram, False), (comb, False)):
-        eps = RELATIVE_TOLERANCE * max(1.0, np.abs(ring).max())
+        eps = default_tolerance(ring)
         assert kr._star_ring_is_simple(ring, len(ring), eps) == certified
         assert kr._ring_is_simple(ring, len(ring), eps) == _full_ring_check(ring, eps)
 
@@ -205,7 +213,7 @@ def test_star_certificate_fires_on_convex_and_star_rings():
 @given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
 def test_raw_ring_agrees_with_shape(points):
     ring = np.array(points, dtype=float)
-    n, sign, scale, box = kr._raw_ring(ring, RELATIVE_TOLERANCE)
+    n, sign, eps, box = kr._raw_ring(ring, *RING)
     try:
         shape = Shape(ring)
     except InvalidShapeError:
@@ -215,19 +223,19 @@ def test_raw_ring_agrees_with_shape(points):
     if distinct:  # repeated vertices are left to Shape, which drops them
         assert n == len(ring)
         assert sign == (1.0 if np.array_equal(shape.exterior, ring) else -1.0)
-        assert scale == max(1.0, np.abs(ring).max())
+        assert eps == default_tolerance(ring)
         assert box == (ring[:, 0].min(), ring[:, 0].max(), ring[:, 1].min(), ring[:, 1].max())
 
 
 def test_classify_raw_orientation_and_codes():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
-    assert kr.classify_raw(sq, sq[::-1] + 1.0, -1.0, 1e-12)[0] == kr.CONTACT
-    assert kr.classify_raw(sq, sq[::-1] + 0.5, -1.0, 1e-12)[0] == kr.PENETRATING
-    assert kr.classify_raw(bow, sq, -1.0, 1e-12)[0] == -1
-    assert kr.classify_raw(sq, bow, -1.0, 1e-12)[0] == -2
+    assert kr.classify_raw(sq, sq[::-1] + 1.0, -1.0, *RING)[0] == kr.CONTACT
+    assert kr.classify_raw(sq, sq[::-1] + 0.5, -1.0, *RING)[0] == kr.PENETRATING
+    assert kr.classify_raw(bow, sq, -1.0, *RING)[0] == -1
+    assert kr.classify_raw(sq, bow, -1.0, *RING)[0] == -2
     closed = np.vstack([sq, sq[:1]])
-    code, eps, na, fa, nb, fb = kr.classify_raw(closed, sq[::-1] + 3.0, 0.5, 1e-12)
+    code, eps, na, fa, nb, fb = kr.classify_raw(closed, sq[::-1] + 3.0, 0.5, *RING)
     assert (code, eps, na, fa, nb, fb) == (kr.SEPARATE, 0.5, 4, 1.0, 4, -1.0)
 
 
@@ -245,7 +253,7 @@ def test_many_kernels_match_single(many):
     sa = [p[0] for p in many]
     sb = [p[1] for p in many]
     pa, pb = pack(sa), pack(sb)
-    states, eps = km.many_states(*pa, *pb, -1.0, RELATIVE_TOLERANCE)
+    states, eps = km.many_states(*pa, *pb, -1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS)
     want = [kr.relate_state(*a.packed, *b.packed, _eps(a, b)) for a, b in zip(sa, sb)]
     assert states.tolist() == want
     dist = km.many_distances(*pa, *pb, states, eps)
@@ -271,9 +279,9 @@ def test_raw_states_matches_single_pairs(many, closed):
         ra, rb = rows(a), rows(b)
         xa = np.stack([ra[0], ra[1], ra[0], ra[1]])
         xb = np.stack([rb[0], rb[0], rb[1], rb[1]])
-        got = km.raw_states(xa, xb, -1.0, RELATIVE_TOLERANCE)
+        got = km.raw_states(xa, xb, -1.0, *RING)
         for p in range(4):
-            want = kr.classify_raw(xa[p], xb[p], -1.0, RELATIVE_TOLERANCE)
+            want = kr.classify_raw(xa[p], xb[p], -1.0, *RING)
             assert tuple(g[p] for g in got) == want
 
 
@@ -281,15 +289,15 @@ def test_raw_states_flags_invalid_rings():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
     states, _, used_a, _, used_b, _ = km.raw_states(
-        np.stack([sq, bow, sq]), np.stack([sq + 0.5, sq, bow]), -1.0, RELATIVE_TOLERANCE
+        np.stack([sq, bow, sq]), np.stack([sq + 0.5, sq, bow]), -1.0, *RING
     )
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
     # a lopsided bow-tie (nonzero signed area, clockwise by it): invalid, with the sign
     # _raw_ring gives an invalid ring, whichever way its area turns
     lop = np.array([[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 1.0]])
-    _, _, used_a, sign_a, _, _ = km.raw_states(lop[None], sq[None], -1.0, RELATIVE_TOLERANCE)
-    assert used_a[0] == -1 and sign_a[0] == kr._raw_ring(lop, RELATIVE_TOLERANCE)[1] == 1.0
+    _, _, used_a, sign_a, _, _ = km.raw_states(lop[None], sq[None], -1.0, *RING)
+    assert used_a[0] == -1 and sign_a[0] == kr._raw_ring(lop, *RING)[1] == 1.0
 
 
 def _comb(teeth: int) -> np.ndarray:
@@ -309,19 +317,47 @@ def test_raw_states_long_rings_that_need_the_sweep():
     star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(len(t)) % 2, 3.0, 2.0)[:, None]
     xa = np.stack([comb, comb, star, crossed, star])
     xb = np.stack([comb + [0.25, 0.5], star + [12.0, 0.0], comb, star, crossed])
-    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0,
-                                                                RELATIVE_TOLERANCE)
+    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0, *RING)
     assert states.tolist()[3:] == [-1, -1]
     assert used_a.tolist()[3] == -1 and used_b.tolist()[4] == -1
-    assert sign_a[3] == kr._raw_ring(crossed, RELATIVE_TOLERANCE)[1] == sign_b[4]
+    assert sign_a[3] == kr._raw_ring(crossed, *RING)[1] == sign_b[4]
     for p in range(3):
-        want = kr.classify_raw(xa[p], xb[p], -1.0, RELATIVE_TOLERANCE)
+        want = kr.classify_raw(xa[p], xb[p], -1.0, *RING)
         assert (states[p], eps[p], used_a[p], sign_a[p], used_b[p], sign_b[p]) == want
     assert states.tolist()[:3] == [2, 0, 2]
 
 
 def test_raw_ring_small_ring_far_from_the_origin():
     # area 2e-4 at (82, 70): valid, counter-clockwise, its box exact
-    n, sign, scale, box = kr._raw_ring(SMALL_FAR_RING, RELATIVE_TOLERANCE)
+    n, sign, eps, box = kr._raw_ring(SMALL_FAR_RING, *RING)
     assert (n, sign) == (len(SMALL_FAR_RING), 1.0)
-    assert box[1] == SMALL_FAR_RING[:, 0].max() and scale == SMALL_FAR_RING.max()
+    assert box[1] == SMALL_FAR_RING[:, 0].max() and eps == default_tolerance(SMALL_FAR_RING)
+
+
+@given(st.floats(0.0, 1e100), st.floats(0.0, 1e100))
+def test_kernel_tolerance_is_the_python_formula(extent, magnitude):
+    from polycontact._kernels import tolerance as kt
+    from polycontact.tolerances import tolerance_for
+
+    got = kt.tolerance_for(extent, magnitude, RELATIVE_TOLERANCE, ROUNDING_ULPS)
+    assert got == tolerance_for(extent, magnitude)  # bit for bit
+
+
+@given(pairs(holes=False))
+def test_pair_tolerance_is_default_tolerance(pair):
+    a, b, _ = pair
+    na, _, _, ba = kr._raw_ring(a.exterior, *RING)
+    nb, _, _, bb = kr._raw_ring(b.exterior, *RING)
+    assert na > 0 and nb > 0
+    want = default_tolerance(a.exterior, b.exterior)
+    assert kr.pair_tolerance(ba, bb, RELATIVE_TOLERANCE, ROUNDING_ULPS) == want
+    assert kr.classify_raw(a.exterior, b.exterior, -1.0, *RING)[1] == want
+
+
+def test_raw_ring_refuses_out_of_range_without_overflow():
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    with np.errstate(all="raise"):
+        for ring in (sq * 1e200, sq * 1e-300, sq + [np.nan, 0.0], sq + [0.0, np.inf]):
+            assert kr._raw_ring(ring, *RING)[0] == -1
+        assert kr._raw_ring(sq * 1e-90, *RING)[0] == 4
+        assert kr._raw_ring(sq * 1e90, *RING)[0] == 4

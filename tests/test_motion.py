@@ -44,12 +44,22 @@ def test_array_is_the_kernel_vector():
         ({"velocity": "ab"}, "velocity: expected two numbers"),
         ({"acceleration": (math.nan, 0)}, "acceleration: expected finite"),
         ({"angular_velocity": math.inf}, "angular_velocity: expected a finite"),
-        ({"angular_acceleration": "x"}, "angular_acceleration: expected a number"),
-        ({"angular_velocity": True}, "angular_velocity: expected a number"),
     ],
 )
 def test_bad_motion(kwargs, message):
     with pytest.raises(ValueError, match=message):
+        Motion(**kwargs)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"angular_acceleration": "x"}, "angular_acceleration: expected a real number, got str"),
+        ({"angular_velocity": True}, "angular_velocity: expected a real number, got bool"),
+    ],
+)
+def test_motion_numbers_of_the_wrong_type(kwargs, message):
+    with pytest.raises(TypeError, match=message):
         Motion(**kwargs)
 
 

@@ -241,6 +241,26 @@ def test_random_concave_with_holes_against_reference(a, b):
     assert same_region(nfp.region, ref) is None
 
 
+def test_reference_union_of_near_coincident_hulls():
+    # B's two vertices 2e-16 apart in x split it into triangles whose sums with A have
+    # edges a few ulps apart; GEOS's floating union_all of those hulls lost 0.875 of the
+    # area (CI seed of ce6b02e). The oracle now unions on a fine grid; the region is the
+    # convex hull of the vertex differences (both shapes are convex).
+    a = shapely.from_wkt(
+        "POLYGON ((0.9616839614202389 0.2741604609477383, -0.3084305185662055 "
+        "1.0818944565977688, -2.885051884260717 -0.8224813828432158, 0.5483209218954771 "
+        "-1.9233679228404779, 0.9616839614202389 0.2741604609477383))")
+    b = shapely.from_wkt(
+        "POLYGON ((1.6536898730240086 1, 0.6536898730240085 1.75, -0.3463101269759915 "
+        "1.0000000000000002, 0.6536898730240083 0, 1.6536898730240086 1))")
+    nfp = pc.no_fit_polygon(a, b)
+    pa = np.asarray(a.exterior.coords)[:-1]
+    pb = np.asarray(b.exterior.coords)[:-1]
+    hull = shapely.MultiPoint((pb[:, None] - pa[None] + nfp.reference).reshape(-1, 2))
+    assert same_region(nfp.region, hull.convex_hull) is None
+    assert same_region(nfp.region, reference_region(a, b, nfp.reference)) is None
+
+
 @examples(200)
 @given(grid_shapes(), grid_shapes())
 def test_grid_shapes_against_reference_and_lattice(a, b):

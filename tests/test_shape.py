@@ -128,7 +128,6 @@ def test_paper_case_1_centroids_as_reported():
         (SQUARE, [HOLE, [(1.5, 1.5), (2.5, 1.5), (2.5, 2.5)]], "hole 0 and hole 1 overlap"),
         (SQUARE, [[(0, 0), (1, 0), (1, 1)]], "crosses the outer loop"),
         ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], (), "expected an array of shape (N, 2)"),
-        ([("a", 0), (1, 0), (0, 1)], (), "not numbers"),
     ],
 )
 def test_bad_input_is_refused_with_what_and_where(vertices, holes, message):
@@ -232,3 +231,49 @@ def test_accepts_exactly_the_holes_shapely_calls_valid(hole_a, hole_b):
     except InvalidShapeError:
         accepted = False
     assert accepted == valid, shapely.is_valid_reason(shapely.Polygon(outer, holes))
+
+
+def test_a_shape_is_immutable():
+    s = Shape([(0, 0), (2, 0), (2, 2), (0, 2)], [[(0.5, 0.5), (1, 0.5), (1, 1)]])
+    for arr in (s.exterior, *s.holes, s.centroid, *s.packed):
+        assert not arr.flags.writeable
+        with pytest.raises(ValueError):
+            arr[0] = 0
+    for name in ("repairs", "_xy", "_loops", "_area", "_centroid", "_extent", "_magnitude",
+                 "_starts", "_radius"):
+        with pytest.raises(AttributeError, match="immutable"):
+            setattr(s, name, getattr(s, name))
+        with pytest.raises(AttributeError, match="immutable"):
+            delattr(s, name)
+    for name in ("area", "centroid", "exterior", "holes", "loops"):
+        with pytest.raises(AttributeError):
+            setattr(s, name, None)
+    with pytest.raises(AttributeError):
+        s.anything = 1  # __slots__: no new attributes either
+    assert s.area == 3.875 and s.moved((1, 0)).area == 3.875
+
+
+@pytest.mark.parametrize(
+    "vertices, given_type",
+    [
+        ([("a", 0), (1, 0), (0, 1)], "<U"),
+        ([("0", "0"), ("1", "0"), ("0", "1")], "<U"),
+        (np.array([(0, 0), (1, 0), (0, 1)]) + 0j, "complex128"),
+        (np.array([(0, 0), (1, 0), (0, 1)]) > 0, "bool"),
+        ([(0, 0), (1, 0), (0, None)], "NoneType"),
+        ([(0, 0), (1, 0), (0, True)], "bool"),
+        ("0 0, 1 0, 0 1", "str"),
+    ],
+)
+def test_coordinates_that_are_not_real_numbers_are_refused(vertices, given_type):
+    expected = f"^outer loop: expected (an array of )?real numbers.*{given_type}"
+    with pytest.raises(TypeError, match=expected):
+        Shape(vertices)
+
+
+def test_integer_and_decimal_coordinates_are_accepted():
+    from decimal import Decimal
+    from fractions import Fraction
+
+    assert Shape(np.array([(0, 0), (2, 0), (0, 2)], dtype=np.int16)).area == 2.0
+    assert Shape([(Decimal(0), 0), (Fraction(2), 0), (0, 2)]).area == 2.0

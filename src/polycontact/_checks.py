@@ -7,16 +7,28 @@ name the argument.
 Traceback (most recent call last):
 ...
 ValueError: time_tolerance: expected a finite number > 0, got 0.0
+>>> finite_number("1e-3", "tolerance")
+Traceback (most recent call last):
+...
+TypeError: tolerance: expected a real number, got str '1e-3'
 >>> point((1, 2), "reference").tolist()
 [1.0, 2.0]
 """
 
 from __future__ import annotations
 
+import decimal
 import math
+import numbers
 from typing import Any
 
 import numpy as np
+
+
+def is_real(x: Any) -> bool:
+    """Whether ``x`` is one real number: an int, float, fraction or decimal (Python or
+    NumPy), not a bool, a string or a complex number."""
+    return isinstance(x, (numbers.Real, decimal.Decimal)) and not isinstance(x, (bool, np.bool_))
 
 
 def finite_number(
@@ -28,13 +40,20 @@ def finite_number(
     error: type[ValueError] = ValueError,
 ) -> float:
     """``value`` as a finite float (``>= minimum``, or ``> 0`` if ``positive``), else
-    ``error`` naming ``what``. Booleans are refused: ``True`` is not a number here."""
-    if isinstance(value, bool):
-        raise error(f"{what}: expected a number, got {value!r}")
+    ``error`` naming ``what``.
+
+    Only real numbers are taken (Python and NumPy integers and floats, fractions,
+    decimals, 0-d real arrays); anything else raises ``TypeError`` naming ``what`` and
+    the type given: a string is not parsed, a complex number not truncated, and
+    ``True`` is not a number here."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
+        value = value[()]
+    if not is_real(value):
+        raise TypeError(f"{what}: expected a real number, got {type(value).__name__} {value!r}")
     try:
         x = float(value)
-    except (TypeError, ValueError):
-        raise error(f"{what}: expected a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise error(f"{what}: expected a finite number, got {value!r}") from None
     bound = " > 0" if positive else (f" >= {minimum:g}" if minimum is not None else "")
     if not math.isfinite(x) or (positive and x <= 0.0) or (minimum is not None and x < minimum):
         raise error(f"{what}: expected a finite number{bound}, got {x!r}")
@@ -43,9 +62,24 @@ def finite_number(
 
 def point(value: Any, what: str, *, error: type[ValueError] = ValueError) -> np.ndarray:
     """``value`` as a float64 array of shape (2,) with finite entries, else ``error``
-    naming ``what``."""
+    naming ``what``; ``TypeError`` if the entries are not real numbers (strings,
+    booleans, complex numbers)."""
     try:
-        arr = np.array(value, dtype=np.float64)
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise error(f"{what}: expected two numbers (x, y), got {value!r}") from None
+    if raw.shape != (2,):
+        raise error(f"{what}: expected two numbers (x, y), got {value!r}")
+    if raw.dtype.kind == "O" or isinstance(value, (list, tuple)):
+        for x in value if isinstance(value, (list, tuple)) else raw.ravel():
+            if not is_real(x):
+                raise TypeError(f"{what}: expected two real numbers, got a {type(x).__name__}")
+    elif raw.dtype.kind not in "fiu":
+        raise TypeError(
+            f"{what}: expected two real numbers, got {type(value).__name__} {value!r}"
+        )
+    try:
+        arr = np.array(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise error(f"{what}: expected two numbers (x, y), got {value!r}") from None
     if arr.shape != (2,) or not np.isfinite(arr).all():

@@ -15,6 +15,7 @@ no relative motion at all.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -22,6 +23,7 @@ import numpy as np
 from ._checks import finite_number
 from .motion import Motion
 from .shape import Shape, as_shape
+from .tolerances import COORDINATE_LIMIT, check_range
 
 __all__ = ["broad_phase_intervals", "BROAD_PHASE_INFLATION"]
 
@@ -40,6 +42,37 @@ def check_motion(motion: Any, what: str) -> Motion:
     if not isinstance(motion, Motion):
         raise TypeError(f"{what}: expected a polycontact.Motion, got {type(motion).__name__}")
     return motion
+
+
+def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
+    """Refuse a motion that carries the body's coordinates, or its points' speeds or
+    accelerations, beyond :data:`polycontact.tolerances.COORDINATE_LIMIT` within
+    [0, t_max]: the kernels square and multiply them, which would overflow float64.
+    Raises ValueError naming ``what``.
+
+    Examples
+    --------
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> check_reach(sq, Motion(velocity=(1e60, 0)), 1e50, "motion_a")
+    Traceback (most recent call last):
+    ...
+    ValueError: motion_a: the body's coordinates reach 1e+110 within t_max = 1e+50, beyond ±1e+100: products of coordinates would overflow float64
+    """
+    cx, cy = shape.centroid
+    radius = shape.bounding_radius
+    w_max = abs(motion.angular_velocity) + abs(motion.angular_acceleration) * t_max
+    v = math.hypot(*motion.velocity)
+    acc = math.hypot(*motion.acceleration)
+    reach = max(abs(float(cx)), abs(float(cy))) + v * t_max + 0.5 * acc * t_max * t_max + radius
+    speed = v + acc * t_max + w_max * radius
+    accel = acc + (abs(motion.angular_acceleration) + w_max * w_max) * radius
+    for value, name in ((reach, "coordinates reach"), (speed, "points' speeds reach"),
+                        (accel, "points' accelerations reach"), (w_max, "angular speed reaches")):
+        if not value <= COORDINATE_LIMIT:
+            raise ValueError(
+                f"{what}: the body's {name} {value:g} within t_max = {t_max:g}, beyond "
+                f"±{COORDINATE_LIMIT:g}: products of coordinates would overflow float64"
+            )
 
 
 def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) -> np.ndarray:
@@ -85,5 +118,10 @@ def broad_phase_intervals(
     b = as_shape(b, "b")
     ma = check_motion(motion_a, "motion_a")
     mb = check_motion(motion_b, "motion_b")
-    out = intervals_array(a, ma, b, mb, check_t_max(t_max))
+    t_max = check_t_max(t_max)
+    check_range(a.packed[0], "a")
+    check_range(b.packed[0], "b")
+    check_reach(a, ma, t_max, "motion_a")
+    check_reach(b, mb, t_max, "motion_b")
+    out = intervals_array(a, ma, b, mb, t_max)
     return tuple((float(s), float(e)) for s, e in out)

@@ -6,10 +6,11 @@ or grazing a corner — is a **contact**, reported by ``first_contact`` while
 ``collides`` stays False. A flush approach (paper Fig. 17) is a collision at the
 moment the edges meet: the interiors overlap right after.
 
-What ``time`` means: the first instant of penetration, located to within
-``time_tolerance`` **from above**: the bodies penetrate at ``time`` (``state`` is
-PENETRATING) and do not at ``time_bracket[0]``, which is less than ``time_tolerance``
-earlier. ``features``, ``point`` and ``normal`` describe the touching configuration at
+What ``time`` means: the first instant of penetration, located to within the time
+tolerance **from above**: the bodies penetrate at ``time`` (``state`` is PENETRATING)
+and do not at ``time_bracket[0]``, which is less than ``Impact.time_tolerance``
+earlier (``time_tolerance``, or the float spacing of t when that is coarser).
+``features``, ``point`` and ``normal`` describe the touching configuration at
 ``time_bracket[0]``, the moment just before the interiors overlap (for ``"sampled"``:
 the penetrating configuration at ``time``, as the paper records it).
 """
@@ -17,7 +18,6 @@ the penetrating configuration at ``time``, as the paper records it).
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 
 from ._checks import finite_number
-from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_t_max
+from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
 from .relation import Feature, State, classify
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
 
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
 
@@ -106,6 +106,10 @@ class Impact:
         Number of placements classified.
     searched_to : float
         How far in time the search got (t_max when it finished).
+    time_tolerance : float
+        The time tolerance honoured: the one asked for, or what float64 resolves at
+        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · |t|, when that is
+        larger. ``time`` is within it after the first penetration.
     features : tuple of Feature
         At the touching configuration: which vertex of which body meets which edge of
         the other (0-based indices into ``Shape.loops``, body "a" or "b").
@@ -125,25 +129,27 @@ class Impact:
     time_bracket: tuple[float, float] | None = field(repr=False)
     iterations: int = field(repr=False)
     searched_to: float = field(repr=False)
+    time_tolerance: float = field(repr=False)
     _bodies: tuple = field(repr=False, compare=False, default=())
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
         if self.state is None:
             return (), None, None
-        a, ma, b, mb, eps = self._bodies
+        a, ma, b, mb, eps_rel = self._bodies
         if self.status is ImpactStatus.HIT:
             t_lo, t_hi = self.time_bracket
             if self.method == "exact":
-                t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps)
-            rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi), tolerance=eps)
+                t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps_rel)
+            rel_hi = classify(a.at(ma, t_hi), b.at(mb, t_hi),
+                              tolerance=_eps_at(a, ma, b, mb, t_hi, eps_rel))
             rel = rel_hi
             if self.method == "exact":
                 from ._kernels.impact import speed_bound
 
                 reach = (t_hi - t_lo) * speed_bound(ma.array, a.bounding_radius, mb.array,
                                                     b.bounding_radius, t_lo, t_hi)
-                rel_lo = _relation_at(a, ma, b, mb, t_lo, eps, reach)
+                rel_lo = _relation_at(a, ma, b, mb, t_lo, eps_rel, reach)
                 rel = rel_lo if rel_lo.state is State.CONTACT else rel_hi
             # the normal opposes the smallest translation that ends the (tiny) overlap
             # at `time`: at a corner-on-corner or flush touch it is the push direction
@@ -151,10 +157,11 @@ class Impact:
             point = rel.point
             features = rel.features
         elif self.status is ImpactStatus.PENETRATING_AT_START:
-            rel = classify(a.at(ma, 0.0), b.at(mb, 0.0), tolerance=eps)
+            rel = classify(a.at(ma, 0.0), b.at(mb, 0.0),
+                           tolerance=_eps_at(a, ma, b, mb, 0.0, eps_rel))
             features, point, normal = rel.features, rel.point, rel.normal
         else:
-            rel = _relation_at(a, ma, b, mb, self.first_contact, eps)
+            rel = _relation_at(a, ma, b, mb, self.first_contact, eps_rel)
             features, point, normal = rel.features, rel.point, rel.normal
         return (
             tuple(features),
@@ -179,7 +186,7 @@ class Impact:
 
 
 def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi: float,
-                  eps: float) -> tuple[float, float]:
+                  eps_rel: float) -> tuple[float, float]:
     """The exact method's bracket of the first penetration narrowed to the probe length
     λ/S (λ the contact resolution, S the speed bound), so that the features are read
     where the bodies touch: the search brackets it only to ``time_tolerance``. The
@@ -195,25 +202,33 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     (ra, ea), (rb, eb) = body_frame(a), body_frame(b)
     code, hi, lo, *_ = ki._prepared_exact_search(
         ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
-        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps, lam, MAX_ITERATIONS)
+        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, _ULPS, lam, MAX_ITERATIONS)
     return (lo, hi) if code == ki.HIT else (t_lo, t_hi)
 
 
-def _path_scale(shape: Shape, motion: Motion, t_max: float) -> float:
-    """Largest |coordinate| the body can reach in [0, t_max] (for the tolerance)."""
-    cx, cy = shape.centroid
-    reach = (
-        max(abs(float(cx)), abs(float(cy)))
-        + math.hypot(*motion.velocity) * t_max
-        + 0.5 * math.hypot(*motion.acceleration) * t_max * t_max
-        + shape.bounding_radius
-    )
-    return max(1.0, reach)
+#: The float-spacing part of the distance tolerance (see ``tolerance_for``).
+_ULPS = ROUNDING_ULPS * 2.0**-52
 
 
-def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: float,
+def _extent(shape: Shape) -> float:
+    """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
+    kept with the shape's body frame (:func:`body_frame`)."""
+    body_frame(shape, tables=False)
+    return shape._frame[2]
+
+
+def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
+    """The distance tolerance at time t, as the kernels compute it: the size term
+    ``eps_rel`` or the float spacing of the coordinates at t, whichever is larger."""
+    from ._kernels.impact import _eps_at as eps_at
+
+    return float(eps_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
+                        b.bounding_radius, t, eps_rel, _ULPS))
+
+
+def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
                  reach: float = 0.0):
-    """classify at time t, the tolerance widened to the gap and to ``reach``.
+    """classify at time t, the tolerance (local to t) widened to the gap and to ``reach``.
 
     ``reach`` is how far the bodies can still move relative to each other before the
     penetration (speed bound × bracket length): every vertex that can meet an edge by
@@ -224,6 +239,7 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps: floa
     pa = a.at(ma, t)
     pb = b.at(mb, t)
     gap = float(boundary_distance(*pa.packed, *pb.packed))
+    eps = _eps_at(a, ma, b, mb, t, eps_rel)
     return classify(pa, pb, tolerance=max(eps, 1.01 * gap, 1.01 * reach))
 
 
@@ -286,20 +302,45 @@ def time_of_impact(
     every vertex–edge pair under it. The step is the least pair time, both ways.
 
     Near contact the steps shrink fast (the bounds converge quadratically). After a
-    step to t + h that is shorter than ``time_tolerance`` or than a fifth of the step
-    before, the bodies are classified at t + h + 0.99 ``time_tolerance``: penetrating
-    there ends the search with ``time_bracket`` = (t + h, that time) — no penetration
-    began before t + h, so ``time`` is within ``time_tolerance`` after the first
-    penetration. Otherwise, below the probe length τ = min(time_tolerance / 2, λ / S),
-    with λ = :data:`CONTACT_RESOLUTION` · (L_A + L_B), the search steps by τ and
-    classifies the end. A penetrating end is the hit, with the non-penetrating start
-    of the probe as ``time_bracket[0]``. Not penetrating at the end means either no
-    penetration began in the step, or one began and ended inside it — lasting under
-    ``time_tolerance``/2 with no point moving more than λ relative to the other body:
-    a penetration shallower than the contact resolution. Every other penetration is
-    found, whatever the rotation speed. ``features``, ``point`` and ``normal`` are
-    computed when first asked for, from the bracket narrowed by the same search to τ,
-    so that they describe the touch and not a configuration up to a tolerance later.
+    step to t + h that is shorter than the time tolerance or than a fifth of the step
+    before, the bodies are classified at t + h + 0.99 × the time tolerance:
+    penetrating there ends the search with ``time_bracket`` = (t + h, that time) — no
+    penetration began before t + h. Otherwise, below the probe length τ = λ / S, the
+    search steps by τ and classifies the end. A penetrating end is the hit: the probe
+    (non-penetrating start, penetrating end) is narrowed by bisection to the time
+    tolerance, which thus decides how precisely ``time`` is reported, never whether a
+    hit is found nor how many probes are taken. Not penetrating at the end means
+    either no penetration began in the probe, or one began and ended inside it with no
+    point moving more than λ relative to the other body: a penetration shallower than
+    the contact resolution λ. ``features``, ``point`` and ``normal`` are computed when
+    first asked for, from the bracket narrowed by the same search to τ, so that they
+    describe the touch and not a configuration up to a tolerance later.
+
+    **Tolerances are local to the time examined**, never scaled by ``t_max`` or by the
+    length of the travel: at time t the distance tolerance is
+    ``tolerance_for(extent, magnitude)`` (:mod:`polycontact.tolerances`) with the
+    bodies' size and a bound of their |coordinates| over the step; the contact
+    resolution is λ = max(:data:`CONTACT_RESOLUTION` · (L_A + L_B), 128 · eps,
+    S · 4 · 2⁻⁵² · |t|) (well above the rounding of the coordinates, and at least the
+    distance moved in one float step of t); the time tolerance used at t is
+    max(``time_tolerance``, 4 · 2⁻⁵² · |t|) — a tolerance float64 cannot resolve at t is
+    clamped there, and :attr:`Impact.time_tolerance` says which one was honoured.
+
+    **Contract** (``method="exact"``): whatever the speed, spin, acceleration, travel
+    length or time tolerance,
+
+    - a penetration inside [0, t_max] deeper than the distance tolerance eps at its
+      time (1e-12 of the bodies' size, or 64 float spacings of their coordinates
+      there) is found, unless it both begins and ends within one probe — then it is
+      shallower than λ (1e-6 of L_A + L_B for bodies near the origin);
+    - ``time`` is within :attr:`Impact.time_tolerance` after the first such
+      penetration (an overlap within eps is contact, as in :func:`classify`);
+    - bodies already penetrating at t = 0 have status ``penetrating-at-start``;
+    - the answer does not depend on ``t_max`` beyond it (up to the time tolerance);
+    - shapes with coordinates beyond ``tolerances.COORDINATE_LIMIT``, and motions that
+      carry coordinates, point speeds or accelerations beyond it within [0, t_max],
+      are refused with an error naming the argument (float64 products would
+      overflow); they are never answered wrongly.
 
     A sliding contact (paper Fig. 16) is followed by long steps, not probes. Once the
     bodies touch, each step holds the touching vertex–edge pairs (those within λ/64)
@@ -332,7 +373,9 @@ def time_of_impact(
         End of the time window (>= 0).
     method : {"exact", "sampled"}
     time_tolerance : float
-        Accuracy of ``time`` (the paper's threshold, 1e-4 s).
+        Accuracy of ``time`` (the paper's threshold, 1e-4 s); any value > 0. Below
+        what float64 resolves at the time examined (4 · 2⁻⁵² · |t|) it is clamped
+        there, and the result's ``time_tolerance`` says so.
     samples : int
         Points per round of the sampled method (>= 2); ignored by "exact".
     max_iterations : int
@@ -353,6 +396,10 @@ def time_of_impact(
     ...                        t_max=1)                     # slides along from t = 0.9
     >>> slide.collides, round(slide.first_contact, 4), slide.state.value
     (False, 0.9, 'contact')
+    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
+    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
+    (True, True)
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
@@ -370,43 +417,57 @@ def time_of_impact(
 
     from ._kernels import impact as ki
 
-    eps = RELATIVE_TOLERANCE * max(_path_scale(a, ma, t_max), _path_scale(b, mb, t_max))
+    # coordinates (checked once per shape, with its body frame) and motions whose
+    # products would overflow float64 are refused
     exact = method == "exact"
-    ra, ea = body_frame(a, tables=exact)
-    rb, eb = body_frame(b, tables=exact)
+    ra, ea = body_frame(a, tables=exact, what="a")
+    rb, eb = body_frame(b, tables=exact, what="b")
+    check_reach(a, ma, t_max, "motion_a")
+    check_reach(b, mb, t_max, "motion_b")
+    # the size term of the distance tolerance; the kernels add the float spacing of the
+    # coordinates at each time they examine (never a bound over all of [0, t_max])
+    eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
     la, lb = a.bounding_radius, b.bounding_radius
     if exact:
         out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
-                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps,
-                             CONTACT_RESOLUTION * (la + lb), int(max_iterations))
+                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol,
+                             eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations))
     else:
         out = ki.sampled_query(ra, a.packed[1], a.centroid, ma.array, la, rb, b.packed[1],
-                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps,
-                               int(samples))
+                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol,
+                               eps_rel, _ULPS, int(samples))
     intervals, code, t_hi, t_lo, t_contact, iters, reached = out
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
-                   float(t_contact), int(iters), float(reached), intervals, t_max, eps)
+                   float(t_contact), int(iters), float(reached), intervals, t_max, eps_rel, tol)
 
 
-def body_frame(shape: Shape, tables: bool = True) -> tuple[np.ndarray, tuple | None]:
+def body_frame(shape: Shape, tables: bool = True,
+               what: str = "shape") -> tuple[np.ndarray, tuple | None]:
     """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
     for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
     sampled method does not need it). Built on first use and kept with the shape (it
-    is immutable), so that repeated queries on one shape build them once."""
-    r, tab = shape._frame if shape._frame is not None else (None, None)
+    is immutable), so that repeated queries on one shape build them once. On first
+    use the coordinates are also checked (:func:`polycontact.tolerances.check_range`,
+    the error naming ``what``) and the shape's extent kept (see :func:`_extent`)."""
+    r, tab, extent = shape._frame if shape._frame is not None else (None, None, 0.0)
     if r is None:
-        r = shape.packed[0] - shape.centroid
+        xy = shape.packed[0]
+        check_range(xy, what)
+        extent = float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+        r = xy - shape.centroid
         r.flags.writeable = False
     if tables and tab is None:
         from ._kernels.advance import edge_table
 
         tab = edge_table(r, shape.packed[1])
-    shape._frame = (r, tab)
+    shape._frame = (r, tab, extent)
     return r, tab
 
 
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
-            t_max, eps) -> Impact:
+            t_max, eps_rel, tol) -> Impact:
+    from ._kernels.impact import effective_time_tolerance
+
     first_contact = t_contact if t_contact >= 0.0 else None
     state = None
     time = bracket = None
@@ -430,5 +491,6 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         time_bracket=bracket,
         iterations=iters,
         searched_to=reached,
-        _bodies=(a, ma, b, mb, eps),
+        time_tolerance=float(effective_time_tolerance(tol, time if time is not None else reached)),
+        _bodies=(a, ma, b, mb, eps_rel),
     )

@@ -46,7 +46,7 @@ from ._checks import finite_number
 from ._checks import point as point_arg
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]
 
@@ -278,7 +278,8 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
         return hit
     ok = False
     if len(starts) == 2:
-        ok, pxy, pst = _kernels().decompose.ring_pieces(xy, RELATIVE_TOLERANCE, _EAR_CLIPPING_MAX)
+        ok, pxy, pst = _kernels().decompose.ring_pieces(
+            xy, RELATIVE_TOLERANCE, ROUNDING_ULPS, _EAR_CLIPPING_MAX)
         pieces = (pxy, pst)
     if not ok:
         # (shapely.Polygon is slow with an empty hole list)
@@ -297,7 +298,8 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
     # GEOS adds no vertex: triangles share exact coordinates, hence vertex indices
     vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
-    return _kernels().decompose.convex_pieces(vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE)
+    return _kernels().decompose.convex_pieces(
+        vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE, ROUNDING_ULPS)
 
 
 def _entrance(
@@ -312,7 +314,8 @@ def _entrance(
     """
     kn = _kernels().nfp
     rxy_, rst_, stats, cand, meta = kn.entrance_region(
-        bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ANGLE_TOLERANCE
+        bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
+        ANGLE_TOLERANCE
     )
     eps = float(meta[0])
     if meta[1]:

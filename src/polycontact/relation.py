@@ -3,7 +3,8 @@
 The relation of A and B is the relation of A's reference point to the entrance block
 E(A, B) (design.md section 2): inside it the interiors overlap (penetrating), on its
 boundary they touch (contact), outside it they are apart (separate). The decision is an
-exact interior-overlap test with an absolute tolerance (see
+exact interior-overlap test with an absolute tolerance that follows the bodies' size and
+the float spacing of their coordinates (:func:`polycontact.default_tolerance`; see
 :mod:`polycontact._kernels.relation`), so an exact fit, such as a jigsaw piece in its
 socket, is contact, and identical shapes penetrate.
 
@@ -31,7 +32,13 @@ import numpy as np
 from ._checks import finite_number
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE, default_tolerance
+from .tolerances import (
+    COORDINATE_LIMIT,
+    EXTENT_FLOOR,
+    RELATIVE_TOLERANCE,
+    ROUNDING_ULPS,
+    tolerance_for,
+)
 
 __all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many"]
 
@@ -280,6 +287,14 @@ def _kr() -> Any:
 
 _RAW: list[Any] = []  # [classify_raw], bound on first use
 
+#: The default-tolerance rule and the range of coordinates, as the ring kernels take them.
+_RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
+
+
+def _shapes_tolerance(sa: Shape, sb: Shape) -> float:
+    """:func:`polycontact.default_tolerance` of two shapes, from what each cached."""
+    return tolerance_for(max(sa._extent, sb._extent), max(sa._magnitude, sb._magnitude))
+
 
 def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
@@ -293,7 +308,10 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
         (which explains the defect, or cleans repeated vertices).
     tolerance : float, optional
         Absolute tolerance; distances up to it count as touching. Default:
-        :func:`polycontact.default_tolerance` of both bodies' coordinates.
+        :func:`polycontact.default_tolerance` of both bodies: ``max(1e-12 × the larger
+        body's extent, 64 × 2**-52 × the largest |coordinate|)``, so a shift of 1e-9 of
+        a body's size is seen at every scale, and far from the origin the tolerance
+        stays above the float spacing of the coordinates.
 
     Returns
     -------
@@ -328,7 +346,7 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     ):
         if not _RAW:
             _RAW.append(_kr().classify_raw)
-        code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, RELATIVE_TOLERANCE)
+        code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, *_RING_ARGS)
         if code >= 0:
             # The lean path: the bytes are the copy the lazy parts are computed from.
             obj = object.__new__(Relation)
@@ -341,7 +359,7 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     sb = as_shape(b, "b")
     xa, pa = sa.packed
     xb, pb = sb.packed
-    eps = default_tolerance(xa, xb) if tol < 0.0 else tol
+    eps = _shapes_tolerance(sa, sb) if tol < 0.0 else tol
     obj = object.__new__(Relation)
     obj.__dict__.update(
         state=_STATES[_kr().relate_state(xa, pa, xb, pb, eps)], tolerance=eps, _pair=(sa, sb)
@@ -423,7 +441,7 @@ def _classify_arrays(
 
     out = km.raw_states_outputs(arr_a.shape[0])
     _split(arr_a.shape[0], lambda p0, p1: km.raw_states(
-        arr_a[p0:p1], arr_b[p0:p1], tol, RELATIVE_TOLERANCE, [o[p0:p1] for o in out]))
+        arr_a[p0:p1], arr_b[p0:p1], tol, *_RING_ARGS, [o[p0:p1] for o in out]))
     states, eps, used_a, sign_a, used_b, sign_b = out
     if (states < 0).any():
         return None
@@ -456,7 +474,7 @@ def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
         lo = np.zeros(len(rings), dtype=np.int64)
         lo[1:] = np.cumsum(n)[:-1]
         xy = np.concatenate(rings) if rings else np.empty((0, 2))
-        used, sg = km.check_rings(xy, lo, n, RELATIVE_TOLERANCE)
+        used, sg = km.check_rings(xy, lo, n, *_RING_ARGS)
         for k, i in enumerate(raw):
             if used[k] < 0:
                 bodies[i] = as_shape(items[i], f"{what}[{i}]")
@@ -543,7 +561,7 @@ def classify_many(
     def chunk(p0: int, p1: int) -> tuple[np.ndarray, np.ndarray]:
         return km.many_states(
             xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
-            RELATIVE_TOLERANCE,
+            RELATIVE_TOLERANCE, ROUNDING_ULPS,
         )
 
     parts = _split(len(fa), chunk)

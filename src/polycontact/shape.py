@@ -18,8 +18,15 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import is_real
 from .errors import InvalidShapeError
-from .tolerances import default_tolerance
+from .tolerances import (
+    COORDINATE_LIMIT,
+    EXTENT_FLOOR,
+    VALIDATION_ULPS,
+    check_range,
+    validation_tolerance,
+)
 
 __all__ = ["Shape", "as_shape"]
 
@@ -33,12 +40,42 @@ def _signed_area(ring: np.ndarray) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
-def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
-    """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
+def _real_array(ring: ArrayLike, what: str) -> np.ndarray:
+    """``ring`` as a new float64 array, if it holds real numbers only.
+
+    Integers and floats are converted; strings, booleans, complex numbers and other
+    objects raise ``TypeError`` naming ``what`` and the type given (a string such as
+    ``"1.5"`` is not silently parsed, an imaginary part not silently dropped).
+    """
+    if isinstance(ring, (str, bytes)):
+        raise TypeError(f"{what}: expected an array of real numbers, got {type(ring).__name__}")
     try:
-        arr = np.array(ring, dtype=np.float64)
+        arr = np.asarray(ring)
     except (TypeError, ValueError) as exc:
         raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
+    kind = arr.dtype.kind
+    if isinstance(ring, (list, tuple)) and kind in "iu":  # NumPy made ints of any bools
+        for row in ring:
+            for x in row if isinstance(row, (list, tuple)) else ():
+                if isinstance(x, (bool, np.bool_)):
+                    raise TypeError(f"{what}: expected real numbers, got an element of type bool")
+    if kind == "O":
+        for x in arr.ravel():
+            if not is_real(x):
+                raise TypeError(
+                    f"{what}: expected real numbers, got an element of type {type(x).__name__}"
+                )
+    elif kind not in "fiu":
+        raise TypeError(f"{what}: expected real numbers, got an array of dtype {arr.dtype}")
+    try:
+        return np.array(arr, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
+
+
+def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
+    """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
+    arr = _real_array(ring, what)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidShapeError(
             f"{what}: expected an array of shape (N, 2), got shape {arr.shape}"
@@ -51,6 +88,7 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
         )
     if len(arr) == 0:
         raise InvalidShapeError(f"{what}: no vertices")
+    check_range(arr, what)
     keep = np.ones(len(arr), dtype=bool)
     keep[1:] = np.any(arr[1:] != arr[:-1], axis=1)
     arr = arr[keep]
@@ -84,9 +122,17 @@ class Shape:
     Raises
     ------
     InvalidShapeError
-        Fewer than 3 distinct vertices, a non-finite coordinate, zero area, a
-        self-intersection (with its point and the two edges), a hole outside or crossing
-        its outer loop, overlapping holes.
+        Fewer than 3 distinct vertices, a non-finite coordinate, a coordinate beyond
+        ±1e100 or an extent below 1e-100 (see :func:`polycontact.tolerances.check_range`),
+        zero area, a self-intersection (with its point and the two edges), a hole
+        outside or crossing its outer loop, overlapping holes. Two features of a loop
+        count as meeting only when they are closer than float64 can tell apart at the
+        shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
+        message then says which, how far apart, and the float spacing.
+    TypeError
+        Coordinates that are not real numbers (strings, booleans, complex numbers).
+
+    A Shape is immutable: its arrays are read-only and no attribute can be rebound.
 
     Examples
     --------
@@ -100,7 +146,17 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame")
+                 "_frame", "_extent", "_magnitude")
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # Each slot is bound once, at construction; only the time-of-impact search's
+        # private cache of body-frame tables (``_frame``) is filled in later.
+        if name != "_frame" and _bound(self, name):
+            raise AttributeError(f"Shape is immutable: cannot rebind {name!r}")
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"Shape is immutable: cannot delete {name!r}")
 
     def __init__(
         self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
@@ -130,6 +186,14 @@ class Shape:
     def _set(self, loops: Sequence[np.ndarray], repairs: tuple[str, ...]) -> None:
         lens = [len(r) for r in loops]
         xy = np.ascontiguousarray(np.concatenate(loops), dtype=np.float64)
+        # What the default tolerance needs (see polycontact.default_tolerance), cached so
+        # that classify() computes it from two floats per shape.
+        lo = xy.min(axis=0)
+        hi = xy.max(axis=0)
+        extent = max(float(hi[0] - lo[0]), float(hi[1] - lo[1]))
+        magnitude = max(float(-lo.min()), float(hi.max()))
+        if not magnitude <= COORDINATE_LIMIT or extent < EXTENT_FLOOR:
+            check_range(xy, "shape")  # e.g. moved() beyond the range: says so
         starts = np.zeros(len(loops) + 1, dtype=np.int64)
         starts[1:] = np.cumsum(lens)
         xy.flags.writeable = False
@@ -159,18 +223,30 @@ class Shape:
         self._radius = float(
             np.max(np.hypot(xy[:, 0] - self._centroid[0], xy[:, 1] - self._centroid[1]))
         )
+        self._extent = extent
+        self._magnitude = magnitude
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
-        eps = default_tolerance(*loops)
+        # Features meet only when float64 cannot tell them apart: a length compared with
+        # a few float spacings of the coordinates, an area with that length times the
+        # loop's extent. Nothing depends on where the origin is or on the unit.
+        magnitude = max(float(np.abs(r).max()) for r in loops)
+        eps = validation_tolerance(magnitude)
+        spacing = (f"{eps:.3g} = {VALIDATION_ULPS:g} × 2**-52 × {magnitude:g}, the float "
+                   f"spacing of coordinates up to {magnitude:g}")
         for k, ring in enumerate(loops):
             if _collinear(ring, eps):
-                raise InvalidShapeError(f"{_loop_name(k)}: zero area (all vertices on one line)")
-        _check_loops(loops, eps)
+                raise InvalidShapeError(
+                    f"{_loop_name(k)}: zero area (all vertices on one line, within {spacing})"
+                )
+        _check_loops(loops, eps, spacing)
         for k, ring in enumerate(loops):
             area = _signed_area(ring)
-            if abs(area) <= eps * max(float(np.max(np.ptp(ring, axis=0))), 1.0):
-                raise InvalidShapeError(f"{_loop_name(k)}: zero area")
+            if abs(area) <= eps * float(np.max(np.ptp(ring, axis=0))):
+                raise InvalidShapeError(
+                    f"{_loop_name(k)}: zero area ({area:.3g}: thinner than {spacing})"
+                )
             if (k == 0) != (area > 0):
                 loops[k] = ring[::-1].copy()
         if len(loops) > 1:
@@ -364,13 +440,53 @@ def as_shape(obj: Any, what: str = "shape") -> Shape:
         return Shape(obj)
     except InvalidShapeError as exc:
         raise InvalidShapeError(f"{what}: {exc}") from None
+    except TypeError as exc:  # coordinates that are not real numbers
+        raise TypeError(f"{what}: {exc}") from None
 
 
 def _fmt(v: float) -> str:
     return f"{v:.12g}"
 
 
-def _check_loops(loops: list[np.ndarray], eps: float) -> None:
+def _bound(obj: Any, name: str) -> bool:
+    try:
+        object.__getattribute__(obj, name)
+    except AttributeError:
+        return False
+    return True
+
+
+def _point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    d = b - a
+    den = float(d @ d)
+    t = min(1.0, max(0.0, float((p - a) @ d) / den)) if den > 0.0 else 0.0
+    return float(np.hypot(*(p - (a + t * d))))
+
+
+def _closest_features(loop: np.ndarray, ei: int, ej: int) -> tuple[float, int, int]:
+    """``(distance, vertex, edge)``: of the ends of edges ``ei`` and ``ej`` of one loop
+    (their shared vertex, if any, left out), the one nearest the other edge; distance 0
+    when the edges cross. For messages: how far apart the features that met are."""
+    n = len(loop)
+
+    def orient(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> float:
+        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+
+    a, b = loop[ei], loop[(ei + 1) % n]
+    c, d = loop[ej], loop[(ej + 1) % n]
+    if orient(a, b, c) * orient(a, b, d) < 0.0 and orient(c, d, a) * orient(c, d, b) < 0.0:
+        return 0.0, ei, ej
+    ends_i = {ei, (ei + 1) % n}
+    ends_j = {ej, (ej + 1) % n}
+    shared = ends_i & ends_j
+    best = (np.inf, -1, -1)
+    for v, e in [(v, ej) for v in ends_i - shared] + [(v, ei) for v in ends_j - shared]:
+        p, q = loop[e], loop[(e + 1) % n]
+        best = min(best, (_point_segment(loop[v], p, q), v, e))
+    return best
+
+
+def _check_loops(loops: list[np.ndarray], eps: float, spacing: str) -> None:
     from ._kernels import validate as kv
 
     xy = np.ascontiguousarray(np.concatenate(loops))
@@ -378,6 +494,13 @@ def _check_loops(loops: list[np.ndarray], eps: float) -> None:
     starts[1:] = np.cumsum([len(r) for r in loops])
     code, ki, ei, kj, ej, x, y = kv.first_defect(xy, starts, eps)
     at = f"({_fmt(x)}, {_fmt(y)})"
+    if code in (kv.SELF_INTERSECTION, kv.SPIKE):
+        apart, v, e = _closest_features(loops[ki], ei, ej)
+        if apart > 0.0:
+            raise InvalidShapeError(
+                f"{_loop_name(ki)}: vertex {v} is {apart:.3g} from edge {e} (near {at}): "
+                f"closer than float64 can tell apart, below {spacing}"
+            )
     if code == kv.SELF_INTERSECTION:
         raise InvalidShapeError(
             f"{_loop_name(ki)}: self-intersection at {at} between edge {ei} and edge {ej}"
@@ -395,7 +518,8 @@ def _check_loops(loops: list[np.ndarray], eps: float) -> None:
 
 
 def _collinear(ring: np.ndarray, eps: float) -> bool:
-    """All vertices within eps of the line through vertex 0 and the vertex farthest from it."""
+    """All vertices within eps of the line through vertex 0 and the vertex farthest from it
+    (a length compared with a length)."""
     d = ring - ring[0]
     far = int(np.argmax(np.hypot(d[:, 0], d[:, 1])))
     u = d[far] / np.hypot(*d[far])

@@ -11,7 +11,13 @@ term is what a user means by "the same place" (a shift of 1e-9 of a body's size 
 seen as a shift, at any scale); the second keeps the tolerance above the rounding of
 the few operations that produce and compare coordinates (a translation, a rotation, a
 difference of two coordinates) when small bodies sit far from the origin. Lengths are
-compared with ``eps``; areas with ``eps * length``.
+compared with ``eps``; areas with ``eps * length``. The same formula is compiled for
+the kernels (:mod:`polycontact._kernels.tolerance`), so every path gives a pair the
+same tolerance.
+
+A polygon's own validity is judged on a finer scale: two of its features meet only
+when float64 cannot tell them apart (:func:`validation_tolerance`, 4 float spacings of
+its largest coordinate), so every polygon GEOS calls valid is accepted, at any scale.
 
 Coordinates must lie in ``[-COORDINATE_LIMIT, COORDINATE_LIMIT]`` and every body must
 be larger than ``EXTENT_FLOOR``: the kernels form products of up to three coordinate
@@ -34,7 +40,9 @@ __all__ = [
     "ROUNDING_ULPS",
     "COORDINATE_LIMIT",
     "EXTENT_FLOOR",
+    "VALIDATION_ULPS",
     "tolerance_for",
+    "validation_tolerance",
     "default_tolerance",
     "check_range",
 ]
@@ -45,17 +53,25 @@ __all__ = [
 RELATIVE_TOLERANCE = 1e-12
 
 #: Relative to the float spacing of the coordinates: 64 units in the last place of the
-#: largest |coordinate| (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
+#: largest absolute coordinate (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
 #: small body far from the origin moves its vertices by rounding errors of a few ulps
 #: of its coordinates; 64 ulps is well above that and still resolves 1e-4 at 1e9.
 ROUNDING_ULPS = 64.0
 
-#: Largest |coordinate| accepted. Products of three coordinate differences (up to
+#: Largest absolute coordinate accepted. Products of three coordinate differences (up to
 #: (2e100)**3 = 8e300) stay finite in float64 (max ~1.8e308).
 COORDINATE_LIMIT = 1e100
 
 #: Smallest body extent accepted: products of three lengths (1e-300) stay normal floats.
 EXTENT_FLOOR = 1e-100
+
+#: A polygon is refused as invalid (two of its features meet) only when they are
+#: closer than float64 can tell apart: 4 units in the last place of its largest
+#: |coordinate|, about the rounding of a distance computed from such coordinates. This
+#: is far below :func:`tolerance_for` on purpose: a valid polygon (GEOS's "very skinny
+#: polygon", 10 wide and 1e15 long) is accepted, and its features closer than the
+#: classification tolerance are then decided as touching.
+VALIDATION_ULPS = 4.0
 
 _ULP = 2.0**-52
 
@@ -75,6 +91,19 @@ def tolerance_for(extent: float, magnitude: float) -> float:
     14.211
     """
     return max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * _ULP * magnitude)
+
+
+def validation_tolerance(magnitude: float) -> float:
+    """Distance below which two features of one polygon whose coordinates reach
+    ``magnitude`` cannot be told apart in float64: ``VALIDATION_ULPS * 2**-52 *
+    magnitude``.
+
+    Examples
+    --------
+    >>> round(validation_tolerance(1e9) / 1e-7, 3)    # 4 float spacings at 1e9
+    8.882
+    """
+    return VALIDATION_ULPS * _ULP * magnitude
 
 
 def default_tolerance(*bodies: np.ndarray) -> float:
@@ -107,7 +136,7 @@ def check_range(xy: np.ndarray, what: str) -> None:
     """Refuse coordinates that float64 cannot carry through the kernels.
 
     ``xy`` is a finite float64 (N, 2) array of one body (or loop), ``what`` names it in
-    the error. Raises :class:`polycontact.InvalidShapeError` if some |coordinate|
+    the error. Raises :class:`polycontact.InvalidShapeError` if some absolute coordinate
     exceeds :data:`COORDINATE_LIMIT` or the body's extent is below :data:`EXTENT_FLOOR`
     (and not zero: a zero extent is a degenerate ring, refused elsewhere).
 

@@ -1,11 +1,20 @@
 """Kernels: times when two bounding circles overlap (paper Eq. 5 with accelerations).
 
-The squared distance of the centroids minus the squared sum of the radii is a
-polynomial of degree at most 4 in t. Its sign pattern on ``[lo, hi]`` is found without
-eigenvalues: the derivatives are isolated from the linear one upward, so that between
-consecutive breakpoints each derivative is monotone and every root is bracketed and
-bisected to the last bit. Double roots (the circles only grazing) and lower degrees
-(no acceleration, no relative motion) need no special case.
+With D(t) = c_A(t) − c_B(t) = d0 + dv t + h t² (h = Δa/2, per component), the circles
+overlap where f(t) = |D(t)|² − R² <= 0, a polynomial of degree at most 4 in t. Its
+sign pattern on ``[lo, hi]`` is found without eigenvalues: the derivatives are isolated
+from the linear one upward, so that between consecutive breakpoints each derivative is
+monotone and every root is bracketed and bisected to the last bit. Double roots (the
+circles only grazing) and lower degrees (no acceleration, no relative motion) need no
+special case.
+
+Nothing is expanded into power-basis coefficients: f and its derivatives are evaluated
+from D, D' = dv + 2 h t and D'' = 2 h, in coordinates relative to the bodies (f itself
+through the sign of |D| − R). Expanded coefficients lose everything at long travel or
+far from the origin (|d0|² = 1e18 swallows R² = 2 when d0 = 1e9); these evaluations
+keep each root to the float spacing of the positions, and the radius is widened by a
+bound of that rounding (:func:`rounding_allowance`), so the intervals are never too
+short. The roots are polished by bisection to adjacent floats.
 """
 
 from __future__ import annotations
@@ -13,24 +22,64 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True, nogil=True)
-def _eval(c, deg, t):
-    r = 0.0
-    for k in range(deg, -1, -1):
-        r = r * t + c[k]
-    return r
+_ULP = 2.0**-52
 
 
 @njit(cache=True, nogil=True)
-def _bisect(c, deg, a, b, fa):
-    """A root of c in [a, b], where c is monotone and changes sign (fa = c(a))."""
+def relative_motion(ca, ma, cb, mb):
+    """``p`` of shape (3, 2): rows d0, dv, h of D(t) = d0 + dv t + h t², the centroid of
+    A relative to B's (``ma``, ``mb``: motion vectors ``[vx, vy, ax, ay, ω, α]``)."""
+    p = np.empty((3, 2))
+    for k in range(2):
+        p[0, k] = ca[k] - cb[k]
+        p[1, k] = ma[k] - mb[k]
+        p[2, k] = 0.5 * (ma[2 + k] - mb[2 + k])
+    return p
+
+
+@njit(cache=True, nogil=True)
+def degree(p):
+    """Degree of f = |D|² − R²: 4 with relative acceleration, 2 with relative velocity
+    only, else 0."""
+    if p[2, 0] != 0.0 or p[2, 1] != 0.0:
+        return 4
+    if p[1, 0] != 0.0 or p[1, 1] != 0.0:
+        return 2
+    return 0
+
+
+@njit(cache=True, nogil=True)
+def derivative(p, r, k, t):
+    """The k-th derivative of f(t) = |D(t)|² − r² at t for k >= 1, evaluated from D and
+    its derivatives (no expanded coefficients); for k = 0, |D(t)| − r, which has the
+    sign of f and is monotone where f is."""
+    dx = p[0, 0] + (p[1, 0] + p[2, 0] * t) * t
+    dy = p[0, 1] + (p[1, 1] + p[2, 1] * t) * t
+    d1x = p[1, 0] + 2.0 * p[2, 0] * t
+    d1y = p[1, 1] + 2.0 * p[2, 1] * t
+    d2x = 2.0 * p[2, 0]
+    d2y = 2.0 * p[2, 1]
+    if k == 0:
+        return np.hypot(dx, dy) - r
+    if k == 1:
+        return 2.0 * (dx * d1x + dy * d1y)
+    if k == 2:
+        return 2.0 * (d1x * d1x + d1y * d1y + dx * d2x + dy * d2y)
+    if k == 3:
+        return 6.0 * (d1x * d2x + d1y * d2y)
+    return 6.0 * (d2x * d2x + d2y * d2y)
+
+
+@njit(cache=True, nogil=True)
+def _bisect(p, r, k, a, b, fa):
+    """A root of the k-th :func:`derivative` in [a, b], where it is monotone and changes
+    sign (fa = its value at a), to adjacent floats."""
     neg = fa < 0.0
     for _ in range(2100):
         m = 0.5 * (a + b)
         if m <= a or m >= b:
             break
-        fm = _eval(c, deg, m)
+        fm = derivative(p, r, k, m)
         if fm == 0.0:
             return m
         if (fm < 0.0) == neg:
@@ -41,44 +90,32 @@ def _bisect(c, deg, a, b, fa):
 
 
 @njit(cache=True, nogil=True)
-def monotone_breakpoints(coeffs, lo, hi):
-    """Sorted points from lo to hi between which the polynomial is monotone.
-
-    ``coeffs`` are ascending (``coeffs[k]`` multiplies t**k), degree at most 4.
-    """
-    deg = coeffs.shape[0] - 1
-    while deg > 0 and coeffs[deg] == 0.0:
-        deg -= 1
-    # derivatives: ders[k] holds the k-th derivative, ascending coefficients
-    ders = np.zeros((deg + 1, deg + 1))
-    for i in range(deg + 1):
-        ders[0, i] = coeffs[i]
-    for k in range(1, deg + 1):
-        for i in range(deg + 1 - k):
-            ders[k, i] = ders[k - 1, i + 1] * (i + 1)
+def monotone_breakpoints(p, lo, hi):
+    """Sorted points from lo to hi between which f = |D|² − R² is monotone (``p`` from
+    :func:`relative_motion`)."""
+    deg = degree(p)
     pts = np.empty(deg + 2)
     pts[0] = lo
     pts[1] = hi
     npts = 2
-    # ders[deg - 1] is linear, hence monotone on [lo, hi]; walk down to ders[1]
+    # the (deg − 1)-th derivative is linear, hence monotone on [lo, hi]; walk down to f'
     for k in range(deg - 1, 0, -1):
-        dk = deg - k
         new = np.empty(deg + 2)
         new[0] = lo
         nn = 1
         for s in range(npts - 1):
             a = pts[s]
             b = pts[s + 1]
-            fa = _eval(ders[k], dk, a)
-            fb = _eval(ders[k], dk, b)
+            fa = derivative(p, 0.0, k, a)
+            fb = derivative(p, 0.0, k, b)
             if fa == 0.0:
-                r = a
+                x = a
             elif fb == 0.0 or (fa < 0.0) != (fb < 0.0):
-                r = b if fb == 0.0 else _bisect(ders[k], dk, a, b, fa)
+                x = b if fb == 0.0 else _bisect(p, 0.0, k, a, b, fa)
             else:
                 continue
-            if lo < r < hi and r > new[nn - 1]:
-                new[nn] = r
+            if lo < x < hi and x > new[nn - 1]:
+                new[nn] = x
                 nn += 1
         new[nn] = hi
         nn += 1
@@ -88,25 +125,22 @@ def monotone_breakpoints(coeffs, lo, hi):
 
 
 @njit(cache=True, nogil=True)
-def nonpositive_intervals(coeffs, lo, hi):
-    """Closed intervals of [lo, hi] where the polynomial is <= 0, merged, as (k, 2)."""
-    deg = coeffs.shape[0] - 1
-    while deg > 0 and coeffs[deg] == 0.0:
-        deg -= 1
-    pts = monotone_breakpoints(coeffs, lo, hi)
+def nonpositive_intervals(p, r, lo, hi):
+    """Closed intervals of [lo, hi] where |D(t)| <= r, merged, as (k, 2)."""
+    pts = monotone_breakpoints(p, lo, hi)
     out = np.empty((pts.shape[0], 2))
     n = 0
     for s in range(pts.shape[0] - 1):
         a = pts[s]
         b = pts[s + 1]
-        fa = _eval(coeffs, deg, a)
-        fb = _eval(coeffs, deg, b)
+        fa = derivative(p, r, 0, a)
+        fb = derivative(p, r, 0, b)
         if fa <= 0.0 and fb <= 0.0:
             x0, x1 = a, b
         elif fa <= 0.0:
-            x0, x1 = a, (a if fa == 0.0 else _bisect(coeffs, deg, a, b, fa))
+            x0, x1 = a, (a if fa == 0.0 else _bisect(p, r, 0, a, b, fa))
         elif fb <= 0.0:
-            x0, x1 = (b if fb == 0.0 else _bisect(coeffs, deg, a, b, fa)), b
+            x0, x1 = (b if fb == 0.0 else _bisect(p, r, 0, a, b, fa)), b
         else:
             continue
         if n > 0 and x0 <= out[n - 1, 1]:
@@ -119,28 +153,23 @@ def nonpositive_intervals(coeffs, lo, hi):
 
 
 @njit(cache=True, nogil=True)
-def circle_overlap_coefficients(ca, ma, ra, cb, mb, rb, inflate):
-    """Ascending coefficients of |c_A(t) − c_B(t)|² − (R (1 + inflate))², R = ra + rb.
-
-    ``ma``/``mb`` are motion vectors ``[vx, vy, ax, ay, ω, α]``.
-    """
-    c = np.zeros(5)
-    for k in range(2):
-        d0 = ca[k] - cb[k]
-        dv = ma[k] - mb[k]
-        h = 0.5 * (ma[2 + k] - mb[2 + k])
-        c[4] += h * h
-        c[3] += 2.0 * h * dv
-        c[2] += dv * dv + 2.0 * h * d0
-        c[1] += 2.0 * d0 * dv
-        c[0] += d0 * d0
-    r = (ra + rb) * (1.0 + inflate)
-    c[0] -= r * r
-    return c
+def rounding_allowance(ca, ma, cb, mb, t_max):
+    """A bound of the rounding in the centroids and in D(t) over [0, t_max]: 16 units of
+    2**-52 of the largest |term| of c_A(t) and c_B(t) (initial position, travel at the
+    initial speed, travel by the acceleration)."""
+    big = 0.0
+    for c, m in ((ca, ma), (cb, mb)):
+        for k in range(2):
+            big += abs(c[k]) + abs(m[k]) * t_max + 0.5 * abs(m[2 + k]) * t_max * t_max
+    return 16.0 * _ULP * big
 
 
 @njit(cache=True, nogil=True)
 def overlap_intervals(ca, ma, ra, cb, mb, rb, t_max, inflate):
-    """Closed sub-intervals of [0, t_max] where the bounding circles touch or overlap."""
-    c = circle_overlap_coefficients(ca, ma, ra, cb, mb, rb, inflate)
-    return nonpositive_intervals(c, 0.0, t_max)
+    """Closed sub-intervals of [0, t_max] where the bounding circles touch or overlap,
+    the sum of their radii R enlarged by ``inflate`` (relative), or by the rounding of
+    the positions (:func:`rounding_allowance`) where that is larger (far from the
+    origin, at long travel), so that no instant of overlap is dropped."""
+    big = ra + rb
+    r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, t_max))
+    return nonpositive_intervals(relative_motion(ca, ma, cb, mb), r, 0.0, t_max)

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .tolerance import tolerance_of
+
 
 @njit(cache=True, nogil=True)
 def _orient(ax, ay, bx, by, cx, cy):
@@ -18,14 +20,15 @@ def _orient(ax, ay, bx, by, cx, cy):
 
 
 @njit(cache=True, nogil=True)
-def convex_pieces(vxy, tri, rel_tol):
+def convex_pieces(vxy, tri, rel_tol, ulps):
     """Convex pieces covering the union of triangles.
 
     ``vxy`` (V, 2) float64 holds the vertices and ``tri`` (T, 3) int64 the triangles as
     vertex indices (either orientation). Two triangles are neighbours when they share
     an edge, i.e. two vertex indices. Triangles whose doubled area is at most ``eps``
-    times their longest edge are dropped (zero area), with
-    ``eps = rel_tol * max(1, largest |coordinate|)``. Returns ``(xy, starts)``: the
+    times their longest edge are dropped (zero area), with ``eps`` the default
+    tolerance of the vertices (:func:`polycontact._kernels.tolerance.tolerance_of`
+    with ``rel_tol`` and ``ulps``). Returns ``(xy, starts)``: the
     pieces packed like a shape's loops, each counter-clockwise, piece ``k`` in rows
     ``starts[k]:starts[k + 1]``. Vertices where two merged edges go straight on are
     removed.
@@ -34,7 +37,7 @@ def convex_pieces(vxy, tri, rel_tol):
     nv = vxy.shape[0]
     vx = vxy[:, 0]
     vy = vxy[:, 1]
-    eps = rel_tol * max(1.0, np.abs(vxy).max())
+    eps = tolerance_of(vxy, rel_tol, ulps)
     org = np.empty(3 * n_tri, np.int64)
     nxt = np.empty(3 * n_tri, np.int64)
     prv = np.empty(3 * n_tri, np.int64)
@@ -238,7 +241,7 @@ def ear_triangles(xy):
 
 
 @njit(cache=True, nogil=True)
-def ring_pieces(xy, rel_tol, max_ear):
+def ring_pieces(xy, rel_tol, ulps, max_ear):
     """Convex pieces of a simple CCW ring in one call: ``(ok, xy, starts)``.
 
     The ring itself when it is convex; else best-ear triangles merged by
@@ -250,6 +253,6 @@ def ring_pieces(xy, rel_tol, max_ear):
     if xy.shape[0] <= max_ear:
         ok, tri = ear_triangles(xy)
         if ok:
-            pxy, st = convex_pieces(xy, tri, rel_tol)
+            pxy, st = convex_pieces(xy, tri, rel_tol, ulps)
             return True, pxy, st
     return False, np.empty((0, 2)), np.zeros(1, np.int64)

@@ -8,6 +8,13 @@ see :mod:`polycontact._kernels`), its centroid at t = 0 ``c0`` and its motion ve
 
 Both searches visit only the broad-phase intervals (rows of ``intervals``).
 
+Tolerances are local to the time examined (:func:`local_tolerances`): the distance
+tolerance follows the bodies' size (``eps_rel``) and the float spacing of their
+coordinates at that time (``ulps`` times the largest |coordinate|), the contact
+resolution stays well above it, and the time tolerance is never finer than the float
+spacing of t (:func:`effective_time_tolerance`). Nothing depends on how far the search
+could go (``t_max``).
+
 Status codes returned by the searches (see :class:`polycontact.ImpactStatus`):
 0 no penetration in the window, 1 hit, 2 already penetrating at t = 0,
 3 iteration budget exhausted (no verdict).
@@ -30,6 +37,64 @@ INITIALLY_PENETRATING = 2
 OUT_OF_ITERATIONS = 3
 
 _PENETRATING = 2
+
+#: The contact resolution is at least this many distance tolerances: the pair steps
+#: hold pairs ``PAIR_GAP`` of it apart, and a touching pair's certificate (allowing
+#: ``eps`` behind an edge's line) is sound only while ``eps`` is well inside that gap
+#: (2 ``eps`` <= ``PAIR_GAP`` · λ): a vertex that slipped ``eps`` past a corner is then
+#: still a touching pair of both edges there.
+LAM_PER_EPS = 128.0
+
+#: The time tolerance is never below this many units of 2**-52 |t| (the float spacing
+#: of t is at most 2**-52 |t|): a probe of half of it moves t by at least one float.
+TIME_ULPS = 4.0
+
+_ULP = 2.0**-52
+_TINY = 2.2250738585072014e-308
+
+
+@njit(cache=True, nogil=True)
+def effective_time_tolerance(time_tol, t):
+    """The time tolerance used at time t: ``time_tol``, or what float64 resolves at t
+    (``TIME_ULPS`` · 2**-52 |t|) when that is larger.
+
+    >>> effective_time_tolerance(1e-4, 2.0), effective_time_tolerance(1e-300, 1.0) > 1e-16
+    (0.0001, True)
+    """
+    return max(time_tol, TIME_ULPS * _ULP * abs(t), _TINY)
+
+
+@njit(cache=True, nogil=True)
+def _reach(c0, m, radius, t0, t1):
+    """An upper bound of every |coordinate| of a body over [t0, t1]: its centroid's
+    largest |component| at either end plus the sag of the parabola (|a| h²/8), plus its
+    bounding radius."""
+    h = t1 - t0
+    out = 0.0
+    for k in range(2):
+        x0 = c0[k] + m[k] * t0 + 0.5 * m[2 + k] * t0 * t0
+        x1 = c0[k] + m[k] * t1 + 0.5 * m[2 + k] * t1 * t1
+        out = max(out, max(abs(x0), abs(x1)) + 0.125 * abs(m[2 + k]) * h * h)
+    return out + radius
+
+
+@njit(cache=True, nogil=True)
+def local_tolerances(ca, ma, la, cb, mb, lb, t0, t1, eps_rel, ulps, lam0):
+    """``(eps, lam)`` valid over [t0, t1]: the distance tolerance
+    ``max(eps_rel, ulps · M)``, M a bound of every |coordinate| of both bodies over the
+    window (as :func:`polycontact.tolerances.tolerance_for`), and the contact resolution
+    ``max(lam0, LAM_PER_EPS · eps)``.
+
+    >>> import numpy as np
+    >>> m = np.zeros(6)
+    >>> eps, lam = local_tolerances(np.array([1e9, 0]), m, 1.0, np.array([1e9 + 3, 0]), m,
+    ...                             1.0, 0.0, 1.0, 1e-12, 64 * 2.0**-52, 1e-6)
+    >>> round(eps / 1e-6, 2), lam == 128 * eps
+    (14.21, True)
+    """
+    mag = max(_reach(ca, ma, la, t0, t1), _reach(cb, mb, lb, t0, t1))
+    eps = max(eps_rel, ulps * mag)
+    return eps, max(lam0, LAM_PER_EPS * eps)
 
 
 @njit(cache=True, nogil=True)
@@ -211,15 +276,21 @@ def _search_scratch(ra, rb):
 
 
 @njit(cache=True, nogil=True)
-def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps, lam,
+def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps_rel, ulps, lam,
                  max_iter):
     """Continuous search for the first penetration (conservative advancement).
 
     Returns ``(status, t_hi, t_lo, first_contact, iterations, t_reached)``: on a hit the
-    bodies penetrate at ``t_hi`` and do not at ``t_lo`` (``t_hi − t_lo`` below
-    ``time_tol``; no penetration begins before ``t_lo``); ``first_contact`` is the first
-    visited time with boundary distance <= ``lam`` (−1 if none); ``t_reached`` is how
-    far the search got.
+    bodies penetrate at ``t_hi`` and do not at ``t_lo`` (``t_hi − t_lo`` below the
+    effective time tolerance at ``t_hi``, :func:`effective_time_tolerance`; no
+    penetration begins before ``t_lo``); ``first_contact`` is the first visited time
+    with boundary distance <= the contact resolution (−1 if none); ``t_reached`` is
+    how far the search got.
+
+    The distance tolerance and the contact resolution are local (:func:`local_tolerances`
+    from ``eps_rel``, ``ulps`` and ``lam``, the resolution asked for); the resolution
+    also covers the float spacing of t: a probe moves t by at least a float, so λ is at
+    least S · ``TIME_ULPS`` · 2**-52 |t|.
 
     Invariant: no penetration has been skipped before ``t`` (see
     :func:`polycontact.time_of_impact` for the argument). From a non-penetrating time
@@ -228,18 +299,18 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     - :func:`pair_step` gives a step h <= H during which no vertex–edge pair can
       meet (second-order bounds, see :mod:`polycontact._kernels.advance`), so the
       boundaries cannot meet and no penetration can start. After a step shorter than
-      ``time_tol`` or than ``GUESS_SHRINK`` times the one before, the bodies are
-      classified at ``t + h + 0.99 time_tol``: penetrating there is the hit, bracketed
+      the time tolerance or than ``GUESS_SHRINK`` times the one before, the bodies are
+      classified at ``t + h + 0.99 tol``: penetrating there is the hit, bracketed
       by (t + h, that time). If h is at least the probe
-      length ``tau = min(time_tol / 2, lam / S)`` it is taken. The pairs are held
+      length ``tau = lam / S`` it is taken. The pairs are held
       ``lam`` apart until the first contact (so that the first time found within
       ``lam`` is at most a probe late) and ``PAIR_GAP · lam`` apart after it, which
       leaves fewer probes to the hit: where the step to ``lam`` is shorter than tau
-      before the first contact, the step to ``PAIR_GAP · lam`` (at most
-      ``time_tol / 2``) is taken instead;
-    - otherwise the step is ``tau``: a penetration that begins and ends inside it lasts
-      less than ``time_tol / 2`` with no point moving more than ``lam`` relative to the
-      other body; any other penetration is still penetrating at ``t + tau``.
+      before the first contact, the step to ``PAIR_GAP · lam`` (at most ``tau``) is
+      taken instead;
+    - otherwise the step is ``tau``: a penetration that begins and ends inside it has
+      no point moving more than ``lam`` relative to the other body (it is shallower
+      than ``lam``); any other penetration is still penetrating at ``t + tau``.
 
     - after the first contact the steps hold touching pairs to their edges' turning
       lines (``touch = eps`` in :func:`pair_step`: no penetration beyond ``eps``
@@ -248,22 +319,32 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
       with one of them, up to ``eps``), so a sliding contact is followed by long
       steps, not by probes.
 
-    A penetrating state at the end of a probe is the hit, bracketed by the probe.
+    A penetrating state at the end of a probe is the hit: the probe brackets it, and
+    bisection (:func:`_narrow`) narrows the bracket to the time tolerance. The time
+    tolerance thus decides how precisely ``t_hi`` is reported, never whether a hit is
+    found, nor how many probes are taken.
     """
     return _prepared_exact_search(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
-                                  edge_table(rb, sb), intervals, time_tol, eps, lam, max_iter)
+                                  edge_table(rb, sb), intervals, time_tol, eps_rel, ulps, lam,
+                                  max_iter)
 
 
 @njit(cache=True, nogil=True)
 def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
-                           eps, lam, max_iter):
+                           eps_rel, ulps, lam, max_iter):
     """:func:`exact_search` with each body's :func:`edge_table` given (built once per
     shape by the caller)."""
     xa, xb, scratch = _search_scratch(ra, rb)
     stack, stau = traversal_stack()
     return _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
-                         eps, lam, max_iter, xa, xb, np.empty(2), np.empty(2),
+                         eps_rel, ulps, lam, max_iter, xa, xb, np.empty(2), np.empty(2),
                          np.full(3, -1, np.int64), stack, stau, scratch)
+
+
+@njit(cache=True, nogil=True)
+def _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
+    """The distance tolerance at time t (:func:`local_tolerances` on [t, t])."""
+    return max(eps_rel, ulps * max(_reach(ca, ma, la, t, t), _reach(cb, mb, lb, t, t)))
 
 
 # The searches run without Numba's reference counting (``_nrt=False``): each step passes
@@ -271,14 +352,13 @@ def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, inter
 # the geometry of a small pair. Nothing in them may allocate (the compiler refuses if it
 # does): their callers pass every buffer in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol, eps, lam,
-                  max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
+def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol, eps_rel,
+                  ulps, lam0, max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
     """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
     of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair; ``stack``,
     ``stau``: :func:`traversal_stack`). The bodies are placed (``xa``, ``xb``) only to be
     classified or for a slide: the steps read each vertex they need from the body
     frame."""
-    lam_pair = PAIR_GAP * lam
     first_contact = -1.0
     t_guess = -1.0
     h_prev = np.inf
@@ -291,7 +371,8 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
         pa[0], pa[1] = centre(ca, ma, t)
         pb[0], pb[1] = centre(cb, mb, t)
         # after t = 0 an interval opens with the bounding circles just touching: apart
-        if t == 0.0 and state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps,
+        if t == 0.0 and state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
+                                 _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
                                  scratch) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
@@ -301,6 +382,12 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
             t_end = min(t2, t + window)
             s = speed_bound(ma, la, mb, lb, t, t_end)
+            tol = effective_time_tolerance(time_tol, t)
+            # tolerances local to the window; a probe moves t by at least a float, which
+            # moves the points by up to s times that: the resolution covers it
+            eps, lam = local_tolerances(ca, ma, la, cb, mb, lb, t, t_end, eps_rel, ulps, lam0)
+            lam = max(lam, TIME_ULPS * _ULP * abs(t) * s)
+            lam_pair = PAIR_GAP * lam
             # until the first contact the pairs are stepped to lam, so that the first
             # time found within lam is at most a probe late; then closer
             # once touching, a touching pair is held to its edge's line instead (a slide
@@ -312,23 +399,26 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 first_contact = t
             if t >= t2 or s <= 0.0:
                 break  # at the end, or no relative motion: the state at t holds to t2
-            if (h < time_tol or h < GUESS_SHRINK * h_prev) and t + h >= t_guess:
+            if (h < tol or h < GUESS_SHRINK * h_prev) and t + h >= t_guess:
                 # no contact before t + h: a penetration (just under) a tolerance later
                 # brackets the first one in (t + h, t_guess], as finely as asked. Worth a
                 # classification when the step is short or shrinking fast (the pair
                 # bounds converge quadratically near contact), once per guess.
-                t_guess = min(t + h + 0.99 * time_tol, t2)
-                if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_guess, eps,
+                t_guess = min(t + h + 0.99 * effective_time_tolerance(time_tol, t + h), t2)
+                if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_guess,
+                            _eps_at(ca, ma, la, cb, mb, lb, t_guess, eps_rel, ulps),
                             scratch) == _PENETRATING:
                     return HIT, t_guess, t + h, first_contact if first_contact >= 0.0 else t + h, \
                         it, t_guess
             h_prev = h
-            tau = min(0.5 * time_tol, lam / s)
+            # the probe length follows the resolution, not the time tolerance: a
+            # penetrating probe end is narrowed to the tolerance by bisection
+            tau = min(lam / s, t_end - t)
             if h < tau and first_contact < 0.0:
-                # about to touch: step the pairs to lam_pair instead, at most
-                # time_tol / 2 at a time (so the first contact found is no later)
+                # about to touch: step the pairs to lam_pair instead, at most a probe
+                # at a time (so the first contact found is no later)
                 h = min(pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
-                                  stack, stau, 0.0)[1], 0.5 * time_tol)
+                                  stack, stau, 0.0)[1], tau)
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
                 # touching: a line through the touching features may separate them
                 place(ra, ca, ma, t, xa)
@@ -355,34 +445,59 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 continue
             pa[0], pa[1] = centre(ca, ma, t_new)
             pb[0], pb[1] = centre(cb, mb, t_new)
-            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new, eps,
+            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new,
+                        _eps_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
                         scratch) == _PENETRATING:
-                # the probe is the bracket: t_new − t = tau <= time_tol / 2, finer than
-                # asked, so no bisection
+                # the probe brackets the first penetration (no point moved more than
+                # lam in it); narrowed to the time tolerance by bisection
                 if first_contact < 0.0 or first_contact > t:
                     first_contact = t
-                return HIT, t_new, t, first_contact, it, t_new
+                lo, hi, it = _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, t, t_new,
+                                     time_tol, eps_rel, ulps, it, scratch)
+                return HIT, hi, lo, first_contact, it, hi
             t = t_new
     return NO_HIT, -1.0, -1.0, first_contact, it, t
 
 
+@njit(cache=True, nogil=True, _nrt=False)
+def _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, lo, hi, time_tol, eps_rel, ulps, it,
+            scratch):
+    """Bisect [lo, hi] (no penetration at lo, penetration at hi) until it is no longer
+    than the effective time tolerance at hi; ``(lo, hi, it)``, each classification
+    counted in ``it``."""
+    while hi - lo > effective_time_tolerance(time_tol, hi):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        it += 1
+        if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, mid,
+                    _eps_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps), scratch) == _PENETRATING:
+            hi = mid
+        else:
+            lo = mid
+    return lo, hi, it
+
+
 @njit(cache=True, nogil=True)
-def sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps):
+def sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n, eps_rel,
+                   ulps):
     """The paper's §3 steps 3–6 on each interval, literally.
 
     n time points t_1 = T1, ..., t_n = T2 (spacing (T2 − T1)/(n − 1)); t0 is the first
     penetrating one; the next interval is [t0 − (T2 − T1)/n, t0]; stop when
-    T2 − T1 < threshold and report T2. Returns ``(status, t_hi, t_lo, first_contact,
-    evaluations)``; ``first_contact`` is the earliest sample in contact (−1 if none).
+    T2 − T1 < threshold (or the interval is a single float) and report T2. Each sample
+    is classified with the distance tolerance at its time (:func:`local_tolerances`).
+    Returns ``(status, t_hi, t_lo, first_contact, evaluations)``; ``first_contact`` is
+    the earliest sample in contact (−1 if none).
     """
     xa, xb, scratch = _search_scratch(ra, rb)
-    return _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps, xa,
-                           xb, scratch)
+    return _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n,
+                           eps_rel, ulps, xa, xb, scratch)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps, xa, xb,
-                    scratch):
+def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n, eps_rel,
+                    ulps, xa, xb, scratch):
     """:func:`sampled_search` with its buffers passed in (see :func:`_exact_search`)."""
     first_contact = -1.0
     evals = 0
@@ -391,7 +506,9 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
         hi = intervals[k, 1]
         if lo == 0.0:
             evals += 1
-            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0, eps, scratch) == _PENETRATING:
+            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0,
+                        _eps_at(ca, ma, la, cb, mb, lb, 0.0, eps_rel, ulps),
+                        scratch) == _PENETRATING:
                 return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, evals
         found = False
         while True:
@@ -399,7 +516,8 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
             for i in range(n):
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
-                st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch)
+                st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
+                              _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), scratch)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
                     first_contact = t
                 if st == _PENETRATING:
@@ -411,7 +529,7 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
             length = hi - lo
             lo = max(t0 - length / n, 0.0)
             hi = t0
-            if hi - lo < threshold:
+            if hi - lo < threshold or hi - lo <= TIME_ULPS * _ULP * hi:
                 break
         if found:
             return HIT, hi, lo, first_contact, evals
@@ -419,24 +537,25 @@ def _sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, intervals, threshold, n, eps
 
 
 @njit(cache=True, nogil=True)
-def exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, time_tol, eps,
-                lam, max_iter):
+def exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, time_tol,
+                eps_rel, ulps, lam, max_iter):
     """Broad phase and :func:`exact_search` in one call (one dispatch from Python), with
     each body's :func:`edge_table` given. Returns ``(intervals, status, t_hi, t_lo,
     first_contact, iterations, t_reached)``."""
     iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
     code, hi, lo, contact, its, reached = _prepared_exact_search(
-        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps, lam, max_iter)
+        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps_rel, ulps, lam,
+        max_iter)
     return iv, code, hi, lo, contact, its, reached
 
 
 @njit(cache=True, nogil=True)
-def sampled_query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, time_tol, eps,
-                  samples):
+def sampled_query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, time_tol, eps_rel,
+                  ulps, samples):
     """Broad phase and :func:`sampled_search` with ``samples`` points in one call; returns
     what :func:`exact_query` does (``iterations``: the classifications; ``t_reached``:
     t_hi on a hit, else t_max)."""
     iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
-    code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, rb, sb, cb, mb, iv, time_tol,
-                                                samples, eps)
+    code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, iv,
+                                                time_tol, samples, eps_rel, ulps)
     return iv, code, hi, lo, contact, its, hi if code == HIT else t_max

@@ -14,6 +14,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .tolerance import tolerance_of
+
 
 @njit(cache=True, nogil=True)
 def _lowest(xy, s, e):
@@ -603,11 +605,12 @@ def _ring_stats(xy, starts):
 
 
 @njit(cache=True, nogil=True)
-def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
+def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     """Everything the no-fit polygon needs, in one call (few arrays: boxing costs).
 
     ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
-    ``a0 − A``. ``eps <= 0`` means ``rel_tol * max(1, largest |coordinate| of the sums)``.
+    ``a0 − A``. ``eps <= 0`` means the default tolerance of the sums' coordinates
+    (:func:`polycontact._kernels.tolerance.tolerance_of` with ``rel_tol`` and ``ulps``).
     Returns ``(ring_xy, ring_starts, ring_stats, candidates, meta)``: the outline's
     rings, closed (each ends with its first point); their signed area and length
     (R, 2); candidate exact fits then candidate slides as segments (C, 4), an exact
@@ -617,7 +620,7 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ang_tol):
     """
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
     if eps <= 0.0:
-        eps = rel_tol * max(1.0, np.abs(sums).max())
+        eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])
     if starts.shape[0] == 2:
         rs = np.array([0, sums.shape[0]], np.int64)

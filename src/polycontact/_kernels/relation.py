@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .tolerance import box_extent_magnitude, tolerance_for
 from .validate import _orient, _point_segment_distance, closest_on_segment, segment_meet
 
 SEPARATE = 0
@@ -217,7 +218,7 @@ def _cones_overlap(
     If ``swept``, the edge rows are ordered by ``order`` (xmin ascending; ``maxw`` the
     widest edge) and only the rows near p are read; otherwise every row is read.
     ``rays`` (at least 2 cnt rows of 6) and ``rord`` (as many ints) are scratch: rows
-    ``(pseudo-angle, edge length, opening, of A, unit direction)``, and their order.
+    ``(pseudo-angle, length of the edge left from p, opening, of A, unit direction)``, and their order.
     """
     lo = 0
     if swept:
@@ -251,12 +252,14 @@ def _cones_overlap(
             continue
         ex = (wx - ux) / le
         ey = (wy - uy) / le
+        # Each ray's length is what is left of the edge from p: the sliver test below
+        # measures how far apart two rays get before one of them ends.
         if du > eps or dw <= eps:  # ray from p (or from w) back along the edge
             if not (du <= eps and dw <= eps):
-                _put_ray(rays, r, -ex, -ey, le, flip < 0.0, a_side)
+                _put_ray(rays, r, -ex, -ey, du, flip < 0.0, a_side)
                 r += 1
         if dw > eps:  # ray from p (or from u) forward along the edge
-            _put_ray(rays, r, ex, ey, le, flip > 0.0, a_side)
+            _put_ray(rays, r, ex, ey, dw, flip > 0.0, a_side)
             r += 1
     if r == 0:
         return False
@@ -718,8 +721,9 @@ def _star_ring_is_simple(xy, n, eps):
     h_min · sin(min(γ_min, π/2)) apart, γ_min the narrowest wedge. When that exceeds
     ``2 eps`` no two such edges meet within eps and no two consecutive edges fold back,
     which is all :func:`_ring_is_simple` checks. The margin dwarfs the rounding of c,
-    the u_i and the products (relative 1e-16 against eps >= 1e-12 of the scale), so a
-    certified ring is simple by the exact predicate too.
+    the u_i and the products (a few ulps of the coordinates, against eps >= 1e-12 of
+    the extent and >= 64 ulps of the largest coordinate), so a certified ring is simple
+    by the exact predicate too.
     """
     cx = 0.0
     cy = 0.0
@@ -870,47 +874,54 @@ def _sorted_edge_boxes(xy, n):
 
 
 @njit(cache=True, nogil=True)
-def _raw_ring(xy, rel):
-    """Check one raw (N, 2) ring; returns ``(n, sign, scale, box)``.
+def _raw_ring(xy, rel, ulps, limit, floor):
+    """Check one raw (N, 2) ring; returns ``(n, sign, eps, box)``.
 
     ``n`` is the number of vertices used (a repeated closing point dropped), or -1 when
-    the ring is not a valid simple polygon as given (the caller then lets
-    :class:`polycontact.Shape` explain or repair); ``sign`` is +1.0 counter-clockwise,
-    -1.0 clockwise; ``scale`` the largest absolute coordinate (at least 1); ``box`` the
-    bounding box ``(xmin, xmax, ymin, ymax)``.
+    the ring is not a valid simple polygon as given, or lies outside the range the
+    kernels carry (|coordinate| above ``limit``, extent below ``floor``; the caller then
+    lets :class:`polycontact.Shape` explain or repair); ``sign`` is +1.0
+    counter-clockwise, -1.0 clockwise; ``eps`` the ring's own default tolerance
+    (:func:`polycontact._kernels.tolerance.tolerance_for` of its extent and largest
+    |coordinate|, with ``rel`` and ``ulps``); ``box`` the bounding box
+    ``(xmin, xmax, ymin, ymax)``.
     """
-    n, sign, scale, box = _ring_summary(xy, rel)
-    if n > 0 and not _ring_is_simple(xy, n, rel * scale):
-        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
-    return n, sign, scale, box
+    n, sign, eps, box = _ring_summary(xy, rel, ulps, limit, floor)
+    if n > 0 and not _ring_is_simple(xy, n, eps):
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    return n, sign, eps, box
 
 
 @njit(cache=True, nogil=True)
-def _ring_summary(xy, rel):
+def _ring_summary(xy, rel, ulps, limit, floor):
     """:func:`_raw_ring` but for the simplicity check (left to the caller)."""
     n = xy.shape[0]
     if xy.shape[1] != 2:
-        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
     if n >= 2 and xy[n - 1, 0] == xy[0, 0] and xy[n - 1, 1] == xy[0, 1]:
         n -= 1
     if n < 3:
-        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
-    # One pass: finiteness, scale, bounding box and twice the signed area (taken
-    # relative to the first vertex, so a small ring far from the origin keeps its digits).
-    x0 = np.inf
-    x1 = -np.inf
-    y0 = np.inf
-    y1 = -np.inf
-    a2 = 0.0
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    # One pass: range (which also refuses NaN and infinities), bounding box and twice
+    # the signed area (taken relative to the first vertex, so a small ring far from the
+    # origin keeps its digits; the two terms at vertex 0 are zero). A vertex is checked
+    # before it enters a product, so nothing overflows on the way to a refusal.
     ox = xy[0, 0]
     oy = xy[0, 1]
-    jx = xy[n - 1, 0]
-    jy = xy[n - 1, 1]
-    for i in range(n):
+    if not (abs(ox) <= limit and abs(oy) <= limit):
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    x0 = ox
+    x1 = ox
+    y0 = oy
+    y1 = oy
+    a2 = 0.0
+    jx = ox
+    jy = oy
+    for i in range(1, n):
         x = xy[i, 0]
         y = xy[i, 1]
-        if not (abs(x) < np.inf and abs(y) < np.inf):
-            return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
+        if not (abs(x) <= limit and abs(y) <= limit):
+            return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
         x0 = min(x0, x)
         x1 = max(x1, x)
         y0 = min(y0, y)
@@ -918,28 +929,43 @@ def _ring_summary(xy, rel):
         a2 += (jx - ox) * (y - oy) - (x - ox) * (jy - oy)
         jx = x
         jy = y
-    scale = max(1.0, -x0, x1, -y0, y1)
-    eps = rel * scale
-    if abs(0.5 * a2) <= eps * max(max(x1 - x0, y1 - y0), 1.0):
-        return -1, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
-    return n, (1.0 if a2 > 0.0 else -1.0), scale, (x0, x1, y0, y1)
+    extent, magnitude = box_extent_magnitude(x0, x1, y0, y1)
+    if extent < floor:
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    eps = tolerance_for(extent, magnitude, rel, ulps)
+    # An area compared with an area: eps times the ring's extent.
+    if abs(0.5 * a2) <= eps * extent:
+        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    return n, (1.0 if a2 > 0.0 else -1.0), eps, (x0, x1, y0, y1)
 
 
 @njit(cache=True, nogil=True)
-def classify_raw(a, b, tol, rel):
+def pair_tolerance(ba, bb, rel, ulps):
+    """The default tolerance of two bodies from their bounding boxes ``(xmin, xmax,
+    ymin, ymax)``: the larger extent, the largest |coordinate| (as
+    :func:`polycontact.default_tolerance`)."""
+    ea, ma = box_extent_magnitude(ba[0], ba[1], ba[2], ba[3])
+    eb, mb = box_extent_magnitude(bb[0], bb[1], bb[2], bb[3])
+    return tolerance_for(max(ea, eb), max(ma, mb), rel, ulps)
+
+
+@njit(cache=True, nogil=True)
+def classify_raw(a, b, tol, rel, ulps, limit, floor):
     """Validate two raw outer rings and classify them in one call.
 
     Returns ``(state, eps, na, sign_a, nb, sign_b)``; ``state`` is -1 when ring A is not
     valid as given and -2 when ring B is not (the caller re-raises through ``Shape``).
-    ``tol`` < 0 means the default tolerance ``rel`` × the largest coordinate.
+    ``tol`` < 0 means the default tolerance (:func:`pair_tolerance` with ``rel`` and
+    ``ulps``); ``limit`` and ``floor`` bound the coordinates and extents accepted (see
+    :func:`_raw_ring`).
     """
-    na, fa, sca, _ = _raw_ring(a, rel)
+    na, fa, _, ba = _raw_ring(a, rel, ulps, limit, floor)
     if na < 0:
         return -1, 0.0, na, fa, 0, 1.0
-    nb, fb, scb, _ = _raw_ring(b, rel)
+    nb, fb, _, bb = _raw_ring(b, rel, ulps, limit, floor)
     if nb < 0:
         return -2, 0.0, na, fa, nb, fb
-    eps = tol if tol >= 0.0 else rel * max(sca, scb)
+    eps = tol if tol >= 0.0 else pair_tolerance(ba, bb, rel, ulps)
     sa = np.empty(2, np.int64)
     sa[0] = 0
     sa[1] = na

@@ -26,18 +26,23 @@ from .relation import (
     _scratch,
     _state_in,
     closest_pair,
+    pair_tolerance,
     penetration,
 )
+from .tolerance import extent_magnitude, tolerance_for
 
 
 @njit(cache=True, nogil=True)
-def check_rings(xy, lo, n, rel):
-    """Validate raw rings ``xy[lo[p]:lo[p] + n[p]]``; returns (vertices used or -1, sign)."""
+def check_rings(xy, lo, n, rel, ulps, limit, floor):
+    """Validate raw rings ``xy[lo[p]:lo[p] + n[p]]``; returns (vertices used or -1, sign).
+
+    ``rel``, ``ulps``, ``limit``, ``floor``: as for
+    :func:`polycontact._kernels.relation._raw_ring`."""
     p_count = lo.shape[0]
     used = np.empty(p_count, np.int64)
     sign = np.empty(p_count)
     for p in range(p_count):
-        u, s, _, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel)
+        u, s, _, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel, ulps, limit, floor)
         used[p] = u
         sign[p] = s
     return used, sign
@@ -54,7 +59,7 @@ def raw_states_outputs(p_count):
             np.empty(p_count), np.empty(p_count, np.int64), np.empty(p_count))
 
 
-def raw_states(xa, xb, tol, rel, out=None):
+def raw_states(xa, xb, tol, rel, ulps, limit, floor, out=None):
     """Validate and classify P pairs of raw outer rings, ``xa`` (P, N, 2) against
     ``xb`` (P, M, 2), in one pass over the pairs.
 
@@ -62,7 +67,9 @@ def raw_states(xa, xb, tol, rel, out=None):
     (int8; -1 when either ring is not valid as given), the tolerance, and per ring
     the vertices used (a repeated closing point dropped; -1 if invalid) and the
     orientation sign (see :func:`polycontact._kernels.relation._raw_ring`).
-    ``tol`` < 0 means per pair ``rel`` × the largest absolute coordinate of the pair.
+    ``tol`` < 0 means per pair the default tolerance
+    (:func:`polycontact._kernels.relation.pair_tolerance` with ``rel`` and ``ulps``);
+    ``limit`` and ``floor`` bound the coordinates and extents accepted.
 
     The pass itself (:func:`_raw_states_into`) allocates nothing; the few pairs it
     leaves undecided (long rings that need a sorted sweep) are finished by
@@ -73,20 +80,20 @@ def raw_states(xa, xb, tol, rel, out=None):
         out = raw_states_outputs(xa.shape[0])
     scratch = (*_scratch(xa.shape[1] + xb.shape[1]), np.zeros(2, np.int64),
                np.zeros(2, np.int64))
-    if _raw_states_into(xa, xb, tol, rel, *out, *scratch):
-        _finish_undecided(xa, xb, tol, rel, *out, *scratch)
+    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch):
+        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _finish_undecided(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sign_b, box, ids,
-                      touch, rays, rord, sa, sb):
+def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
+                      used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
     """Validate (with the sorted sweep) and classify the pairs marked ``_UNDECIDED``."""
     for p in range(xa.shape[0]):
         if states[p] != _UNDECIDED:
             continue
-        na, fa, sca, ba = _raw_ring(xa[p], rel)
-        nb, fb, scb, bb = _raw_ring(xb[p], rel)
+        na, fa, _, ba = _raw_ring(xa[p], rel, ulps, limit, floor)
+        nb, fb, _, bb = _raw_ring(xb[p], rel, ulps, limit, floor)
         used_a[p] = na
         used_b[p] = nb
         sign_a[p] = fa
@@ -94,8 +101,8 @@ def _finish_undecided(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sig
         if na < 0 or nb < 0:
             states[p] = -1
             continue
-        states[p], eps[p] = _pair_state(xa[p], na, fa, sca, ba, xb[p], nb, fb, scb, bb, tol,
-                                        rel, sa, sb, box, ids, touch, rays, rord)
+        states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel, ulps,
+                                        sa, sb, box, ids, touch, rays, rord)
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the pass creates a view
@@ -103,16 +110,16 @@ def _finish_undecided(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sig
 # updates of those cost about as much as classifying a pair of 12-gons (measured 0.27
 # against 0.16 us per pair). Nothing in it may allocate (the compiler refuses if it does).
 @njit(cache=True, nogil=True, _nrt=False)
-def _raw_states_into(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sign_b, box, ids,
-                     touch, rays, rord, sa, sb):
+def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
+                     used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
     """:func:`raw_states`' pass over the pairs, into its arrays; a pair with a ring that
     needs the sorted sweep is marked ``_UNDECIDED`` (returns whether any is)."""
     undecided = False
     for p in range(xa.shape[0]):
-        na, fa, sca, ba = _ring_summary(xa[p], rel)
-        nb, fb, scb, bb = _ring_summary(xb[p], rel)
-        ka = _ring_is_simple_unswept(xa[p], na, rel * sca) if na > 0 else 0
-        kb = _ring_is_simple_unswept(xb[p], nb, rel * scb) if nb > 0 else 0
+        na, fa, ea, ba = _ring_summary(xa[p], rel, ulps, limit, floor)
+        nb, fb, eb, bb = _ring_summary(xb[p], rel, ulps, limit, floor)
+        ka = _ring_is_simple_unswept(xa[p], na, ea) if na > 0 else 0
+        kb = _ring_is_simple_unswept(xb[p], nb, eb) if nb > 0 else 0
         used_a[p] = na if ka != 0 else -1
         used_b[p] = nb if kb != 0 else -1
         sign_a[p] = fa if ka != 0 else 1.0     # as _raw_ring gives for an invalid ring
@@ -123,16 +130,16 @@ def _raw_states_into(xa, xb, tol, rel, states, eps, used_a, sign_a, used_b, sign
             states[p] = _UNDECIDED
             undecided = True
         else:
-            states[p], eps[p] = _pair_state(xa[p], na, fa, sca, ba, xb[p], nb, fb, scb, bb,
-                                            tol, rel, sa, sb, box, ids, touch, rays, rord)
+            states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel,
+                                            ulps, sa, sb, box, ids, touch, rays, rord)
     return undecided
 
 
 @njit(cache=True, nogil=True)
-def _pair_state(ya, na, fa, sca, ba, yb, nb, fb, scb, bb, tol, rel, sa, sb, box, ids, touch,
+def _pair_state(ya, na, fa, ba, yb, nb, fb, bb, tol, rel, ulps, sa, sb, box, ids, touch,
                 rays, rord):
     """``(state, eps)`` of two valid raw rings (their :func:`_ring_summary` values)."""
-    e = tol if tol >= 0.0 else rel * max(sca, scb)
+    e = tol if tol >= 0.0 else pair_tolerance(ba, bb, rel, ulps)
     if ba[0] > bb[1] + e or bb[0] > ba[1] + e or ba[2] > bb[3] + e or bb[2] > ba[3] + e:
         return SEPARATE, e  # boxes apart: no call into the state kernel
     sa[1] = na
@@ -169,18 +176,12 @@ def _largest(ls, bs):
 
 
 @njit(cache=True, nogil=True)
-def _scale(xy):
-    s = 1.0
-    for i in range(xy.shape[0]):
-        s = max(s, abs(xy[i, 0]), abs(xy[i, 1]))
-    return s
-
-
-@njit(cache=True, nogil=True)
-def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
+def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel, ulps):
     """States (int8: 0 separate, 1 contact, 2 penetrating) and tolerances of P pairs.
 
-    ``tol`` < 0 means per pair ``rel`` × the largest absolute coordinate of the pair.
+    ``tol`` < 0 means per pair the default tolerance of the two bodies
+    (:func:`polycontact._kernels.tolerance.tolerance_for` of the larger extent and the
+    largest |coordinate|, with ``rel`` and ``ulps``).
     """
     p_count = bsa.shape[0] - 1
     states = np.empty(p_count, np.int8)
@@ -193,7 +194,12 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel):
     for p in range(p_count):
         ya, sa = _body_into(xa, lsa, bsa, p, buf_a)
         yb, sb = _body_into(xb, lsb, bsb, p, buf_b)
-        e = tol if tol >= 0.0 else rel * max(_scale(ya), _scale(yb))
+        if tol >= 0.0:
+            e = tol
+        else:
+            ea, ma = extent_magnitude(ya)
+            eb, mb = extent_magnitude(yb)
+            e = tolerance_for(max(ea, eb), max(ma, mb), rel, ulps)
         eps[p] = e
         states[p] = _state_in(ya, sa, fa[p], yb, sb, fb[p], e, box, ids, touch, rays, rord)
     return states, eps

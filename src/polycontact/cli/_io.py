@@ -42,7 +42,7 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
                 f"{path}: expected a body with 'vertices' or a GeoJSON Polygon"
             )
         return Shape.from_wkt(text, repair=repair)
-    except InvalidShapeError as exc:
+    except (InvalidShapeError, TypeError) as exc:  # TypeError: coordinates not numbers
         raise CommandError(f"{path}: {exc}") from None
 
 

@@ -22,7 +22,8 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("b", metavar="B.json", help="second body (B)")
     p.add_argument("--tolerance", type=non_negative_number, default=None, metavar="T",
                    help="absolute distance that counts as touching "
-                   "(default 1e-12 × the largest coordinate, at least 1e-12)")
+                   "(default max(1e-12 × the larger body's extent, 64 float spacings of "
+                   "the largest |coordinate|))")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
     p.add_argument("--json", action="store_true", help="print one JSON object")

@@ -73,6 +73,7 @@ def report(body_a: Any, body_b: Any, impact: Any) -> dict:
         "status": impact.status.value,
         "pair": [body_a.name, body_b.name],
         "time_bracket": None if impact.time_bracket is None else list(impact.time_bracket),
+        "time_tolerance": impact.time_tolerance,
         "iterations": impact.iterations,
     }
 

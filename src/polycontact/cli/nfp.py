@@ -42,8 +42,8 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("--inner", action="store_true",
                    help="the inner-fit polygon instead: where A lies inside B")
     p.add_argument("--tolerance", type=positive_number, default=None, metavar="T",
-                   help="absolute distance tolerance (default 1e-12 × the largest "
-                   "coordinate, at least 1e-12)")
+                   help="absolute distance tolerance (default max(1e-12 × the extent, "
+                   "64 float spacings of the largest |coordinate|) of the sums)")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
     out = p.add_mutually_exclusive_group()

@@ -123,17 +123,18 @@ def _union(ax: Any, block: Any) -> None:
 
 def _reference(ax: Any, block: Any) -> list[Any]:
     x, y = block.reference
-    return ax.plot([x], [y], marker="o", color="crimson", markeredgecolor="black",
+    handles: list[Any] = ax.plot([x], [y], marker="o", color="crimson", markeredgecolor="black",
                    markersize=7, linestyle="none", zorder=5,
                    label=f"reference point a0 ({x:.4g}, {y:.4g})")
+    return handles
 
 
 def _legend_handles(reference: list[Any]) -> list[Any]:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    handles = [Patch(facecolor=c, edgecolor=c, alpha=0.4, label=t.split(":")[0])
-               for c, t in FAMILY_STYLE.values()]
+    handles: list[Any] = [Patch(facecolor=c, edgecolor=c, alpha=0.4, label=t.split(":")[0])
+                          for c, t in FAMILY_STYLE.values()]
     handles += [
         Patch(facecolor="tab:red", alpha=0.3, label="E(A, B)"),
         Line2D([], [], color="black", linewidth=1.8, label="outline of E(A, B) = no-fit polygon"),

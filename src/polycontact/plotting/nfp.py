@@ -18,13 +18,13 @@ def _patch(geom: Any, **style: Any) -> Any:
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
 
-    verts = []
-    codes = []
+    verts: list[np.ndarray] = []
+    codes: list[int] = []
     for poly in shapely.get_parts(shapely.orient_polygons(geom)):
         for ring in (poly.exterior, *poly.interiors):
             xy = np.asarray(ring.coords)[:, :2]
             verts.extend(xy)
-            codes.extend([Path.MOVETO] + [Path.LINETO] * (len(xy) - 2) + [Path.CLOSEPOLY])
+            codes.extend(int(c) for c in [Path.MOVETO, *[Path.LINETO] * (len(xy) - 2), Path.CLOSEPOLY])
     return PathPatch(Path(np.asarray(verts), codes), **style)
 
 

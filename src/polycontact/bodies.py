@@ -1,0 +1,149 @@
+"""One way in: every form a body may take, turned into a :class:`~polycontact.Shape`.
+
+Everywhere polycontact takes a body (the functions, :class:`Shape` itself,
+``classify_many``, scenes, the command line) it accepts the same forms:
+
+- a :class:`Shape` (used as it is);
+- an array-like of shape (N, 2): the outer loop, closed or not, either orientation;
+- a Shapely ``Polygon`` (or a ``MultiPolygon`` of exactly one part);
+- anything with ``__geo_interface__`` (GeoPandas, other geometry libraries);
+- a GeoJSON mapping: ``Polygon``, a ``MultiPolygon`` of one part, or a ``Feature``
+  holding one;
+- a body mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
+  ``"name"`` is ignored), the scene files' form;
+- WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
+  above, or WKB bytes.
+
+A value of another type raises ``TypeError``; a value of an accepted type that is not a
+valid polygon raises :class:`~polycontact.InvalidShapeError` (a ``ValueError``). Both
+name the argument.
+
+Examples
+--------
+>>> import shapely
+>>> from polycontact.bodies import as_shape
+>>> forms = [
+...     [(0, 0), (1, 0), (1, 1), (0, 1)],
+...     shapely.box(0, 0, 1, 1),
+...     {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]},
+...     {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+...     "POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))",
+...     shapely.box(0, 0, 1, 1).wkb,
+... ]
+>>> [as_shape(f).area for f in forms]
+[1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+>>> as_shape(3, "a")
+Traceback (most recent call last):
+...
+TypeError: a: expected a body (Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB), got int
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidShapeError
+from .shape import Shape
+
+__all__ = ["as_shape", "BODY_FORMS"]
+
+#: The forms a body may take, as error messages list them.
+BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+
+_BODY_KEYS = {"vertices", "holes", "name"}
+
+
+def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever accepted form it takes (see the module).
+
+    Parameters
+    ----------
+    obj : body
+        One of the forms listed in the module docstring.
+    what : str
+        The argument's name, put at the start of every error message.
+    repair : bool, default False
+        Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
+
+    Returns
+    -------
+    Shape
+        ``obj`` itself when it is already a Shape.
+
+    Raises
+    ------
+    TypeError
+        ``obj`` is of no accepted type.
+    InvalidShapeError
+        ``obj`` is of an accepted type but not a valid polygon.
+    """
+    if isinstance(obj, Shape):
+        return obj
+    try:
+        return _coerce(obj, repair)
+    except InvalidShapeError as exc:
+        raise InvalidShapeError(f"{what}: {exc}") from None
+    except TypeError as exc:
+        raise TypeError(f"{what}: {exc}") from None
+
+
+def _coerce(obj: Any, repair: bool) -> Shape:
+    if isinstance(obj, (bytes, bytearray, memoryview)):
+        return Shape.from_shapely(_from_wkb(bytes(obj)), repair=repair)
+    if isinstance(obj, str):
+        return _from_text(obj, repair)
+    if hasattr(obj, "geom_type") and hasattr(obj, "wkb"):  # a shapely geometry
+        return Shape.from_shapely(obj, repair=repair)
+    if isinstance(obj, Mapping):
+        return _from_mapping(obj, repair)
+    geo = getattr(obj, "__geo_interface__", None)
+    if isinstance(geo, Mapping):
+        return _from_mapping(geo, repair)
+    if isinstance(obj, (np.ndarray, list, tuple)):
+        return Shape(obj, repair=repair)
+    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+
+
+def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
+    if "vertices" in data:
+        unknown = sorted(set(data) - _BODY_KEYS)
+        if unknown:
+            raise InvalidShapeError(
+                f"body mapping: unknown key {unknown[0]!r} (expected 'vertices', 'holes')"
+            )
+        holes = data.get("holes", ())
+        if holes is None or isinstance(holes, (str, bytes, Mapping)):
+            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+        return Shape(data["vertices"], holes, repair=repair)
+    if "type" in data:
+        return Shape.from_geojson(dict(data), repair=repair)
+    raise InvalidShapeError(
+        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        f"got keys {sorted(map(str, data))}"
+    )
+
+
+def _from_text(text: str, repair: bool) -> Shape:
+    stripped = text.lstrip()
+    if stripped.startswith("{"):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InvalidShapeError(f"not valid JSON ({exc})") from None
+        if not isinstance(data, Mapping):
+            raise InvalidShapeError("JSON text: expected an object")
+        return _from_mapping(data, repair)
+    return Shape.from_wkt(text, repair=repair)
+
+
+def _from_wkb(data: bytes) -> Any:
+    import shapely
+
+    try:
+        return shapely.from_wkb(data)
+    except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
+        raise InvalidShapeError(f"not valid WKB ({exc})") from None
