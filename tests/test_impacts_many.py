@@ -23,8 +23,8 @@ from profiles import examples
 import polycontact as pc
 from polycontact import ImpactStatus, InvalidShapeError, Motion, Shape
 from polycontact._kernels.swept import swept_boxes
-from polycontact.broad_phase import intervals_array
-from polycontact.impacts import (MAX_SLICES, SWEPT_MARGIN, candidate_pairs, event_time,
+from polycontact.broad_phase import BROAD_PHASE_INFLATION, intervals_array
+from polycontact.impacts import (MAX_SLICES, SWEPT_ROUNDING_ULPS, candidate_pairs, event_time,
                                  first_impact, first_impacts, time_of_impact_many)
 
 SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
@@ -184,7 +184,8 @@ def test_time_of_impact_many_empty_and_arrays_untouched():
      ValueError, "samples"),
     (lambda: first_impacts([SQ, SQ, SQ], [Motion()] * 2, 1),
      ValueError, r"motions: expected 3 motions \(one per shape of shapes\), got 2"),
-    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), InvalidShapeError, r"shapes\[1\]: "),
+    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), TypeError,
+     r"shapes\[1\]: outer loop: expected an array of real numbers, got str"),
     (lambda: first_impacts([SQ, SQ], [Motion(), None], 1), TypeError, r"motions\[1\]: "),
     (lambda: first_impacts([SQ, SQ], [Motion()] * 2, math.nan), ValueError, "t_max"),
     (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1).impact(1),
@@ -302,7 +303,8 @@ def test_swept_boxes_hold_each_bounding_circle_at_every_time(swarm, frac):
     cent = np.array([s.centroid for s in shapes])
     m = np.array([mo.array for mo in moves])
     rad = np.array([s.bounding_radius for s in shapes])
-    boxes, owner = swept_boxes(cent, m, rad, t_max, MAX_SLICES, SWEPT_MARGIN)
+    boxes, owner = swept_boxes(cent, m, rad, t_max, MAX_SLICES, BROAD_PHASE_INFLATION,
+                               SWEPT_ROUNDING_ULPS * 2.0**-52)
     t = frac * t_max
     for k, (s, mo) in enumerate(zip(shapes, moves)):
         translation, _ = mo.pose(t)
@@ -324,12 +326,40 @@ def test_swept_bounds_keep_a_grazing_pass_and_drop_far_pairs():
     assert pairs.tolist() == [[0, 1]]
 
 
-def test_swept_bounds_keep_pairs_whose_paths_overflow_float64():
-    # v t and a t²/2 overflow to +inf and -inf: their sum is NaN, the box the whole plane
-    wild = Motion(velocity=(1e300, 0), acceleration=(-1e300, 0))
-    pairs = candidate_pairs([SQ, SQ.moved((50, 0)), SQ.moved((0, 1e6))],
-                            [wild, Motion(), Motion()], 1e10)
-    assert pairs.tolist() == [[0, 1], [0, 2]]
+def test_swept_bounds_far_from_the_origin_grow_by_the_float_spacing():
+    # unit squares at 1e9, 10 apart, at rest: the boxes are grown by the rounding of
+    # positions there (~3e-5), as the pairwise broad phase is, not by a fraction of the
+    # offset (1e-6 of it made every body within 1e3 a candidate)
+    far = [SQ.moved((1e9 + 10.0 * k, -1e9)) for k in range(3)]
+    assert candidate_pairs(far, [Motion()] * 3, 1e3).tolist() == []
+    # ...and a grazing pass there is kept (circles of radius sqrt(1/2), sqrt(2) apart
+    # as a passes b: the pairwise broad phase sees them meet)
+    a = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]).moved((1e9, 1e9))
+    pair = [a, a.moved((5, math.sqrt(2)))]
+    moves = [Motion(velocity=(1, 0)), Motion()]
+    assert len(intervals_array(pair[0], moves[0], pair[1], moves[1], 10.0))
+    assert candidate_pairs(pair, moves, 10.0).tolist() == [[0, 1]]
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda: candidate_pairs([SQ, SQ.moved((50, 0))],
+                             [Motion(velocity=(1e300, 0), acceleration=(-1e300, 0)), Motion()],
+                             1e10), ValueError, r"motions\[0\]: the body's coordinates reach"),
+    (lambda: first_impacts([SQ, SQ.moved((3, 0)), SQ.moved((9, 0))],
+                           [Motion(), Motion(), Motion(velocity=(1e60, 0))], 1e50),
+     ValueError, r"motions\[2\]: the body's coordinates reach .*overflow"),
+    (lambda: time_of_impact_many([SQ, SQ], [Motion()] * 2, [SQ, SQ.moved((3, 0))],
+                                 [Motion(), Motion(angular_velocity=1e120)], t_max=1),
+     ValueError, r"motions_b\[1\]: the body's (points' speeds|angular speed) reach.*overflow"),
+    (lambda: time_of_impact_many([SQ], [Motion(acceleration=(0, 1e30))], [SQ], [Motion()],
+                                 t_max=1e50),
+     ValueError, r"motions_a\[0\]: .*overflow"),
+])
+def test_motions_that_overflow_float64_are_refused_naming_the_body(call, error, message):
+    # time_of_impact refuses them (check_reach); a pair far apart from the others too,
+    # whether or not the swept bounds would search it
+    with pytest.raises(error, match=message):
+        call()
 
 
 @pytest.mark.parametrize("scale, offset", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e9), (1e-3, 1e6)])

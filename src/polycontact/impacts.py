@@ -24,10 +24,10 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ._checks import finite_number
-from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_t_max
+from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .errors import InvalidShapeError
-from .impact import (_METHODS, _STATUS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact, ImpactStatus,
-                     _path_scale, _result, body_frame)
+from .impact import (_METHODS, _STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
+                     ImpactStatus, _extent, _result, body_frame)
 from .motion import Motion
 from .shape import Shape, as_shape
 from .tolerances import RELATIVE_TOLERANCE
@@ -40,13 +40,19 @@ __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", 
 #: boxes of a long, fast path grow longer instead of more numerous.
 MAX_SLICES = 16
 
-#: The swept boxes are grown by this fraction of each body's reach (its radius plus
-#: how far from the origin its centroid can get) beyond its bounding radius: the
-#: rounding of the circle-overlap quartic of ``time_of_impact`` moves the distance at
-#: which it sees the circles meet by less than ~1e-7 of the reach, so the boxes never
-#: leave out a pair the pairwise call would search. It only adds candidates (each
-#: costs one quartic).
-SWEPT_MARGIN = 1e-6
+#: The swept boxes are grown beyond each body's bounding radius as the circle-overlap
+#: broad phase of ``time_of_impact`` grows the sum of the radii: by
+#: ``BROAD_PHASE_INFLATION`` of the radius, and by this many units of 2**-52 of the
+#: body's reach (its radius plus the |terms| of its centroid's path over [0, t_max]:
+#: position, travel at the initial speed, travel by the acceleration, summed over x
+#: and y). 16 of them are the pairwise call's own widening
+#: (``_kernels.broad_phase.rounding_allowance``, which sums the same terms of both
+#: bodies), the rest cover the rounding of |c_A(t) − c_B(t)| there and of the boxes
+#: here (a few units each), so the boxes never leave out a pair the pairwise call
+#: would search. Far from the origin this is the float spacing of the positions, not a
+#: fraction of them: a unit body at 1e9 is grown by ~3e-5 (1e-6 of the reach, the
+#: margin before, was 1e3: every body within a thousand units was a candidate).
+SWEPT_ROUNDING_ULPS = 64.0
 
 #: Width of the broad-phase interval table per pair (a quartic is <= 0 on at most 3
 #: disjoint intervals).
@@ -181,10 +187,11 @@ def _pack(shapes: list[Shape], exact: bool) -> tuple:
 
 
 def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
-            mb: np.ndarray, eps: np.ndarray, t_max: float, method: str, tol: float,
+            mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
             samples: int, max_iterations: int, threads: int) -> tuple:
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
-    search of ``time_of_impact`` on ``threads`` threads; the raw result arrays."""
+    search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
+    of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
@@ -201,8 +208,8 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
 
     def run(todo: np.ndarray) -> None:
-        impacts_chunk(todo, sa, sb, ma, mb, eps, *tables, t_max, BROAD_PHASE_INFLATION, tol,
-                      CONTACT_RESOLUTION, max_iterations, exact, samples, *out)
+        impacts_chunk(todo, sa, sb, ma, mb, eps_rel, *tables, t_max, BROAD_PHASE_INFLATION,
+                      tol, _ULPS, CONTACT_RESOLUTION, max_iterations, exact, samples, *out)
 
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
@@ -218,7 +225,8 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     return out
 
 
-def _maker(shape_of, motion_of, raw, t_max: float, method: str, eps: np.ndarray):
+def _maker(shape_of, motion_of, raw, t_max: float, method: str, eps_rel: np.ndarray,
+           tol: float):
     code, t_hi, t_lo, contact, iters, reached, n_iv, iv = raw
 
     def make(p: int) -> Impact:
@@ -226,7 +234,7 @@ def _maker(shape_of, motion_of, raw, t_max: float, method: str, eps: np.ndarray)
         b, mb = shape_of(p, 1), motion_of(p, 1)
         return _result(a, ma, b, mb, method, _STATUS[int(code[p])], float(t_hi[p]),
                        float(t_lo[p]), float(contact[p]), int(iters[p]), float(reached[p]),
-                       iv[p, :n_iv[p]], t_max, float(eps[p]))
+                       iv[p, :n_iv[p]], t_max, float(eps_rel[p]), tol)
 
     return make
 
@@ -252,9 +260,19 @@ def _motion_array(motions: list[Motion]) -> np.ndarray:
                      for m in motions], dtype=np.float64).reshape(len(motions), 6)
 
 
-def _path_scales(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.ndarray:
-    return np.array([_path_scale(s, m, t_max) for s, m in zip(shapes, motions)],
-                    dtype=np.float64)
+def _extents(shapes: list[Shape], motions: list[Motion], names: list[tuple[str, str]],
+             t_max: float) -> np.ndarray:
+    """Each body's extent (:func:`polycontact.impact._extent`: its pairs' distance
+    tolerance has the size term ``RELATIVE_TOLERANCE * max(extent_a, extent_b)``, as in
+    ``time_of_impact``), after the checks ``time_of_impact`` makes: the coordinates
+    (once per shape, with its body frame), then motions that would carry coordinates,
+    speeds or accelerations beyond float64's safe range within [0, t_max]. Errors name
+    the body's arguments, ``names[k] = (shape's, motion's)``."""
+    for s, (what, _) in zip(shapes, names):
+        body_frame(s, tables=False, what=what)
+    for s, m, (_, what) in zip(shapes, motions, names):
+        check_reach(s, m, t_max, what)
+    return np.array([_extent(s) for s in shapes], dtype=np.float64)
 
 
 def time_of_impact_many(
@@ -333,24 +351,28 @@ def time_of_impact_many(
     body = np.empty(2 * p_count, np.int64)
     b_shapes: list[Shape] = []
     b_motions: list[Motion] = []
+    names: list[tuple[str, str]] = []          # where each body first appears
     for k, (s, m) in enumerate(zip(a + b, ma + mb)):
         u = seen.setdefault((id(s), id(m)), len(b_shapes))
         if u == len(b_shapes):
             b_shapes.append(s)
             b_motions.append(m)
+            side, q = ("a", k) if k < p_count else ("b", k - p_count)
+            names.append((f"shapes_{side}[{q}]", f"motions_{side}[{q}]"))
         body[k] = u
+    extent = _extents(b_shapes, b_motions, names, t_max)
     uniq, index = _unique(b_shapes)
-    scale = _path_scales(b_shapes, b_motions, t_max)
     rows = _motion_array(b_motions)
     ba, bb = body[:p_count], body[p_count:]
-    eps = RELATIVE_TOLERANCE * np.maximum(scale[ba], scale[bb])
-    raw = _search(uniq, index[ba], index[bb], rows[ba], rows[bb], eps, t_max, method, tol,
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[ba], extent[bb])
+    raw = _search(uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel, t_max, method, tol,
                   samples, max_iterations, threads)
     code, t_hi, _, contact, *_ = raw
     collides = code == 1
     pairs = (a, b)
     moves = (ma, mb)
-    make = _maker(lambda p, s: pairs[s][p], lambda p, s: moves[s][p], raw, t_max, method, eps)
+    make = _maker(lambda p, s: pairs[s][p], lambda p, s: moves[s][p], raw, t_max, method,
+                  eps_rel, tol)
     return ImpactBatch(
         status=code,
         collides=collides,
@@ -377,7 +399,10 @@ def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
     """
     shapes = _shapes(shapes, "shapes")
     motions = _motions(motions, "motions", len(shapes), "shapes")
-    return _candidates(shapes, motions, check_t_max(t_max))
+    t_max = check_t_max(t_max)
+    _extents(shapes, motions, [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))],
+             t_max)
+    return _candidates(shapes, motions, t_max)
 
 
 def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.ndarray:
@@ -389,7 +414,7 @@ def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.
     cent = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2)
     rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
     boxes, owner = swept_boxes(cent, _motion_array(motions), rad, t_max, MAX_SLICES,
-                               SWEPT_MARGIN)
+                               BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
     return box_pairs(boxes, owner, n)
 
 
@@ -474,6 +499,9 @@ def first_impacts(
     motions = _motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = _options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
+    # every body is checked as time_of_impact checks it, searched or not
+    extent = _extents(shapes, motions,
+                      [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))], t_max)
     pairs = _candidates(shapes, motions, t_max)
     if len(pairs) == 0:
         return []
@@ -485,15 +513,14 @@ def first_impacts(
     sub_motions = [motions[k] for k in used]
     uniq, index = _unique(sub_shapes)
     m = _motion_array(sub_motions)
-    scale = _path_scales(sub_shapes, sub_motions, t_max)
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[pairs[:, 0]], extent[pairs[:, 1]])
     i, j = local[pairs[:, 0]], local[pairs[:, 1]]
-    eps = RELATIVE_TOLERANCE * np.maximum(scale[i], scale[j])
-    raw = _search(uniq, index[i], index[j], m[i], m[j], eps, t_max, method, tol, samples,
+    raw = _search(uniq, index[i], index[j], m[i], m[j], eps_rel, t_max, method, tol, samples,
                   max_iterations, threads)
     i, j = pairs[:, 0], pairs[:, 1]
     code, _, _, contact, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
-                  t_max, method, eps)
+                  t_max, method, eps_rel, tol)
     events = [PairImpact(int(i[p]), int(j[p]), make(p))
               for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
     events.sort(key=lambda e: (event_time(e.impact), e.i, e.j))

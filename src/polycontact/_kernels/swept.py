@@ -5,8 +5,8 @@ acceleration and spin stays within its bounding circle (radius ``L``) about its
 centroid, and its centroid follows ``c(t) = c0 + v t + a t²/2``. Over a time slice
 ``[t0, t1]`` each coordinate of that path is a parabola, so its range is spanned by the
 slice's ends and the apex ``t* = −v/a`` when it falls inside; the box of that range
-grown by ``L`` (and a rounding margin) holds the body for the whole slice, whatever its
-spin. Each body gets enough slices that its centroid moves at most about ``L`` per
+grown by ``L`` (widened as the pairwise broad phase widens the radii, see
+:func:`swept_boxes`) holds the body for the whole slice, whatever its spin. Each body gets enough slices that its centroid moves at most about ``L`` per
 slice (at most ``max_slices``), so the boxes hug the path. Two bodies can touch at
 time t only if the boxes of the slices holding t overlap in x, in y and in time:
 a sort-and-sweep over the space–time boxes (on the axis where the boxes spread most)
@@ -42,16 +42,21 @@ def _coordinate_range(c, v, a, t0, t1):
 
 
 @njit(cache=True, nogil=True)
-def swept_boxes(c, m, radius, t_max, max_slices, margin):
+def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
     """Space–time boxes bounding each body over ``[0, t_max]``.
 
     ``c`` (N, 2) centroids at t = 0, ``m`` (N, 6) motion vectors ``[vx, vy, ax, ay, ω,
     α]``, ``radius`` (N,) bounding radii. Body i gets ``k_i = clamp(ceil(travel_i /
     radius_i), 1, max_slices)`` slices of ``[0, t_max]`` (``travel_i = |v| t_max +
     |a| t_max²/2`` bounds its centroid's path length). Each box is grown by the radius
-    and by ``margin`` times the body's reach (``radius + |c0| + travel``, with
-    components in the max norm), which covers the rounding of the path here and of the
-    circle-overlap quartic (whose error in distance is below ``1e-7`` of the reach).
+    times ``1 + inflate`` and by ``ulps`` times the body's reach ``radius + Σ_x,y (|c0| +
+    |v| t_max + |a| t_max²/2)``: the terms whose sum over both bodies, times 16 units of
+    2**-52, the pairwise broad phase adds to the sum of the radii
+    (:func:`polycontact._kernels.broad_phase.rounding_allowance`); ``ulps`` above that
+    covers the rounding of the centre distance there and of the boxes here. Two bodies
+    whose inflated circles the pairwise broad phase sees meeting at some t thus have
+    boxes that meet in x, y and time (slice ends are computed one way for every body,
+    so the slices tile ``[0, t_max]``).
 
     Returns ``(boxes, owner)``: ``boxes[k] = (x_lo, x_hi, y_lo, y_hi, t_lo, t_hi)`` and
     the body it bounds.
@@ -74,9 +79,9 @@ def swept_boxes(c, m, radius, t_max, max_slices, margin):
     for i in range(n):
         k = counts[i]
         vx, vy, ax, ay = m[i, 0], m[i, 1], m[i, 2], m[i, 3]
-        reach = radius[i] + max(abs(c[i, 0]), abs(c[i, 1])) + \
+        reach = radius[i] + abs(c[i, 0]) + abs(c[i, 1]) + \
             (abs(vx) + abs(vy)) * t_max + 0.5 * (abs(ax) + abs(ay)) * t_max * t_max
-        grow = radius[i] + margin * reach
+        grow = radius[i] * (1.0 + inflate) + ulps * reach
         for s in range(k):
             t0 = t_max * s / k
             t1 = t_max if s == k - 1 else t_max * (s + 1) / k
@@ -161,15 +166,16 @@ def box_pairs(boxes, owner, n_bodies):
 
 
 @njit(cache=True, nogil=True)
-def impacts_chunk(todo, sa, sb, ma, mb, eps, r, starts, nxt, links, circles, r_len, v_off,
-                  s_off, n_off, cent, rad, t_max, inflate, time_tol, contact_resolution,
+def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles, r_len, v_off,
+                  s_off, n_off, cent, rad, t_max, inflate, time_tol, ulps, contact_resolution,
                   max_iter, exact, samples, code, t_hi, t_lo, contact, iters, reached,
                   n_iv, iv):
     """Time of impact of the pairs ``todo`` (indices into the pair arrays), results
     written in place at those indices.
 
     Pair p is shape ``sa[p]`` moving with ``ma[p]`` against shape ``sb[p]`` moving with
-    ``mb[p]``, distance tolerance ``eps[p]``. Shape s is packed as rows
+    ``mb[p]``, the size term of its distance tolerance ``eps_rel[p]`` (the kernels add
+    ``ulps`` times the largest |coordinate| at each time they examine). Shape s is packed as rows
     ``v_off[s]:v_off[s + 1]`` of ``r`` (vertices about its centroid), ``nxt`` and
     ``r_len``; loop starts ``starts[s_off[s]:s_off[s + 1]]``; circle tree rows
     ``n_off[s]:n_off[s + 1]`` of ``links`` and ``circles`` (the ``edge_table`` of
@@ -195,11 +201,11 @@ def impacts_chunk(todo, sa, sb, ma, mb, eps, r, starts, nxt, links, circles, r_l
             eb = (nxt[v_off[b]:v_off[b + 1]], links[n_off[b]:n_off[b + 1]],
                   circles[n_off[b]:n_off[b + 1]], r_len[v_off[b]:v_off[b + 1]])
             out = exact_query(ra, sta, cent[a], ma[p], la, ea, rb, stb, cent[b], mb[p], lb, eb,
-                              t_max, inflate, time_tol, eps[p], contact_resolution * (la + lb),
-                              max_iter)
+                              t_max, inflate, time_tol, eps_rel[p], ulps,
+                              contact_resolution * (la + lb), max_iter)
         else:
             out = sampled_query(ra, sta, cent[a], ma[p], la, rb, stb, cent[b], mb[p], lb, t_max,
-                                inflate, time_tol, eps[p], samples)
+                                inflate, time_tol, eps_rel[p], ulps, samples)
         intervals, c, hi, lo, ct, its, got = out
         code[p] = c
         t_hi[p] = hi
