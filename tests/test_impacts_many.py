@@ -362,7 +362,8 @@ def test_motions_that_overflow_float64_are_refused_naming_the_body(call, error, 
         call()
 
 
-@pytest.mark.parametrize("scale, offset", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e9), (1e-3, 1e6)])
+@pytest.mark.parametrize("scale, offset", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e9), (1e-3, 1e6),
+                                           (1e-3, 1e9), (1e6, 1e9)])
 def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset):
     rng = np.random.default_rng(7)
     ring = np.array([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)], float)
@@ -378,3 +379,37 @@ def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset)
     events = first_impacts(shapes, moves, 1.5, max_iterations=BUDGET)
     assert {(e.i, e.j): e.impact for e in events} == want
     assert any(e.impact.collides for e in events)
+
+
+# the cases of issue 14's defects 3-6 (time of impact), through the batched calls: each
+# answer (time, time_tolerance, bracket, features) is the pairwise call's
+DEFECT_CASES = {
+    "defect3_fast_flush": (SQ, Motion(velocity=(2e6, 0)), SQ.moved((3, 0)), Motion(), 5.0, 1e-4),
+    "defect4_long_travel": (SQ, Motion(velocity=(1, 0)), SQ.moved((1e9, 0.3)), Motion(), 2e9,
+                            1e-4),
+    "defect5_far_away": (SQ.moved((1e9, 0)), Motion(velocity=(1, 0)), SQ.moved((1e9 + 3, 0)),
+                         Motion(), 5.0, 1e-4),
+    "defect5_large_t_max": (SQ, Motion(velocity=(1, 0), angular_velocity=0.5),
+                            SQ.moved((3, 0)), Motion(), 1e13, 1e-4),
+    "defect6_tiny_time_tolerance": (SQ, Motion(velocity=(1, 0)), SQ.moved((3, 0)), Motion(),
+                                    5.0, 1e-300),
+    "defect6_slow_long_window": (SQ, Motion(velocity=(1e-5, 0)), SQ.moved((3, 0)), Motion(),
+                                 1e6, 1e-12),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DEFECT_CASES))
+def test_defects3_to_6_batched_answers_equal_the_pairwise_ones(case):
+    a, ma, b, mb, t_max, tol = DEFECT_CASES[case]
+    want = pc.time_of_impact(a, ma, b, mb, t_max=t_max, time_tolerance=tol)
+    back = pc.time_of_impact(b, mb, a, ma, t_max=t_max, time_tolerance=tol)
+    assert want.collides and back.collides
+    batch = time_of_impact_many([a, b], [ma, mb], [b, a], [mb, ma], t_max=t_max,
+                                time_tolerance=tol)
+    assert list(batch) == [want, back]
+    assert batch.impact(0).time_tolerance == want.time_tolerance
+    assert batch.impact(0).features == want.features
+    # with a bystander far off the path: the one event is the pair's
+    away = SQ.moved((-50, 1e3))
+    events = first_impacts([a, b, away], [ma, mb, Motion()], t_max, time_tolerance=tol)
+    assert [(e.i, e.j) for e in events] == [(0, 1)] and events[0].impact == want
