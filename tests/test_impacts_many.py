@@ -341,6 +341,32 @@ def test_swept_bounds_far_from_the_origin_grow_by_the_float_spacing():
     assert candidate_pairs(pair, moves, 10.0).tolist() == [[0, 1]]
 
 
+@examples(200)
+@given(st.sampled_from([1e3, 1e6, 1e9]), st.floats(-1, 1), st.floats(-1, 1), st.floats(0, 6.3),
+       st.floats(0, 1.5), st.sampled_from([1e-2, 1.0, 1e2]), st.floats(0.05, 1.5),
+       st.sampled_from([0.0, 1.0, 100.0]), st.floats(0, 6.3), st.sampled_from([1e-3, 1.0, 1e3]))
+def test_swept_bounds_keep_pairs_within_the_pairwise_rounding_allowance(
+        offset, fx, fy, direction, turn, size, frac, speed, heading, t_max):
+    # two bodies travelling together far from the origin, their bounding circles apart
+    # by a fraction of the widening the pairwise broad phase gives them for the rounding
+    # of positions there (rounding_allowance): it searches the pair whenever that
+    # widening covers the gap, so the swept boxes must keep it (boxes grown by the
+    # radius alone drop it)
+    from polycontact._kernels.broad_phase import rounding_allowance
+
+    a = Shape((SQ.moved((0, 0), turn).loops[0] - SQ.centroid) * size + offset * np.array([fx, fy]))
+    b = a.moved((0, 0), 0.7)
+    v = speed * size / t_max * np.array([math.cos(heading), math.sin(heading)])
+    m = Motion(velocity=v)
+    allow = rounding_allowance(a.centroid, m.array, a.centroid, m.array, t_max)
+    d = (a.bounding_radius + b.bounding_radius + frac * allow) * np.array(
+        [math.cos(direction), math.sin(direction)])
+    b = b.moved(a.centroid + d - b.centroid)
+    if not len(intervals_array(a, m, b, m, t_max)):
+        return          # the rounding of the placement took the pair out of reach
+    assert candidate_pairs([a, b], [m, m], t_max).tolist() == [[0, 1]]
+
+
 @pytest.mark.parametrize("call, error, message", [
     (lambda: candidate_pairs([SQ, SQ.moved((50, 0))],
                              [Motion(velocity=(1e300, 0), acceleration=(-1e300, 0)), Motion()],
