@@ -15,7 +15,9 @@ pass. Printed, in one run:
   ``time_of_impact`` whose events must equal those of ``first_impacts`` (same pairs,
   equal ``Impact`` objects);
 - medians over R rounds (each: ``first_impacts`` and ``first_impact``, median of 5
-  calls, then one run of each loop) and the median of the per-round ratios;
+  calls, then one run of each loop) and the median of the per-round ratios, with their
+  spread (fastest and slowest call of ``first_impacts``, range of the ratios and of the
+  loops over the rounds);
 - ``time_of_impact_many`` on one thread and on all CPUs against a loop of
   ``time_of_impact``, on two pair lists: the candidate pairs (short searches) and pairs
   of fast-spinning neighbours (long searches).
@@ -71,12 +73,18 @@ def spinning_pairs(n: int, seed: int) -> tuple[list, list, list, list]:
     return sa, ma, sb, mb
 
 
-def median_time(fn, repeat: int) -> tuple[float, object]:
+def timings(fn, repeat: int) -> tuple[list[float], object]:
+    """Wall-clock seconds of ``repeat`` calls, and the last result."""
     times, out = [], None
     for _ in range(repeat):
         t0 = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - t0)
+    return times, out
+
+
+def median_time(fn, repeat: int) -> tuple[float, object]:
+    times, out = timings(fn, repeat)
     return float(np.median(times)), out
 
 
@@ -111,16 +119,19 @@ def main() -> None:
 
     # rounds: first_impacts (median of 5 calls) right before each all-pairs loop, so
     # that the ratio of a round compares runs under the same load of the machine
-    rounds = []
+    rounds, fast_calls = [], []
     for _ in range(args.repeat):
-        t_fast, events = median_time(lambda: pc.first_impacts(shapes, motions, t_max), 5)
+        calls, events = timings(lambda: pc.first_impacts(shapes, motions, t_max), 5)
+        fast_calls += calls
+        t_fast = float(np.median(calls))
         t_one, first = median_time(lambda: pc.first_impact(shapes, motions, t_max), 5)
         t_scene, (ba, bb, imp) = median_time(lambda: scene_obj.first_impact(), 1)
         t_brute, slow = median_time(brute, 1)
         rounds.append((t_fast, t_one, t_scene, t_brute))
     t_fast, t_one, t_scene, t_brute = np.median(rounds, axis=0)
-    r_scene = np.median([r[2] / r[0] for r in rounds])
-    r_brute = np.median([r[3] / r[0] for r in rounds])
+    ratios_scene = [r[2] / r[0] for r in rounds]
+    ratios_brute = [r[3] / r[0] for r in rounds]
+    r_scene, r_brute = np.median(ratios_scene), np.median(ratios_brute)
     hits = sum(e.impact.collides for e in events)
     print(f"first_impacts: {1e3 * t_fast:9.1f} ms  (swept bounds alone {1e3 * t_cand:.1f} ms: "
           f"{len(cand)} candidate pairs; {len(events)} pairs meet, {hits} collide)")
@@ -136,6 +147,12 @@ def main() -> None:
     print(f"speed-up (medians over {args.repeat} rounds of the per-round ratios): "
           f"first_impacts vs Scene.first_impact {r_scene:.0f}x, vs the double loop "
           f"{r_brute:.0f}x (target >= 50x)")
+    print(f"spread: first_impacts {1e3 * min(fast_calls):.1f}-{1e3 * max(fast_calls):.1f} ms over "
+          f"{len(fast_calls)} calls; per-round ratios {min(ratios_scene):.0f}-"
+          f"{max(ratios_scene):.0f}x (Scene), {min(ratios_brute):.0f}-{max(ratios_brute):.0f}x "
+          f"(double loop); all-pairs loops {min(r[2] for r in rounds):.2f}-"
+          f"{max(r[2] for r in rounds):.2f} s (Scene), {min(r[3] for r in rounds):.2f}-"
+          f"{max(r[3] for r in rounds):.2f} s (double loop)")
 
     # pair lists of a user's own: those candidate pairs, and pairs of fast-spinning
     # neighbours (long searches: there the threads pay)

@@ -322,8 +322,11 @@ def time_of_impact_many(
     ------
     TypeError, ValueError, InvalidShapeError
         Naming the argument and the index: ``shapes_b[3]: outer loop: ...``,
-        ``motions_a[2]: expected a polycontact.Motion, got tuple``, or
-        ``motions_b: expected 4 motions (one per shape of shapes_b), got 3``.
+        ``motions_a[2]: expected a polycontact.Motion, got tuple``,
+        ``motions_b: expected 4 motions (one per shape of shapes_b), got 3``, or a
+        motion ``time_of_impact`` refuses because the body's coordinates, speeds or
+        accelerations would overflow float64 within ``[0, t_max]``
+        (``motions_b[1]: the body's coordinates reach ...``).
 
     Examples
     --------
@@ -387,7 +390,12 @@ def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
                     t_max: float) -> np.ndarray:
     """Pairs ``(i, j)``, i < j, whose swept bounds over ``[0, t_max]`` meet: a superset of
     the pairs whose bounding circles come within reach of each other in that window,
-    hence of every pair that can touch. Shape (K, 2), sorted, int64.
+    hence of every pair that can touch. Shape (K, 2), sorted, int64. The boxes are
+    widened as :func:`polycontact.time_of_impact`'s broad phase widens the circles (a
+    relative inflation and the rounding of positions far from the origin), so every
+    pair it would search is here. Motions it refuses (coordinates, speeds or
+    accelerations that would overflow float64) are refused here too, naming
+    ``motions[k]``.
 
     Examples
     --------
@@ -483,6 +491,12 @@ def first_impacts(
     -------
     list of PairImpact
         ``(i, j, impact)`` named tuples.
+
+    Raises
+    ------
+    TypeError, ValueError, InvalidShapeError
+        As :func:`time_of_impact_many`, naming ``shapes[k]`` or ``motions[k]``; every
+        body is checked, whether or not a pair of it is searched.
 
     Examples
     --------

@@ -6,8 +6,9 @@ centroid, and its centroid follows ``c(t) = c0 + v t + a t²/2``. Over a time sl
 ``[t0, t1]`` each coordinate of that path is a parabola, so its range is spanned by the
 slice's ends and the apex ``t* = −v/a`` when it falls inside; the box of that range
 grown by ``L`` (widened as the pairwise broad phase widens the radii, see
-:func:`swept_boxes`) holds the body for the whole slice, whatever its spin. Each body gets enough slices that its centroid moves at most about ``L`` per
-slice (at most ``max_slices``), so the boxes hug the path. Two bodies can touch at
+:func:`swept_boxes`) holds the body for the whole slice, whatever its spin. Each body
+gets enough slices that its centroid moves at most about ``L`` per slice (at most
+``max_slices``), so the boxes hug the path. Two bodies can touch at
 time t only if the boxes of the slices holding t overlap in x, in y and in time:
 a sort-and-sweep over the space–time boxes (on the axis where the boxes spread most)
 lists every such pair once.
@@ -175,15 +176,16 @@ def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles,
 
     Pair p is shape ``sa[p]`` moving with ``ma[p]`` against shape ``sb[p]`` moving with
     ``mb[p]``, the size term of its distance tolerance ``eps_rel[p]`` (the kernels add
-    ``ulps`` times the largest |coordinate| at each time they examine). Shape s is packed as rows
-    ``v_off[s]:v_off[s + 1]`` of ``r`` (vertices about its centroid), ``nxt`` and
-    ``r_len``; loop starts ``starts[s_off[s]:s_off[s + 1]]``; circle tree rows
-    ``n_off[s]:n_off[s + 1]`` of ``links`` and ``circles`` (the ``edge_table`` of
+    ``ulps`` times the largest |coordinate| at each time they examine). Shape s is
+    packed as rows ``v_off[s]:v_off[s + 1]`` of ``r`` (vertices about its centroid),
+    ``nxt`` and ``r_len``; loop starts ``starts[s_off[s]:s_off[s + 1]]``; circle tree
+    rows ``n_off[s]:n_off[s + 1]`` of ``links`` and ``circles`` (the ``edge_table`` of
     :mod:`polycontact._kernels.advance`, body-local indices); centroid ``cent[s]``,
     bounding radius ``rad[s]``. Each pair runs ``exact_query`` (``exact``) or
-    ``sampled_query`` with the same arguments as ``polycontact.time_of_impact``; its
-    outputs go to ``code``, ``t_hi``, ``t_lo``, ``contact``, ``iters``, ``reached``, and
-    its broad-phase intervals to ``iv[p, :n_iv[p]]``.
+    ``sampled_query`` with the same arguments as ``polycontact.time_of_impact``
+    (contact resolution ``contact_resolution * (rad[a] + rad[b])``); its outputs go to
+    ``code``, ``t_hi``, ``t_lo``, ``contact``, ``iters``, ``reached``, and its broad-phase
+    intervals to ``iv[p, :n_iv[p]]``.
     """
     for k in range(todo.shape[0]):
         p = todo[k]
