@@ -37,8 +37,12 @@ def add_parser(subparsers: Any) -> None:
                    help="accuracy of the time (default: the scene's, else 1e-4)")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
+    p.add_argument("--all", action="store_true",
+                   help="list every pair that meets within t_max, by time (not only the "
+                   "first impact)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="OUT.png", help="draw the bodies, paths and contact")
+    p.add_argument("--plot", metavar="OUT.png",
+                   help="draw the bodies, paths and contact (with --all: the earliest event)")
     p.set_defaults(func=run)
 
 
@@ -116,11 +120,25 @@ def run(args: argparse.Namespace) -> int:
         for note in body.shape.repairs:
             print(f"polycontact collide: repaired {body.name}: {note}",
                   file=sys.stderr)
-    body_a, body_b, impact = scene.first_impact(
-        method=args.method, time_tolerance=args.time_tolerance, samples=args.samples
-    )
-    rep = report(body_a, body_b, impact)
-    print(json.dumps(rep) if args.json else _text(rep))
+    options = {"method": args.method, "time_tolerance": args.time_tolerance,
+               "samples": args.samples}
+    if args.all:
+        events = scene.impacts(**options)
+        reps = [report(a, b, imp) for a, b, imp in events]
+        if args.json:
+            print(json.dumps({"events": reps}))
+        else:
+            print(f"{len(reps)} pair(s) meet within t_max = {scene.t_max:g}" +
+                  "".join("\n\n" + _text(r) for r in reps))
+        if not events:
+            if args.plot:
+                raise CommandError("--plot: no pair meets, nothing to draw")
+            return 0
+        body_a, body_b, impact = events[0]
+    else:
+        body_a, body_b, impact = scene.first_impact(**options)
+        rep = report(body_a, body_b, impact)
+        print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
         import matplotlib
 
