@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import InvalidShapeError, PolycontactError
@@ -44,6 +45,23 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
         return Shape.from_wkt(text, repair=repair)
     except (InvalidShapeError, TypeError) as exc:  # TypeError: coordinates not numbers
         raise CommandError(f"{path}: {exc}") from None
+
+
+def integer_at_least(minimum: int) -> Callable[[str], int]:
+    """An argparse ``type`` for an integer option >= ``minimum``."""
+
+    def parse(text: str) -> int:
+        import argparse
+
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {minimum}, got {value}")
+        return value
+
+    return parse
 
 
 def _number_option(text: str, *, zero_allowed: bool) -> float:

@@ -7,17 +7,7 @@ import json
 import sys
 from typing import Any
 
-from ._io import CommandError, index_text, positive_number
-
-
-def _samples(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 2, got {value}")
-    return value
+from ._io import CommandError, index_text, integer_at_least, positive_number
 
 
 def add_parser(subparsers: Any) -> None:
@@ -31,7 +21,7 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("scene", metavar="SCENE.json", help="scene file (see the README)")
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
-    p.add_argument("--samples", type=_samples, default=10,
+    p.add_argument("--samples", type=integer_at_least(2), default=10,
                    help="time points per round of the sampled method (default 10)")
     p.add_argument("--time-tolerance", type=positive_number, default=None,
                    help="accuracy of the time (default: the scene's, else 1e-4)")
