@@ -405,3 +405,64 @@ def test_feasible_region_avoids_the_container_holes():
     world.add(TEMPLATES[0], (2, 2))
     region = world.feasible_region(TEMPLATES[3])
     assert not region.contains(shapely.Point(2, 2)) and len(world._nfp_cache) == 1
+
+
+def test_bodies_centred_on_cell_edges_are_found():
+    # Squares of side 1 and 2 (box side exactly a power of two: half a cell out of their
+    # own cell) with box centres on cell edges and between them, touching and
+    # overlapping: the broad phase's cell range must keep every neighbour.
+    # The first body sets the grid's origin (its centre). Bodies are added from the top
+    # right down, so a pair (i < j) is found from the body up and right: a cell range
+    # cut short on its low side would lose it.
+    world = pc.World()
+    unit = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    two = pc.Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+    world.add(unit, (0.5, 0.5))
+    for x in range(5, -1, -1):
+        for y in range(3, -1, -1):
+            world.add(unit, (0.5 + x, 0.5 + y))
+            world.add(unit, (8.375 + x, 0.375 + y))  # centres just below cell edges
+    for x in range(3):
+        world.add(two, (1.0 + 2 * x, 5.0))
+        world.add(unit, (1.0 + 2 * x, 6.5))
+        world.add(two, (0.5 + 2 * x, -1.0))
+    got = world.contacts()
+    pairs, states = brute_contacts(world)
+    assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    probes = [(unit, (x / 8, y / 8)) for x in range(-8, 120, 3) for y in range(-40, 60, 3)]
+    probes += [(two, (x / 4, y / 4)) for x in range(-4, 60) for y in range(-20, 30)]
+    for shape in (unit, two):
+        pos = [p for s, p in probes if s is shape]
+        many = world.query_many(shape, pos)
+        one = [max([0, *world.query(shape, p).states.tolist()]) for p in pos]
+        assert many.tolist() == one
+
+
+def test_query_many_tests_the_container_last_with_the_same_answer():
+    # query_many tests the container's box, then the bodies, then (only if no body is
+    # penetrated) the container's outline and holes: every mix of the three gives the
+    # worst state that query gives.
+    world = pc.World(CONTAINER)
+    world.add(TEMPLATES[3], (2.5, 2.5))
+    world.add(TEMPLATES[0], (9.0, 7.0))
+    sq = TEMPLATES[3]
+    cases = {
+        (-1.0, 5.0): 2,   # off the container's box
+        (0.25, 5.0): 2,   # crosses the outline, box inside the container's box
+        (0.5, 5.0): 1,    # touches the outline only
+        (6.0, 5.0): 2,    # in the hole
+        (4.5, 5.0): 1,    # touches the hole only
+        (3.5, 2.5): 1,    # touches a body only
+        (2.75, 2.5): 2,   # penetrates a body
+        (3.5, 3.5): 1,    # corner contact with a body
+        (1.5, 0.5): 1,    # touches a body and the outline
+        (2.0, 0.25): 2,   # penetrates a body and crosses the outline
+        (3.0, 7.0): 0,    # free
+    }
+    pos = list(cases)
+    many = world.query_many(sq, pos)
+    one = []
+    for p in pos:
+        q = world.query(sq, p)
+        one.append(max([q.container_state, *q.states.tolist()]))
+    assert many.tolist() == one == list(cases.values())
