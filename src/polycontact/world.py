@@ -589,10 +589,13 @@ class World:
         states, used = k.classify_pairs(self._xy, self._ls, self._lo, self._nl, self._eps,
                                         tol, pi, pj, self._vmax, self._lmax,
                                         _chunks(len(pi)))
-        hit = states > 0
+        hit = np.flatnonzero(states)
+        if self._next < 2**31:  # one key per pair, no overflow: one sort, not a lexsort
+            hit = hit[np.argsort(pi[hit] * self._next + pj[hit], kind="stable")]
+        else:
+            hit = hit[np.lexsort((pj[hit], pi[hit]))]
         pairs = np.stack([pi[hit], pj[hit]], axis=1)
-        order = np.lexsort((pairs[:, 1], pairs[:, 0]))
-        pairs, states, used = pairs[order], states[hit][order], used[hit][order]
+        states, used = states[hit], used[hit]
         if self._container is not None and len(alive):
             cst = k.container_states(self._xy, self._ls, self._lo, self._nl, self._box,
                                      self._eps, tol, alive, *self._hazards()[:4],

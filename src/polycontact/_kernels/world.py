@@ -244,7 +244,7 @@ def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps
     return pi[:n], pj[:n]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _view(xy, ls, lo, nl, b, buf):
     """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
     first = ls[lo[b]]
