@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from profiles import examples
 
 import polycontact as pc
+import polycontact.world as world_module
 from polycontact.tolerances import default_tolerance
 
 # ../shared/datasets beside the repository (its parent, or the parent of a worktree's
@@ -407,7 +408,10 @@ def test_feasible_region_avoids_the_container_holes():
     assert not region.contains(shapely.Point(2, 2)) and len(world._nfp_cache) == 1
 
 
-def test_bodies_centred_on_cell_edges_are_found():
+@pytest.mark.parametrize("scan", [0, 10**9], ids=["grid", "box scan"])
+def test_bodies_centred_on_cell_edges_are_found(monkeypatch, scan):
+    # query_many goes through the grid, or (few bodies) tests every body's box: both.
+    monkeypatch.setattr(world_module, "_SCAN_BODIES", scan)
     # Squares of side 1 and 2 (box side exactly a power of two: half a cell out of their
     # own cell) with box centres on cell edges and between them, touching and
     # overlapping: the broad phase's cell range must keep every neighbour.
@@ -438,7 +442,9 @@ def test_bodies_centred_on_cell_edges_are_found():
         assert many.tolist() == one
 
 
-def test_query_many_tests_the_container_last_with_the_same_answer():
+@pytest.mark.parametrize("scan", [0, 10**9], ids=["grid", "box scan"])
+def test_query_many_tests_the_container_last_with_the_same_answer(monkeypatch, scan):
+    monkeypatch.setattr(world_module, "_SCAN_BODIES", scan)
     # query_many tests the container's box, then the bodies, then (only if no body is
     # penetrated) the container's outline and holes: every mix of the three gives the
     # worst state that query gives.

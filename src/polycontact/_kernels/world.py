@@ -386,7 +386,7 @@ def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
 @njit(cache=True, nogil=True)
 def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                  level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax,
-                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, p0, p1, out):
+                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, p0, p1, out):
     n = ss[ss.shape[0] - 1]
     qxy = np.empty((n, 2))
     cand = np.empty(n_ids, np.int64)
@@ -407,10 +407,15 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
         if worst < 2:
             e0 = tol if tol >= 0.0 else qeps
             d = e0 + (tol if tol >= 0.0 else emax)
-            m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d,
-                        y0 - d, y1 + d, 0, n_ids, cand)
+            if scan.shape[0]:
+                m = scan.shape[0]
+                src = scan
+            else:
+                m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d,
+                            x1 + d, y0 - d, y1 + d, 0, n_ids, cand)
+                src = cand
             for t in range(m):
-                j = cand[t]
+                j = src[t]
                 e = tol if tol >= 0.0 else max(qeps, eps[j])
                 if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
                     continue
@@ -429,20 +434,22 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
 @njit(cache=True, nogil=True, parallel=True)
 def query_many(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt, level,
                lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax, lmax,
-               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, chunks):
+               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, chunks):
     """Worst state (int8) of the shape (sxy, ss) placed at each (px[p], py[p], angles[p])
-    over every body and the container (outside counts as 2); ``chunks`` = 1: serial."""
+    over every body and the container (outside counts as 2); ``chunks`` = 1: serial.
+    ``scan``: the live bodies, to be tested box by box instead of through the grid (a
+    few bodies), or empty (use the grid)."""
     p_count = px.shape[0]
     out = np.empty(p_count, np.int8)
     if chunks == 1:
         _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                      level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, 0,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, 0,
                      p_count, out)
         return out
     for c in prange(chunks):
         _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                      level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan,
                      p_count * c // chunks, p_count * (c + 1) // chunks, out)
     return out
