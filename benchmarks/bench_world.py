@@ -1,7 +1,8 @@
 """Benchmark: a World of many bodies against Shapely 2 (STRtree + relate).
 
 Run: ``python benchmarks/bench_world.py`` (``--quick``: 10³ and 10⁴ bodies only, fewer
-repeats). Medians of several repeats; the peers are measured in the same run.
+repeats; ``--threads 1``: the parallel kernels on one thread). Medians of several
+repeats; the peers are measured in the same run.
 
 1. All contacts of N random concave 12-gons packed densely (N = 10³, 10⁴, 10⁵): stars
    of radius about 0.6 on a jittered unit grid, so each body meets a few neighbours
@@ -98,8 +99,9 @@ def shapely_contacts(polys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def bench_contacts(sizes: list[int], repeats: int) -> None:
     print("All contacts of N random concave 12-gons, packed densely (median seconds)")
-    print(f"{'N':>7} {'pairs':>7} {'world.contacts':>15} {'per body':>10} {'Shapely':>10} "
-          f"{'ratio':>7} {'CPU ratio':>10} {'build World':>12} {'same answer':>12}")
+    print(f"{'N':>7} {'pairs':>7} {'world.contacts':>15} {'per body':>10} {'CPU/body':>9} "
+          f"{'Shapely':>10} {'ratio':>7} {'CPU ratio':>10} {'build World':>12} "
+          f"{'same answer':>12}")
     rng = np.random.default_rng(1)
     pc.World().add_many(stars(rng, 10))  # compile / warm
     for n in sizes:
@@ -116,7 +118,8 @@ def bench_contacts(sizes: list[int], repeats: int) -> None:
         order = np.lexsort((sp[:, 1], sp[:, 0]))
         same = got.pairs.tolist() == sp[order].tolist() and got.states.tolist() == \
             ss[order].tolist()
-        print(f"{n:>7} {len(got):>7} {tw:>15.4f} {1e6 * tw / n:>8.2f}µs {ts:>10.4f} "
+        print(f"{n:>7} {len(got):>7} {tw:>15.4f} {1e6 * tw / n:>8.2f}µs "
+              f"{1e6 * CPU['ours'] / n:>7.2f}µs {ts:>10.4f} "
               f"{ts / tw:>6.1f}× {CPU['shapely'] / CPU['ours']:>9.1f}× {build:>11.3f}s "
               f"{str(same):>12}")
 
@@ -216,8 +219,13 @@ def bench_placements(repeats: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="10³ and 10⁴ only, 3 repeats")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="Numba threads for the parallel kernels (default: all)")
     args = parser.parse_args()
     import numba
+
+    if args.threads:
+        numba.set_num_threads(args.threads)
 
     import os
 
