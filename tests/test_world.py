@@ -472,3 +472,37 @@ def test_query_many_tests_the_container_last_with_the_same_answer(monkeypatch, s
         q = world.query(sq, p)
         one.append(max([q.container_state, *q.states.tolist()]))
     assert many.tolist() == one == list(cases.values())
+
+
+@pytest.mark.parametrize("count", [3, 40], ids=["level scanned", "cells visited"])
+def test_contacts_each_pair_once_with_a_wide_tolerance(count):
+    # Unit squares with gaps of 0.4 (contact under tolerance 0.5) and 0.6 (apart): the
+    # wide tolerance widens each body's block of cells; with few bodies on the level the
+    # level is scanned body by body instead. Every pair is found, once.
+    world = pc.World()
+    unit = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    side = math.ceil(math.sqrt(count))
+    for k in range(count):
+        x, y = k % side, k // side
+        world.add(unit, (1.4 * x + 0.2 * (y % 2), 1.5 * y + (0.1 if x % 3 == 0 else 0.0)))
+    for tol in (0.5, None):
+        got = world.contacts(tol)
+        pairs, states = brute_contacts(world, tol)
+        assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    assert len(world.contacts(0.5)) > 0
+
+
+def test_contacts_in_merged_far_cells():
+    # Cell indices are clamped 2**25 cells from the first body: these small squares, far
+    # away, share clamped cells; touching and overlapping pairs are still found, once.
+    world = pc.World()
+    world.add(pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    s = 2.0**-10
+    small = pc.Shape(np.array([(0, 0), (1, 0), (1, 1), (0, 1)]) * s)
+    for k in range(12):
+        world.add(small, (1e5 + s * (k % 4) * (1.0 if k < 8 else 0.5), 1e5 + s * (k // 4)))
+        world.add(small, (-1e5 - s * k, -1e5 + s * (k % 3) * 0.75))
+    got = world.contacts()
+    pairs, states = brute_contacts(world)
+    assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    assert (got.states == 1).any() and (got.states == 2).any()
