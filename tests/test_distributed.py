@@ -179,6 +179,21 @@ def test_time_of_impact_many_errors_name_the_caller_s_index(client, change, erro
         pd.time_of_impact_many(a, ma, b, mb, 1, client=client, chunk_size=0)
 
 
+def test_impact_tasks_send_shapes_of_several_tasks_once():
+    # shape 0 is in every task, shape 1 in the first two, shapes 2.. in one task each
+    sa = np.array([0, 0, 0, 0, 0])
+    sb = np.array([1, 2, 1, 3, 4])
+    uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
+    rows, eps = np.zeros((5, 6)), np.ones(5)
+    shared, tasks = pd._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
+    assert shared.shapes() == [uniq[0], uniq[1]]
+    assert [t[2].shapes() for t in tasks] == [[uniq[2]], [uniq[3]], [uniq[4]]]
+    # a task numbers the shared shapes first, then its own
+    assert [[(shared.shapes() + t[2].shapes())[i] for i in t[1]] for t in tasks] == [
+        [uniq[1], uniq[2]], [uniq[1], uniq[3]], [uniq[4]]]
+    assert [t[0].tolist() for t in tasks] == [[0, 0], [0, 0], [0]]
+
+
 def test_map_batches_keeps_the_order(client):
     out = pd.map_batches(_sum_pairs, np.arange(10), np.arange(10, 20), client=client,
                          chunk_size=3, scale=2)
