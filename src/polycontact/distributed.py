@@ -414,7 +414,7 @@ def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.nd
 def _impact_slice(shared: _ShapePack, task: tuple, t_max: float, method: str, tol: float,
                   samples: int, max_iterations: int, threads: int) -> tuple:
     """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
-    (only the shapes it uses are packed); the raw result arrays."""
+    (only the shapes it uses are packed for the kernel); the raw result arrays."""
     from .impacts import _search
 
     sa, sb, own, rows_a, rows_b, eps_rel = task
@@ -427,15 +427,15 @@ def _impact_slice(shared: _ShapePack, task: tuple, t_max: float, method: str, to
 
 
 class _ShapePack:
-    """Shapes sent to Dask workers as five flat arrays, rebuilt there on first use.
+    """Shapes sent to Dask workers as five flat arrays, unpacked there on first use.
 
     A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
     shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
     send against 1 s of work); here every vertex of every shape is one array. The
-    receiving process rebuilds the shapes from their stored loops (the same
-    construction as :meth:`polycontact.Shape.moved`, hence the same centroid and radius,
-    checked against those sent) once, and keeps them (with the tables the search builds
-    on them) for every later task.
+    receiving process unpacks them once into :class:`_PackedShape` (what the search
+    reads of a shape: its packed loops, centroid and bounding radius, as sent, not
+    recomputed) and keeps them, with the tables the search builds on them, for every
+    later task.
 
     Examples
     --------
@@ -443,8 +443,10 @@ class _ShapePack:
     >>> from polycontact import Shape
     >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
     >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))]))).shapes()
-    >>> [s.area for s in back], back[0].holes[0].tolist() == frame.holes[0].tolist()
-    ([32.0, 32.0], True)
+    >>> back[1].centroid.tolist(), back[1].bounding_radius == frame.bounding_radius
+    ([4.0, 3.0], True)
+    >>> [b.tolist() for b in back[0].packed] == [b.tolist() for b in frame.packed]
+    True
     """
 
     def __init__(self, shapes: Sequence[Any]) -> None:
@@ -453,7 +455,7 @@ class _ShapePack:
             np.concatenate([s.packed[0] for s in shapes]) if n else np.empty((0, 2)),
             np.concatenate([np.diff(s.packed[1]) for s in shapes]) if n
             else np.empty(0, np.int64),
-            np.array([len(s.loops) for s in shapes], dtype=np.int64),
+            np.array([len(s.packed[1]) - 1 for s in shapes], dtype=np.int64),
             np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2),
             np.array([s.bounding_radius for s in shapes], dtype=np.float64),
         )
@@ -467,19 +469,33 @@ class _ShapePack:
         self._shapes = None
 
     def shapes(self) -> list[Any]:
-        """The shapes (rebuilt on the first call in a process that received them)."""
+        """The shapes: those given, or, in a process that received them, unpacked."""
         if self._shapes is None:
-            from .shape import Shape
-
             xy, loop_len, n_loops, cent, rad = self.arrays
-            loops = np.split(xy, np.cumsum(loop_len)[:-1]) if len(loop_len) else []
+            loop_end = np.concatenate([[0], np.cumsum(loop_len)])
             first = np.concatenate([[0], np.cumsum(n_loops)])
-            shapes = [Shape._trusted(loops[first[k]:first[k + 1]]) for k in range(len(rad))]
-            got = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(-1, 2)
-            if not (np.array_equal(got, cent)
-                    and np.array_equal([s.bounding_radius for s in shapes], rad)):
-                raise RuntimeError("shapes rebuilt from their loops differ from those sent "
-                                   "(centroid or radius): the results would not be the "
-                                   "local ones")
+            shapes = []
+            for k in range(len(rad)):
+                ends = loop_end[first[k]:first[k + 1] + 1]
+                shapes.append(_PackedShape(xy[ends[0]:ends[-1]], ends - ends[0],
+                                           cent[k].copy(), float(rad[k])))
             self._shapes = shapes
         return self._shapes
+
+
+class _PackedShape:
+    """What the time-of-impact search reads of a :class:`~polycontact.Shape`
+    (``packed``, ``centroid``, ``bounding_radius``, and the body-frame tables it keeps
+    in ``_frame``), on a worker. Read-only arrays, as a Shape's: the kernels are
+    compiled (and cached) for those types."""
+
+    __slots__ = ("packed", "centroid", "bounding_radius", "_frame")
+
+    def __init__(self, xy: np.ndarray, starts: np.ndarray, centroid: np.ndarray,
+                 radius: float) -> None:
+        for array in (xy, starts, centroid):
+            array.flags.writeable = False
+        self.packed = (xy, starts)
+        self.centroid = centroid
+        self.bounding_radius = radius
+        self._frame: Any = None
