@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 from profiles import examples
 
 from polycontact import Shape, State, classify, classify_many
+from polycontact.tolerances import default_tolerance
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
@@ -283,3 +284,40 @@ def test_integer_arrays_are_still_accepted():
     assert classify(sq.astype(np.uint8), sq.astype(np.int32)).state is State.PENETRATING
     assert classify_many(sq[None], (sq + 2)[None]).states.tolist() == [0]
     assert classify(sq, sq, tolerance=np.int64(0)).tolerance == 0.0
+
+
+def test_prebuilt_shapes_path_matches_the_other_paths():
+    # classify() on two Shapes takes a fast path (cached tolerance, compiled entry point
+    # bound on first use): the same relation as from arrays, with and without a
+    # tolerance, on the first call and after it, and for a Shape subclass
+    class Sub(Shape):
+        __slots__ = ()
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    big = Shape(sq * 1e9 + 1e9)
+    for d, want in (((2.0, 0.0), State.SEPARATE), ((1.0, 0.5), State.CONTACT),
+                    ((0.5, 0.5), State.PENETRATING), ((1.0 + 1e-9, 0.0), State.SEPARATE)):
+        for _ in range(2):
+            a, b = Shape(sq), Shape(sq + d)
+            r = classify(a, b)
+            assert r.state is want and r.state is classify(sq, sq + d).state
+            assert r.tolerance == classify(sq, sq + d).tolerance
+            assert r.tolerance == default_tolerance(a.packed[0], b.packed[0])
+            assert classify(a, b, tolerance=0.1).state is classify(sq, sq + d, tolerance=0.1).state
+            sub = Sub.__new__(Sub)
+            sub._set([np.array(sq + d)], ())
+            sub._input = b._input
+            assert classify(a, sub).state is want
+    # the tolerance of a pair is the larger shape's (not each shape's own)
+    assert classify(Shape(sq), big).tolerance == default_tolerance(sq, big.packed[0])
+    with pytest.raises(ValueError, match="tolerance"):
+        classify(Shape(sq), Shape(sq), tolerance=-1.0)
+
+
+def test_entry_point_falls_back_to_the_dispatcher():
+    from polycontact._dispatch import entry_point
+
+    def plain(x):
+        return x + 1
+
+    assert entry_point(plain, (1,)) is plain  # no compiled overloads: the callable itself
