@@ -321,3 +321,25 @@ def test_entry_point_falls_back_to_the_dispatcher():
         return x + 1
 
     assert entry_point(plain, (1,)) is plain  # no compiled overloads: the callable itself
+
+
+def test_batch_gaps_of_separate_pairs_with_holes_and_long_rings():
+    # classify_many's distances find the gap of a separate pair by trying every vertex
+    # against every edge (small pairs) or by the sorted sweep (long rings): both must
+    # see the holes' edges and agree with Shapely
+    frame = Shape([(0, 0), (10, 0), (10, 10), (0, 10)], [[(2, 2), (8, 2), (8, 8), (2, 8)]])
+    inner = Shape([(3, 3), (6, 3), (6, 5), (3, 5)])               # in the hole, 1 from it
+    t = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    disc = np.c_[np.cos(t), np.sin(t)] * 1.5 + [5.0, 5.0]        # 200 vertices, in the hole
+    far = np.c_[np.cos(t), np.sin(t)] + [20.0, 3.0]
+    pairs = [(frame, inner), (inner, frame), (frame, disc), (disc, frame), (far, frame),
+             (far[::-1].copy(), disc), (inner, inner.moved((0.0, 2.5)))]
+    batch = classify_many([p[0] for p in pairs], [p[1] for p in pairs])
+    assert batch.states.tolist() == [0] * len(pairs)
+    want = [shapely.distance(Shape(a).to_shapely() if not isinstance(a, Shape) else
+                             a.to_shapely(),
+                             Shape(b).to_shapely() if not isinstance(b, Shape) else
+                             b.to_shapely()).item() for a, b in pairs]
+    np.testing.assert_allclose(batch.distances, want, rtol=1e-12)
+    np.testing.assert_allclose(batch.distances, [classify(a, b).distance for a, b in pairs],
+                               rtol=1e-12)
