@@ -321,6 +321,15 @@ def test_entry_point_falls_back_to_the_dispatcher():
         return x + 1
 
     assert entry_point(plain, (1,)) is plain  # no compiled overloads: the callable itself
+    # with the Numba this project pins, the compiled code of a kernel is found (not the
+    # dispatcher) and gives the dispatcher's answer
+    from polycontact._kernels import relation as kr
+
+    a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    args = (*a.packed, *a.moved((0.5, 0.5)).packed, 1e-12)
+    fast = entry_point(kr.relate_state, args)
+    assert (fast is not kr.relate_state) == hasattr(kr.relate_state, "overloads")  # JIT on
+    assert fast(*args) == kr.relate_state(*args) == 2
 
 
 def test_batch_gaps_of_separate_pairs_with_holes_and_long_rings():

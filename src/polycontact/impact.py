@@ -498,7 +498,9 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
     if not _TIME_TOLERANCE:
         from ._kernels.impact import effective_time_tolerance
 
-        _TIME_TOLERANCE.append(effective_time_tolerance.py_func)
+        # the Python function behind the kernel (the kernel itself without the JIT)
+        _TIME_TOLERANCE.append(getattr(effective_time_tolerance, "py_func",
+                                       effective_time_tolerance))
     first_contact = t_contact if t_contact >= 0.0 else None
     state = None
     time = bracket = None
