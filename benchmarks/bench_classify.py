@@ -10,6 +10,11 @@ What is timed (medians of several repeats, peers measured in the same run):
 - 100 000 pairs of 12-gons in one call: ``classify_many`` on a (P, N, 2) array against
   ``shapely.relate`` / ``shapely.intersects`` vectorised on prebuilt polygon arrays (and
   with their construction by ``shapely.polygons`` counted);
+- prebuilt :class:`polycontact.Shape` pairs against prebuilt Shapely polygons with
+  ``shapely.relate`` (a simulation's loop), taking turns every 50 pairs, with the
+  target ratio;
+- signed distances of the 100 000 pairs (``classify_many(...).distances``) against the
+  states alone, and for the separate pairs against ``shapely.distance`` (targets printed);
 - growth from 8 to 1024 vertices;
 - ``python -X importtime -c "import polycontact"``.
 
@@ -117,6 +122,54 @@ def ours(a, b):
     return pc.classify(a, b).state
 
 
+def rounds(fns: dict, pairs: dict, repeats: int, chunk: int = 50) -> tuple[dict, dict]:
+    """Per-pair times (us) of two or more functions, taking turns chunk by chunk
+    (``chunk`` pairs each), ``repeats`` times over all pairs, so that a burst of load on
+    the shared machine hits all of them alike. Returns ``({name: [time per pair of
+    each repeat]}, {name: [time per pair in each chunk]})``; chunk i of every function
+    was measured next to chunk i of the others."""
+    for name, fn in fns.items():
+        fn(*pairs[name][0])
+    count = len(next(iter(pairs.values())))
+    per_repeat: dict = {name: [] for name in fns}
+    per_chunk: dict = {name: [] for name in fns}
+    for _ in range(repeats):
+        total = dict.fromkeys(fns, 0.0)
+        for c0 in range(0, count, chunk):
+            for name, fn in fns.items():
+                part = pairs[name][c0 : c0 + chunk]
+                t0 = time.perf_counter()
+                for a, b in part:
+                    fn(a, b)
+                dt = time.perf_counter() - t0
+                total[name] += dt
+                per_chunk[name].append(dt / len(part) * 1e6)
+        for name in fns:
+            per_repeat[name].append(total[name] / count * 1e6)
+    return per_repeat, per_chunk
+
+
+def ratio_text(num: list, den: list, target: float, at_most: bool = False,
+               quantiles: bool = False) -> str:
+    """``median (spread) x, target: met / met at the median only / not met`` of the
+    ratios num / den (per run, or per chunk); the spread is min-max, or the 10th-90th
+    percentile with ``quantiles`` (many chunks: the extremes are single load bursts).
+    The target is ``>= target`` (``<=`` if ``at_most``); "met" when the whole spread
+    meets it."""
+    r = np.array(num) / np.array(den)
+    med = float(np.median(r))
+    lo, hi = (np.percentile(r, 10), np.percentile(r, 90)) if quantiles else (r.min(), r.max())
+    ok = (lambda x: x <= target) if at_most else (lambda x: x >= target)
+    verdict = ("met" if ok(hi if at_most else lo) else
+               "met at the median only" if ok(med) else "not met")
+    sign = "<=" if at_most else ">="
+    return f"{med:5.2f}x ({lo:.2f}-{hi:.2f})  target {sign} {target:g}x: {verdict}"
+
+
+def spread(ts: list) -> str:
+    return f"{np.median(ts):7.2f} ({min(ts):.2f}-{max(ts):.2f})"
+
+
 def shapely_intersects(a, b):
     return shapely.Polygon(a).intersects(shapely.Polygon(b))
 
@@ -168,6 +221,21 @@ def main() -> None:
         print(f"{n:>8} {t_ours:>10.2f} {t_int:>11.2f} {t_rel:>10.2f} "
               f"{t_int / t_ours:>13.1f} {t_rel / t_ours:>9.1f}")
 
+    print("\nclassify on prebuilt Shapes vs shapely.relate on prebuilt polygons (us per "
+          f"pair, median (min-max) of {2 * repeats + 1} passes over the pairs, the two "
+          "taking turns every 50 pairs; ratio = relate / classify per chunk of 50, median "
+          "(10th-90th percentile))")
+    print(f"{'vertices':>8} {'classify(Shape, Shape)':>24} {'shapely.relate':>22}  ratio")
+    for n, target in ((12, 5.0), (96, 3.0), (1024, 1.0)):
+        pairs = make_pairs(rng, n, 600 if n < 1000 else 100)
+        shapes = [(pc.Shape(a), pc.Shape(b)) for a, b in pairs]
+        geoms = [(shapely.Polygon(a), shapely.Polygon(b)) for a, b in pairs]
+        t, chunks = rounds({"ours": ours, "relate": shapely.relate},
+                           {"ours": shapes, "relate": geoms}, 2 * repeats + 1,
+                           50 if n < 1000 else 10)
+        print(f"{n:>8} {spread(t['ours']):>24} {spread(t['relate']):>22}  "
+              f"{ratio_text(chunks['relate'], chunks['ours'], target, quantiles=True)}")
+
     print("\nclassify_many: 100 000 pairs of 12-gons (seconds)")
     base = make_pairs(rng, 12, 3000)
     idx = rng.integers(0, len(base), 100_000)
@@ -186,6 +254,41 @@ def main() -> None:
     print(f"  shapely.intersects (prebuilt)          {t_int:8.3f}   ratio {t_int / t_many:6.1f}x")
     print(f"  shapely.polygons x2 + relate           {t_build + t_rel:8.3f}   "
           f"ratio {(t_build + t_rel) / t_many:6.1f}x")
+    print("\nsigned distances of the same 100 000 pairs (seconds, median (min-max) of "
+          f"{repeats} runs, each from a fresh classify_many)")
+    states_t, dist_t = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        batch = pc.classify_many(arr_a, arr_b)
+        t1 = time.perf_counter()
+        batch.distances  # noqa: B018 - computed on first access
+        states_t.append(t1 - t0)
+        dist_t.append(time.perf_counter() - t1)
+    totals = [s + d for s, d in zip(states_t, dist_t)]
+    print(f"  states                                  {spread(states_t)}")
+    print(f"  distances (on first access)             {spread(dist_t)}")
+    print(f"  distances / states (per run):          {ratio_text(dist_t, states_t, 3.0, True)}")
+    sep = batch.states == 0
+    sep_a, sep_b = np.ascontiguousarray(arr_a[sep]), np.ascontiguousarray(arr_b[sep])
+    poly_sa, poly_sb = shapely.polygons(sep_a), shapely.polygons(sep_b)
+    ours_sep, ours_sep_total, geos_sep = [], [], []
+    for _ in range(repeats):  # interleaved, fresh batch each time
+        t0 = time.perf_counter()
+        b_sep = pc.classify_many(sep_a, sep_b)
+        t1 = time.perf_counter()
+        b_sep.distances  # noqa: B018
+        t2 = time.perf_counter()
+        shapely.distance(poly_sa, poly_sb)
+        t3 = time.perf_counter()
+        ours_sep.append(t2 - t1)
+        ours_sep_total.append(t2 - t0)
+        geos_sep.append(t3 - t2)
+    print(f"  the {int(sep.sum())} separate pairs: distances {spread(ours_sep)}, with their "
+          f"states {spread(ours_sep_total)}, shapely.distance (prebuilt) {spread(geos_sep)}")
+    print(f"    shapely.distance / distances:          {ratio_text(geos_sep, ours_sep, 5.0)}")
+    print(f"    shapely.distance / (states+distances): {ratio_text(geos_sep, ours_sep_total, 5.0)}")
+    np.testing.assert_allclose(b_sep.distances, shapely.distance(poly_sa, poly_sb),
+                               rtol=1e-9, atol=1e-12)
     many = pc.classify_many(arr_a, arr_b).states[:3000]
     rel = shapely.relate(poly_a[:3000], poly_b[:3000])
     inter = shapely.intersects(poly_a[:3000], poly_b[:3000])

@@ -382,3 +382,33 @@ def test_bad_arguments(kwargs, message):
 def test_motion_must_be_a_motion():
     with pytest.raises(TypeError, match="motion_b"):
         time_of_impact(SQ, Motion(), SQ, (1, 0), t_max=1)
+
+
+def test_impact_result_sets_every_field():
+    # time_of_impact builds its Impact field by field (not through __init__, for speed):
+    # every dataclass field must be there, for every status and both methods, and the
+    # fast path (Shapes and Motions: compiled code called directly) must agree with
+    # the dispatcher's (a Shape subclass)
+    import dataclasses
+
+    class Sub(Shape):
+        __slots__ = ()
+
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    sub = Sub.__new__(Sub)
+    sub._set([np.array(sq.exterior) + [3.0, 0.0]], ())
+    sub._input = sq._input
+    fields = {f.name for f in dataclasses.fields(pc.Impact)}
+    for b, mb, t_max in ((sq.moved((3, 0)), Motion(), 5.0), (sq.moved((3, 0)), Motion(), 1.0),
+                         (sq.moved((0.5, 0)), Motion(), 1.0), (sub, Motion(), 5.0)):
+        for method in ("exact", "sampled"):
+            for _ in range(2):
+                hit = time_of_impact(sq, Motion(velocity=(1, 0)), b, mb, t_max=t_max,
+                                     method=method)
+                assert fields <= set(vars(hit)), fields - set(vars(hit))
+                assert hit == pc.Impact(**{f: getattr(hit, f) for f in fields})
+            if b is sub:
+                ref = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), mb,
+                                     t_max=t_max, method=method)
+                assert (hit.time, hit.status, hit.iterations) == (
+                    ref.time, ref.status, ref.iterations)

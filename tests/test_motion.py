@@ -1,5 +1,6 @@
 """Motion: pose formula, Shape.at, validation."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -35,6 +36,25 @@ def test_array_is_the_kernel_vector():
     m = Motion((1, 2), (3, 4), 5, 6)
     assert m.array.tolist() == [1, 2, 3, 4, 5, 6]
     assert m.array.dtype == np.float64
+
+
+def test_cached_kernel_vector_cannot_go_stale():
+    # the vector is built once per motion (time_of_impact passes it as it is): it is
+    # read-only, and the motion cannot be rebound, so it always says what the fields say
+    m = Motion((1, 2), (3, 4), 5, 6)
+    assert m.array is m.array
+    assert not m.array.flags.writeable
+    with pytest.raises(ValueError):
+        m.array[0] = 9.0
+    assert m._norms == (math.hypot(1, 2), math.hypot(3, 4), 5.0, 6.0)
+    assert Motion(angular_velocity=-2, angular_acceleration=-3)._norms == (0.0, 0.0, 2.0, 3.0)
+    for name in ("velocity", "angular_velocity", "_array", "_norms"):
+        with pytest.raises(AttributeError):
+            setattr(m, name, getattr(m, name))
+    moved = dataclasses.replace(m, velocity=(7, 8))
+    assert moved.array.tolist() == [7, 8, 3, 4, 5, 6] and m.array.tolist()[:2] == [1, 2]
+    assert moved._norms[0] == math.hypot(7, 8)
+    assert m == Motion((1, 2), (3, 4), 5, 6) and hash(m) == hash(Motion((1, 2), (3, 4), 5, 6))
 
 
 @pytest.mark.parametrize(

@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 from profiles import examples
 
 from polycontact import Shape, State, classify, classify_many
+from polycontact.tolerances import default_tolerance
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
@@ -283,3 +284,71 @@ def test_integer_arrays_are_still_accepted():
     assert classify(sq.astype(np.uint8), sq.astype(np.int32)).state is State.PENETRATING
     assert classify_many(sq[None], (sq + 2)[None]).states.tolist() == [0]
     assert classify(sq, sq, tolerance=np.int64(0)).tolerance == 0.0
+
+
+def test_prebuilt_shapes_path_matches_the_other_paths():
+    # classify() on two Shapes takes a fast path (cached tolerance, compiled entry point
+    # bound on first use): the same relation as from arrays, with and without a
+    # tolerance, on the first call and after it, and for a Shape subclass
+    class Sub(Shape):
+        __slots__ = ()
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    big = Shape(sq * 1e9 + 1e9)
+    for d, want in (((2.0, 0.0), State.SEPARATE), ((1.0, 0.5), State.CONTACT),
+                    ((0.5, 0.5), State.PENETRATING), ((1.0 + 1e-9, 0.0), State.SEPARATE)):
+        for _ in range(2):
+            a, b = Shape(sq), Shape(sq + d)
+            r = classify(a, b)
+            assert r.state is want and r.state is classify(sq, sq + d).state
+            assert r.tolerance == classify(sq, sq + d).tolerance
+            assert r.tolerance == default_tolerance(a.packed[0], b.packed[0])
+            assert classify(a, b, tolerance=0.1).state is classify(sq, sq + d, tolerance=0.1).state
+            sub = Sub.__new__(Sub)
+            sub._set([np.array(sq + d)], ())
+            sub._input = b._input
+            assert classify(a, sub).state is want
+    # the tolerance of a pair is the larger shape's (not each shape's own)
+    assert classify(Shape(sq), big).tolerance == default_tolerance(sq, big.packed[0])
+    with pytest.raises(ValueError, match="tolerance"):
+        classify(Shape(sq), Shape(sq), tolerance=-1.0)
+
+
+def test_entry_point_falls_back_to_the_dispatcher():
+    from polycontact._dispatch import entry_point
+
+    def plain(x):
+        return x + 1
+
+    assert entry_point(plain, (1,)) is plain  # no compiled overloads: the callable itself
+    # with the Numba this project pins, the compiled code of a kernel is found (not the
+    # dispatcher) and gives the dispatcher's answer
+    from polycontact._kernels import relation as kr
+
+    a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    args = (*a.packed, *a.moved((0.5, 0.5)).packed, 1e-12)
+    fast = entry_point(kr.relate_state, args)
+    assert (fast is not kr.relate_state) == hasattr(kr.relate_state, "overloads")  # JIT on
+    assert fast(*args) == kr.relate_state(*args) == 2
+
+
+def test_batch_gaps_of_separate_pairs_with_holes_and_long_rings():
+    # classify_many's distances find the gap of a separate pair by trying every vertex
+    # against every edge (small pairs) or by the sorted sweep (long rings): both must
+    # see the holes' edges and agree with Shapely
+    frame = Shape([(0, 0), (10, 0), (10, 10), (0, 10)], [[(2, 2), (8, 2), (8, 8), (2, 8)]])
+    inner = Shape([(3, 3), (6, 3), (6, 5), (3, 5)])               # in the hole, 1 from it
+    t = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    disc = np.c_[np.cos(t), np.sin(t)] * 1.5 + [5.0, 5.0]        # 200 vertices, in the hole
+    far = np.c_[np.cos(t), np.sin(t)] + [20.0, 3.0]
+    pairs = [(frame, inner), (inner, frame), (frame, disc), (disc, frame), (far, frame),
+             (far[::-1].copy(), disc), (inner, inner.moved((0.0, 2.5)))]
+    batch = classify_many([p[0] for p in pairs], [p[1] for p in pairs])
+    assert batch.states.tolist() == [0] * len(pairs)
+    want = [shapely.distance(Shape(a).to_shapely() if not isinstance(a, Shape) else
+                             a.to_shapely(),
+                             Shape(b).to_shapely() if not isinstance(b, Shape) else
+                             b.to_shapely()).item() for a, b in pairs]
+    np.testing.assert_allclose(batch.distances, want, rtol=1e-12)
+    np.testing.assert_allclose(batch.distances, [classify(a, b).distance for a, b in pairs],
+                               rtol=1e-12)

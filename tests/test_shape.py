@@ -13,6 +13,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from polycontact import InvalidShapeError, Shape
+from polycontact.tolerances import default_tolerance
 
 SQUARE = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
 HOLE = [(1.0, 1.0), (1.0, 3.0), (3.0, 3.0), (3.0, 1.0)]
@@ -240,7 +241,7 @@ def test_a_shape_is_immutable():
         with pytest.raises(ValueError):
             arr[0] = 0
     for name in ("repairs", "_xy", "_loops", "_area", "_centroid", "_extent", "_magnitude",
-                 "_starts", "_radius"):
+                 "_tolerance", "_starts", "_radius"):
         with pytest.raises(AttributeError, match="immutable"):
             setattr(s, name, getattr(s, name))
         with pytest.raises(AttributeError, match="immutable"):
@@ -251,6 +252,19 @@ def test_a_shape_is_immutable():
     with pytest.raises(AttributeError):
         s.anything = 1  # __slots__: no new attributes either
     assert s.area == 3.875 and s.moved((1, 0)).area == 3.875
+
+
+@pytest.mark.parametrize("scale, offset", [(1.0, 0.0), (1e-9, 0.0), (1e9, 0.0), (1.0, 1e9),
+                                           (1e-6, -3e5)])
+def test_cached_tolerance_is_the_default_tolerance_of_the_shape(scale, offset):
+    # classify() reads the tolerance cached on each shape; it must be what
+    # default_tolerance computes from the coordinates, for the shape and every shape
+    # made from it (moved, rotated, with holes)
+    s = Shape(np.array([(0, 0), (4, 0), (4, 3), (0, 3)]) * scale + offset,
+              [np.array([(1, 1), (2, 1), (2, 2)]) * scale + offset])
+    for shape in (s, s.moved((5 * scale, -7 * scale), 0.3), s.moved((1e3 * scale, 0))):
+        assert shape._tolerance == default_tolerance(shape.packed[0])
+        assert shape._tolerance == default_tolerance(*shape.loops)
 
 
 @pytest.mark.parametrize(

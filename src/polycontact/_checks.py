@@ -46,6 +46,9 @@ def finite_number(
     decimals, 0-d real arrays); anything else raises ``TypeError`` naming ``what`` and
     the type given: a string is not parsed, a complex number not truncated, and
     ``True`` is not a number here."""
+    if (type(value) is float and value - value == 0.0  # finite: inf - inf and nan are nan
+            and (not positive or value > 0.0) and (minimum is None or value >= minimum)):
+        return value  # the common case, in nanoseconds: a finite float within bounds
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
         value = value[()]
     if not is_real(value):

@@ -15,7 +15,6 @@ no relative motion at all.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -58,14 +57,16 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
     ...
     ValueError: motion_a: the body's coordinates reach 1e+110 within t_max = 1e+50, beyond ±1e+100: products of coordinates would overflow float64
     """
-    cx, cy = shape.centroid
+    cx, cy = shape.centroid.tolist()
     radius = shape.bounding_radius
-    w_max = abs(motion.angular_velocity) + abs(motion.angular_acceleration) * t_max
-    v = math.hypot(*motion.velocity)
-    acc = math.hypot(*motion.acceleration)
-    reach = max(abs(float(cx)), abs(float(cy))) + v * t_max + 0.5 * acc * t_max * t_max + radius
+    v, acc, w, alpha = motion._norms  # |v|, |a|, |ω|, |α|, kept with the motion
+    w_max = w + alpha * t_max
+    reach = max(abs(cx), abs(cy)) + v * t_max + 0.5 * acc * t_max * t_max + radius
     speed = v + acc * t_max + w_max * radius
-    accel = acc + (abs(motion.angular_acceleration) + w_max * w_max) * radius
+    accel = acc + (alpha + w_max * w_max) * radius
+    if reach <= COORDINATE_LIMIT and speed <= COORDINATE_LIMIT and accel <= COORDINATE_LIMIT \
+            and w_max <= COORDINATE_LIMIT:
+        return
     for value, name in ((reach, "coordinates reach"), (speed, "points' speeds reach"),
                         (accel, "points' accelerations reach"), (w_max, "angular speed reaches")):
         if not value <= COORDINATE_LIMIT:

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import finite_number
+from ._dispatch import entry_point
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
 from .relation import Feature, State, classify
@@ -213,9 +214,8 @@ _ULPS = ROUNDING_ULPS * 2.0**-52
 
 def _extent(shape: Shape) -> float:
     """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
-    kept with the shape's body frame (:func:`body_frame`)."""
-    body_frame(shape, tables=False)
-    return shape._frame[2]
+    cached on the shape."""
+    return shape._extent
 
 
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
@@ -410,13 +410,14 @@ def time_of_impact(
     tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
         raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+    if type(samples) is not int and (
+            isinstance(samples, bool) or not isinstance(samples, (int, np.integer))) \
+            or samples < 2:
         raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
+    if type(max_iterations) is not int and (
+            isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))) \
             or max_iterations < 1:
         raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
-
-    from ._kernels import impact as ki
 
     # coordinates (checked once per shape, with its body frame) and motions whose
     # products would overflow float64 are refused
@@ -427,19 +428,43 @@ def time_of_impact(
     check_reach(b, mb, t_max, "motion_b")
     # the size term of the distance tolerance; the kernels add the float spacing of the
     # coordinates at each time they examine (never a bound over all of [0, t_max])
-    eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
+    eps_rel = RELATIVE_TOLERANCE * max(a._extent, b._extent)
     la, lb = a.bounding_radius, b.bounding_radius
+    sa, ca, sb, cb = a.packed[1], a.centroid, b.packed[1], b.centroid
     if exact:
-        out = ki.exact_query(ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1],
-                             b.centroid, mb.array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol,
-                             eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations))
+        args = (ra, sa, ca, ma.array, la, ea, rb, sb, cb, mb.array, lb, eb, t_max,
+                BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb),
+                int(max_iterations))
     else:
-        out = ki.sampled_query(ra, a.packed[1], a.centroid, ma.array, la, rb, b.packed[1],
-                               b.centroid, mb.array, lb, t_max, BROAD_PHASE_INFLATION, tol,
-                               eps_rel, _ULPS, int(samples))
+        args = (ra, sa, ca, ma.array, la, rb, sb, cb, mb.array, lb, t_max,
+                BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples))
+    out = _query(method, args, type(a) is Shape and type(b) is Shape
+                 and type(ma) is Motion and type(mb) is Motion)
     intervals, code, t_hi, t_lo, t_contact, iters, reached = out
     return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
                    float(t_contact), int(iters), float(reached), intervals, t_max, eps_rel, tol)
+
+
+#: The compiled entry points of the query kernels by method (see :func:`_query`).
+_ENTRY: dict[str, Any] = {}
+
+
+def _query(method: str, args: tuple, fixed: bool) -> tuple:
+    """Run the query kernel of ``method`` on ``args``. ``fixed``: the bodies are Shapes
+    and the motions Motions, so every argument has the type it always has (read-only
+    shape and motion arrays, the body-frame tables, Python floats and ints) and the
+    compiled code is called without the dispatcher's type resolution (see
+    :mod:`polycontact._dispatch`); otherwise through the dispatcher."""
+    fast = _ENTRY.get(method if fixed else "")
+    if fast is not None:
+        return fast(*args)
+    from ._kernels import impact as ki
+
+    kernel = ki.exact_query if method == "exact" else ki.sampled_query
+    if not fixed:
+        return kernel(*args)
+    fast = _ENTRY[method] = entry_point(kernel, args)
+    return fast(*args)
 
 
 def body_frame(shape: Shape, tables: bool = True,
@@ -450,7 +475,10 @@ def body_frame(shape: Shape, tables: bool = True,
     is immutable), so that repeated queries on one shape build them once. On first
     use the coordinates are also checked (:func:`polycontact.tolerances.check_range`,
     the error naming ``what``) and the shape's extent kept (see :func:`_extent`)."""
-    r, tab, extent = shape._frame if shape._frame is not None else (None, None, 0.0)
+    frame = shape._frame
+    if frame is not None and (frame[1] is not None or not tables):
+        return frame[0], frame[1]
+    r, tab, extent = frame if frame is not None else (None, None, 0.0)
     if r is None:
         xy = shape.packed[0]
         check_range(xy, what)
@@ -467,8 +495,12 @@ def body_frame(shape: Shape, tables: bool = True,
 
 def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
             t_max, eps_rel, tol) -> Impact:
-    from ._kernels.impact import effective_time_tolerance
+    if not _TIME_TOLERANCE:
+        from ._kernels.impact import effective_time_tolerance
 
+        # the Python function behind the kernel (the kernel itself without the JIT)
+        _TIME_TOLERANCE.append(getattr(effective_time_tolerance, "py_func",
+                                       effective_time_tolerance))
     first_contact = t_contact if t_contact >= 0.0 else None
     state = None
     time = bracket = None
@@ -481,17 +513,25 @@ def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached,
         state = State.CONTACT
     if status is ImpactStatus.NO_HIT:
         reached = t_max
-    return Impact(
-        collides=status is ImpactStatus.HIT,
-        time=time,
-        first_contact=first_contact,
-        state=state,
-        status=status,
-        method=method,
-        broad_phase=tuple(map(tuple, intervals.tolist())),
-        time_bracket=bracket,
-        iterations=iters,
-        searched_to=reached,
-        time_tolerance=float(effective_time_tolerance(tol, time if time is not None else reached)),
-        _bodies=(a, ma, b, mb, eps_rel),
-    )
+    # Built field by field, as the frozen dataclass's __init__ would (at a fraction of
+    # its cost per query); the tests check that every field is set.
+    out = _new(Impact)
+    d = out.__dict__
+    d["collides"] = status is ImpactStatus.HIT
+    d["time"] = time
+    d["first_contact"] = first_contact
+    d["state"] = state
+    d["status"] = status
+    d["method"] = method
+    d["broad_phase"] = tuple(map(tuple, intervals.tolist()))
+    d["time_bracket"] = bracket
+    d["iterations"] = iters
+    d["searched_to"] = reached
+    # (the kernel's formula, run in Python: the same float operations)
+    d["time_tolerance"] = float(_TIME_TOLERANCE[0](tol, time if time is not None else reached))
+    d["_bodies"] = (a, ma, b, mb, eps_rel)
+    return out
+
+
+_new = object.__new__
+_TIME_TOLERANCE: list[Any] = []  # [the kernel's effective_time_tolerance, as Python]

@@ -71,6 +71,15 @@ class Motion:
             "angular_acceleration",
             finite_number(self.angular_acceleration, "angular_acceleration"),
         )
+        # the kernel vector, built once: a time-of-impact query passes it as it is
+        vector = np.array([*self.velocity, *self.acceleration, self.angular_velocity,
+                           self.angular_acceleration], dtype=np.float64)
+        vector.flags.writeable = False
+        object.__setattr__(self, "_array", vector)
+        # |v|, |a|, |ω|, |α|: what the reach check of every query reads
+        object.__setattr__(self, "_norms", (
+            math.hypot(*self.velocity), math.hypot(*self.acceleration),
+            abs(self.angular_velocity), abs(self.angular_acceleration)))
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
         """``(translation, angle)`` at time ``t``: centroid displacement and rotation.
@@ -87,9 +96,6 @@ class Motion:
 
     @property
     def array(self) -> np.ndarray:
-        """The motion as the kernel vector ``[vx, vy, ax, ay, ω, α]`` (float64)."""
-        return np.array(
-            [*self.velocity, *self.acceleration, self.angular_velocity,
-             self.angular_acceleration],
-            dtype=np.float64,
-        )
+        """The motion as the kernel vector ``[vx, vy, ax, ay, ω, α]`` (float64,
+        read-only: built once with the motion, which is immutable)."""
+        return self._array

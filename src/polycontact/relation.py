@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import finite_number
+from ._dispatch import entry_point
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
 from .tolerances import (
@@ -37,7 +38,6 @@ from .tolerances import (
     EXTENT_FLOOR,
     RELATIVE_TOLERANCE,
     ROUNDING_ULPS,
-    tolerance_for,
 )
 
 __all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many"]
@@ -308,9 +308,8 @@ _RAW: list[Any] = []  # [classify_raw], bound on first use
 _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
-def _shapes_tolerance(sa: Shape, sb: Shape) -> float:
-    """:func:`polycontact.default_tolerance` of two shapes, from what each cached."""
-    return tolerance_for(max(sa._extent, sb._extent), max(sa._magnitude, sb._magnitude))
+_STATE: list[Any] = []  # [relate_state's entry point for two Shapes], bound on first use
+_new = object.__new__
 
 
 def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
@@ -350,6 +349,21 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
     >>> round(classify(sq, sq + [0.75, 0.5]).distance, 12)
     -0.25
     """
+    if type(a) is Shape and type(b) is Shape and _STATE:
+        # Prebuilt shapes (a simulation's loop), the fastest path: the tolerance is
+        # cached on each shape and the state kernel is called without the dispatcher's
+        # type resolution (the shapes' read-only arrays have fixed types: see
+        # polycontact._dispatch).
+        if tolerance is None:
+            eps = a._tolerance if a._tolerance > b._tolerance else b._tolerance
+        else:
+            eps = _check_tolerance(tolerance)
+        obj = _new(Relation)
+        d = obj.__dict__
+        d["state"] = _STATES[_STATE[0](a._xy, a._starts, b._xy, b._starts, eps)]
+        d["tolerance"] = eps
+        d["_pair"] = (a, b)
+        return obj
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     if (
         type(a) is _ND
@@ -374,13 +388,16 @@ def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
             return obj
     sa = as_shape(a, "a")
     sb = as_shape(b, "b")
-    xa, pa = sa.packed
-    xb, pb = sb.packed
-    eps = _shapes_tolerance(sa, sb) if tol < 0.0 else tol
-    obj = object.__new__(Relation)
-    obj.__dict__.update(
-        state=_STATES[_kr().relate_state(xa, pa, xb, pb, eps)], tolerance=eps, _pair=(sa, sb)
-    )
+    eps = (sa._tolerance if sa._tolerance > sb._tolerance else sb._tolerance) if tol < 0.0 \
+        else tol
+    if not _STATE:
+        _STATE.append(entry_point(_kr().relate_state, (sa._xy, sa._starts, sb._xy, sb._starts,
+                                                       eps)))
+    obj = _new(Relation)
+    d = obj.__dict__
+    d["state"] = _STATES[_STATE[0](sa._xy, sa._starts, sb._xy, sb._starts, eps)]
+    d["tolerance"] = eps
+    d["_pair"] = (sa, sb)
     return obj
 
 

@@ -29,6 +29,7 @@ from .tolerances import (
     VALIDATION_ULPS,
     check_range,
     default_tolerance,
+    tolerance_for,
     validation_tolerance,
 )
 
@@ -151,7 +152,7 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_input")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -245,6 +246,9 @@ class Shape:
         )
         self._extent = extent
         self._magnitude = magnitude
+        # default_tolerance of this shape alone; of a pair, the larger of the two (the
+        # rule is a max of terms that grow with the extent and the magnitude)
+        self._tolerance = tolerance_for(extent, magnitude)
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
