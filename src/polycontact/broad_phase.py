@@ -22,7 +22,8 @@ import numpy as np
 
 from ._checks import finite_number
 from .motion import Motion
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import COORDINATE_LIMIT, check_range
 
 __all__ = ["broad_phase_intervals", "BROAD_PHASE_INFLATION"]

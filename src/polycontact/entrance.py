@@ -36,7 +36,8 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ._checks import point as point_arg
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import default_tolerance
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]

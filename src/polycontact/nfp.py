@@ -45,7 +45,8 @@ import shapely.affinity
 from ._checks import finite_number
 from ._checks import point as point_arg
 from .errors import InvalidShapeError
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]

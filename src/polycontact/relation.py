@@ -31,7 +31,8 @@ import numpy as np
 
 from ._checks import finite_number
 from .errors import InvalidShapeError
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,

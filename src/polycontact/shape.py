@@ -32,7 +32,7 @@ from .tolerances import (
     validation_tolerance,
 )
 
-__all__ = ["Shape", "as_shape"]
+__all__ = ["Shape"]
 
 ArrayLike = Any
 
@@ -519,20 +519,6 @@ class Shape:
     def __repr__(self) -> str:
         holes = f", {len(self.holes)} hole(s)" if self.holes else ""
         return f"<Shape {len(self.exterior)} vertices{holes}, area {self._area:g}>"
-
-
-def as_shape(obj: Any, what: str = "shape") -> Shape:
-    """Coerce a Shape, a shapely Polygon or an (N, 2) array-like to a :class:`Shape`."""
-    if isinstance(obj, Shape):
-        return obj
-    if hasattr(obj, "geom_type"):
-        return Shape.from_shapely(obj)
-    try:
-        return Shape(obj)
-    except InvalidShapeError as exc:
-        raise InvalidShapeError(f"{what}: {exc}") from None
-    except TypeError as exc:  # coordinates that are not real numbers
-        raise TypeError(f"{what}: {exc}") from None
 
 
 def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

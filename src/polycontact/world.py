@@ -39,7 +39,8 @@ from ._checks import finite_number
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_tolerance
 
 __all__ = ["World", "WorldBody", "Contacts", "Query"]

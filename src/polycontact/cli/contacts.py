@@ -37,7 +37,7 @@ def add_parser(subparsers: Any) -> None:
 def read_layout(path: str) -> tuple[Any, list, list[str]]:
     """(container Shape or None, bodies, names) of a layout file; errors name the file
     and the entry."""
-    from ..shape import Shape
+    from ..bodies import as_shape
 
     try:
         data = json.loads(Path(path).read_text())
@@ -53,20 +53,19 @@ def read_layout(path: str) -> tuple[Any, list, list[str]]:
     container = None
     try:
         if data.get("container") is not None:
-            c = data["container"]
-            container = (Shape(c["vertices"], c.get("holes", ())) if isinstance(c, dict)
-                         else Shape(c))
-    except (InvalidShapeError, KeyError, TypeError) as exc:
-        raise CommandError(f"{path}: container: {exc}") from None
+            container = as_shape(data["container"], f"{path}: container")
+    except (InvalidShapeError, TypeError) as exc:
+        raise CommandError(str(exc)) from None
     bodies, names = [], []
     for k, e in enumerate(entries):
         where = f"{path}: body {k}"
         if not isinstance(e, dict) or "vertices" not in e:
             raise CommandError(f"{where}: expected an object with 'vertices'")
         try:
-            bodies.append(Shape(e["vertices"], e.get("holes", ())))
-        except InvalidShapeError as exc:
-            raise CommandError(f"{where}: {exc}") from None
+            bodies.append(as_shape({"vertices": e["vertices"], "holes": e.get("holes", [])},
+                                   where))
+        except (InvalidShapeError, TypeError) as exc:
+            raise CommandError(str(exc)) from None
         label = e.get("name", e.get("item"))
         names.append(f"{k}" if label is None else f"{k} ({label})")
     return container, bodies, names

@@ -8,7 +8,8 @@ import numpy as np
 
 from ..impact import Impact
 from ..motion import Motion
-from ..shape import Shape, as_shape
+from ..bodies import as_shape
+from ..shape import Shape
 from ._style import label_axes, legend_outside
 
 __all__ = ["plot_impact"]
