@@ -521,7 +521,7 @@ def _pack(items: Any, what: str) -> tuple:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
-        raise InvalidShapeError(
+        raise TypeError(
             f"{what}: expected a sequence of bodies or an array of shape (P, N, 2), "
             f"got {type(items).__name__}"
         )

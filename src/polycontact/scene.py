@@ -70,7 +70,8 @@ class Scene:
 
     @classmethod
     def from_dict(cls, data: Any, *, repair: bool = False) -> Scene:
-        """Build a scene from parsed JSON; ``repair`` is passed to :func:`~polycontact.bodies.as_shape`."""
+        """Build a scene from parsed JSON (lists or tuples); ``repair`` is passed to
+        :func:`~polycontact.bodies.as_shape`."""
         if not isinstance(data, dict):
             raise InvalidSceneError(f"expected a JSON object, got {type(data).__name__}")
         _no_unknown(data, _TOP_KEYS, "")
@@ -204,13 +205,14 @@ def _number(value: Any, what: str) -> float:
 
 
 def _vector(value: Any, what: str) -> tuple[float, float]:
-    if not isinstance(value, list) or len(value) != 2:
-        raise InvalidSceneError(f"{what}: expected [x, y], got {json.dumps(value)}")
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        got = json.dumps(value, default=repr)
+        raise InvalidSceneError(f"{what}: expected [x, y], got {got}")
     return _number(value[0], f"{what}[0]"), _number(value[1], f"{what}[1]")
 
 
 def _ring(value: Any, what: str) -> list[tuple[float, float]]:
-    if not isinstance(value, list):
+    if not isinstance(value, (list, tuple)):
         raise InvalidSceneError(f"{what}: expected a list of [x, y] points")
     return [_vector(p, f"{what}[{i}]") for i, p in enumerate(value)]
 
