@@ -29,6 +29,7 @@ tolerance grid (``grid_size``), which is robust where floating-point overlay is 
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, NamedTuple
@@ -192,6 +193,54 @@ class EntranceBlock:
     def area(self) -> float:
         """Area of the entrance block."""
         return float(self._union.area)
+
+    @property
+    def __geo_interface__(self) -> dict[str, Any]:
+        """The entrance block as a GeoJSON-like (Multi)Polygon mapping (the union,
+        :meth:`to_shapely`), for Shapely, GeoPandas and other geometry libraries."""
+        return dict(self._union.__geo_interface__)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The entrance block as a JSON-ready dict: the object
+        ``polycontact entrance-block --json`` prints.
+
+        Keys ``method``, ``reference`` (a0 as ``[x, y]``), ``components`` (the count of
+        each family, "A2-B0", "A0-B2", "A1-B1"), ``zero_width_components``, ``area``,
+        ``region`` (GeoJSON of :meth:`to_shapely`) and ``relation`` (the
+        :meth:`Relation.to_dict` of A and B at a0).
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> d = pc.entrance_block(a, a.moved((3, 0))).to_dict()
+        >>> d["components"], d["area"], d["relation"]["state"]
+        ({'A2-B0': 4, 'A0-B2': 4, 'A1-B1': 4}, 4.0, 'separate')
+        """
+        import shapely
+
+        return {
+            "method": self.method,
+            "reference": [float(v) for v in self.reference],
+            "components": {f: len(self.of_family(f)) for f in ("A2-B0", "A0-B2", "A1-B1")},
+            "zero_width_components": sum(c.is_degenerate for c in self.components),
+            "area": self.area,
+            "region": json.loads(shapely.to_geojson(self._union)),
+            "relation": self.classify(self.reference).to_dict(),
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw the entrance block; returns the matplotlib Axes of E(A, B).
+
+        Without ``ax``, the four panels of :func:`polycontact.plotting.plot_entrance_block`
+        (one per family, then the union) and the union's Axes is returned; with ``ax``,
+        only the union panel: B, A, E(A, B) with its outline and a0.
+        """
+        from .plotting.entrance_block import plot_entrance_block, plot_union
+
+        if ax is None:
+            return plot_entrance_block(self).axes[3]
+        return plot_union(self, ax)
 
     def classify(self, point: Any, *, tolerance: float | None = None) -> Any:
         """Relation of A, moved so that its reference point is at ``point``, to B.

@@ -186,6 +186,68 @@ class Impact:
         """Unit contact normal at the moment of impact, from A towards B."""
         return self._details[2]
 
+    def to_dict(self, names: tuple[str, str] = ("a", "b")) -> dict[str, Any]:
+        """The impact as a JSON-ready dict: the object ``polycontact collide --json``
+        prints.
+
+        Parameters
+        ----------
+        names : (str, str), default ("a", "b")
+            The names of A and B: ``pair``, and each feature's ``body`` and
+            ``other_body``.
+
+        Returns
+        -------
+        dict
+            Every attribute of the class (``state`` and ``status`` as their values,
+            ``point`` and ``normal`` as ``[x, y]`` or None), ``features`` (each as
+            :meth:`Feature.to_dict` with the body names) and ``pair``.
+
+        Examples
+        --------
+        >>> import json
+        >>> from polycontact import Motion, Shape, time_of_impact
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(), t_max=5)
+        >>> d = hit.to_dict(("red", "blue"))
+        >>> d["status"], round(d["time"], 3), d["pair"], d["features"][0]["other_body"]
+        ('hit', 2.0, ['red', 'blue'], 'blue')
+        >>> json.loads(json.dumps(d)) == d
+        True
+        """
+        own = {"a": tuple(names), "b": (names[1], names[0])}
+        features = []
+        for f in self.features:
+            item = f.to_dict()
+            item["body"], item["other_body"] = own[f.body]
+            features.append(item)
+        return {
+            "collides": self.collides,
+            "time": self.time,
+            "first_contact": self.first_contact,
+            "state": None if self.state is None else self.state.value,
+            "features": features,
+            "point": None if self.point is None else [float(v) for v in self.point],
+            "normal": None if self.normal is None else [float(v) for v in self.normal],
+            "method": self.method,
+            "broad_phase": [list(iv) for iv in self.broad_phase],
+            "status": self.status.value,
+            "pair": list(names),
+            "time_bracket": None if self.time_bracket is None else list(self.time_bracket),
+            "time_tolerance": self.time_tolerance,
+            "iterations": self.iterations,
+            "searched_to": self.searched_to,
+        }
+
+    def plot(self, ax: Any = None, *, names: tuple[str, str] = ("A", "B")) -> Any:
+        """Draw both bodies at t = 0 and at the event, their centroid paths and the
+        contact; returns the matplotlib Axes (see
+        :func:`polycontact.plotting.plot_impact`)."""
+        from .plotting.impact import plot_impact
+
+        a, ma, b, mb, _ = self._bodies
+        return plot_impact(a, ma, b, mb, self, names=names, ax=ax)
+
 
 def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi: float,
                   eps_rel: float) -> tuple[float, float]:

@@ -141,6 +141,48 @@ class NoFitPolygon:
         """The region's boundary (every ring) as a shapely geometry."""
         return self.region.boundary
 
+    @property
+    def __geo_interface__(self) -> dict[str, Any]:
+        """The region as a GeoJSON-like (Multi)Polygon mapping, for Shapely, GeoPandas
+        and other geometry libraries (exact fits and slides are in :meth:`to_dict`)."""
+        return dict(self.region.__geo_interface__)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The no-fit polygon as a JSON-ready dict: the object ``polycontact nfp --json``
+        prints.
+
+        Keys ``reference`` (``[x, y]``), ``region`` (GeoJSON), ``area``, ``holes`` (their
+        number), ``exact_fits`` (``[[x, y], ...]``), ``slides`` (``[[[x0, y0], [x1, y1]],
+        ...]``) and ``tolerance``.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> d = pc.no_fit_polygon(sq, sq.moved((3, 0))).to_dict()
+        >>> d["area"], d["holes"], d["region"]["type"]
+        (4.0, 0, 'Polygon')
+        """
+        import json
+
+        return {
+            "reference": self.reference.tolist(),
+            "region": json.loads(shapely.to_geojson(self.region)),
+            "area": float(self.region.area),
+            "holes": sum(len(g.interiors) for g in shapely.get_parts(self.region)),
+            "exact_fits": self.exact_fits.tolist(),
+            "slides": self.slides.tolist(),
+            "tolerance": float(self.tolerance),
+        }
+
+    def plot(self, ax: Any = None, *, placement: Any = None) -> Any:
+        """Draw B, the region with its holes, exact fits and slides, and A at
+        ``placement``; returns the matplotlib Axes (see
+        :func:`polycontact.plotting.plot_nfp`)."""
+        from .plotting.nfp import plot_nfp
+
+        return plot_nfp(self, placement, ax)
+
 
 def no_fit_polygon(
     a: Any, b: Any, reference: Any = None, *, tolerance: float | None = None

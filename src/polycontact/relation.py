@@ -102,6 +102,21 @@ class Feature:
     kind: str
     own_edge: int | None = None
 
+    def to_dict(self) -> dict[str, Any]:
+        """The feature as a JSON-ready dict (``own_edge`` only for an edge crossing).
+
+        Examples
+        --------
+        >>> Feature("a", 0, 2, 0, 1, "vertex-on-edge").to_dict()
+        {'body': 'a', 'loop': 0, 'vertex': 2, 'other_loop': 0, 'edge': 1, 'kind': 'vertex-on-edge'}
+        """
+        out: dict[str, Any] = {"body": self.body, "loop": self.loop, "vertex": self.vertex,
+                               "other_loop": self.other_loop, "edge": self.edge,
+                               "kind": self.kind}
+        if self.own_edge is not None:
+            out["own_edge"] = self.own_edge
+        return out
+
 
 @dataclass(frozen=True, eq=False)
 class Relation:
@@ -145,6 +160,59 @@ class Relation:
     def __repr__(self) -> str:
         # Only what is already decided: the lazy parts (a depth can be costly) stay lazy.
         return f"Relation(state={self.state.value!r}, tolerance={self.tolerance:g})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The relation as a JSON-ready dict: the object ``polycontact classify --json``
+        prints.
+
+        Keys ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
+        ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``. Only what is
+        returned is computed: separate bodies have no features (nothing touches), so
+        their feature search is skipped.
+
+        Examples
+        --------
+        >>> import json
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> d = classify(sq, [(1, 0), (2, 0), (2, 1), (1, 1)]).to_dict()
+        >>> d["state"], len(d["features"]), d["normal"]
+        ('contact', 8, [1.0, 0.0])
+        >>> json.loads(json.dumps(d)) == d
+        True
+        """
+        features = () if self.state is State.SEPARATE else self.features
+        return {
+            "state": self.state.value,
+            "distance": float(self.distance),
+            "features": [f.to_dict() for f in features],
+            "point": _xy(self.point),
+            "normal": _xy(self.normal),
+            "tolerance": float(self.tolerance),
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw both bodies, the witness point and the normal; returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, it is imported
+            only here: ``pip install polycontact[plot]``).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> ax = classify(sq, [(1, 0), (2, 0), (2, 1), (1, 1)]).plot()
+        >>> ax.get_title()
+        'contact, distance 0'
+        """
+        from .plotting.relation import plot_relation
+
+        return plot_relation(self, ax=ax)
 
     @cached_property
     def shapes(self) -> tuple[Shape, Shape]:
@@ -263,6 +331,11 @@ class Relation:
                 if best is None or score > best[0]:
                     best = (score, n)
         return None if best is None else best[1]
+
+
+def _xy(p: np.ndarray | None) -> list[float] | None:
+    """A point or vector as a JSON-ready ``[x, y]`` (None stays None)."""
+    return None if p is None else [float(v) for v in p]
 
 
 def _local(starts: np.ndarray, g: int) -> tuple[int, int]:

@@ -107,6 +107,10 @@ class Contacts:
     container_ids, container_states : ndarray of shape (M,)
         Bodies that touch the container's boundary (1) or leave it / enter a hole (2);
         empty without a container.
+    ids : ndarray of shape (N,), int64
+        Every body of the world when asked, sorted.
+    container : Shape or None
+        The world's container.
     """
 
     pairs: np.ndarray
@@ -116,6 +120,8 @@ class Contacts:
     container_states: np.ndarray
     _store: tuple = field(repr=False)  # the coordinates as they were
     _tolerance: float | None = field(repr=False)
+    ids: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64), repr=False)
+    container: Shape | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.states)
@@ -135,6 +141,65 @@ class Contacts:
     def penetrating(self) -> np.ndarray:
         """The pairs that penetrate, (P, 2)."""
         return self.pairs[self.states == 2]
+
+    def shape(self, id: int) -> Shape:
+        """The Shape of body ``id`` as it was when the contacts were found."""
+        _, _, lo, nl = self._store
+        if id not in set(self.ids.tolist()):
+            raise IndexError(f"id: no body {id} among the contacts' bodies")
+        return _stored_shape(self._store[0], self._store[1], int(lo[id]), int(nl[id]))
+
+    def to_dict(self, names: Any = None) -> dict[str, Any]:
+        """The contacts as a JSON-ready dict: the object ``polycontact contacts --json``
+        prints.
+
+        Parameters
+        ----------
+        names : sequence or mapping of str, optional
+            A name for each body id (``names[id]``); default the id as text.
+
+        Returns
+        -------
+        dict
+            ``bodies`` (their number), ``container`` (whether there is one),
+            ``contacts`` (per pair: ids ``a``, ``b``, their ``names``, ``state``
+            ``"contact"`` or ``"penetrating"``, witness ``point``) and
+            ``container_contacts`` (per body: ``body``, ``name``, ``state``
+            ``"contact"`` or ``"outside"``).
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> w = pc.World()
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> ids = [w.add(sq), w.add(sq, position=(1.5, 0.5))]
+        >>> w.contacts().to_dict()["contacts"]
+        [{'a': 0, 'b': 1, 'names': ['0', '1'], 'state': 'contact', 'point': [1.0, 0.0]}]
+        """
+        def name(i: int) -> str:
+            return str(i) if names is None else str(names[i])
+
+        pairs = []
+        for k, (i, j) in enumerate(self.pairs.tolist()):
+            point = self.relation(k).point
+            pairs.append({"a": i, "b": j, "names": [name(i), name(j)],
+                          "state": "contact" if self.states[k] == 1 else "penetrating",
+                          "point": None if point is None else [float(v) for v in point]})
+        container = [{"body": i, "name": name(i), "state": "contact" if s == 1 else "outside"}
+                     for i, s in zip(self.container_ids.tolist(),
+                                     self.container_states.tolist())]
+        return {"bodies": len(self.ids), "container": self.container is not None,
+                "contacts": pairs, "container_contacts": container}
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw the bodies (penetrating ones red, those leaving the container orange),
+        the container, the contact points and penetrations; returns the matplotlib Axes.
+
+        See :func:`polycontact.plotting.plot_contacts`.
+        """
+        from .plotting.world import plot_contacts
+
+        return plot_contacts(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -605,7 +670,7 @@ class World:
         self._shared = True
         store = (self._xy, self._ls, self._lo.copy(), self._nl.copy())
         return Contacts(pairs, states, used, c_ids, c_states, store,
-                        None if tolerance is None else tol)
+                        None if tolerance is None else tol, alive, self._container)
 
     def query(self, shape: Any, position: Any = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
