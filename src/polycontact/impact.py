@@ -109,7 +109,7 @@ class Impact:
         How far in time the search got (t_max when it finished).
     time_tolerance : float
         The time tolerance honoured: the one asked for, or what float64 resolves at
-        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · |t|, when that is
+        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · abs(t), when that is
         larger. ``time`` is within it after the first penetration.
     features : tuple of Feature
         At the touching configuration: which vertex of which body meets which edge of
@@ -321,9 +321,71 @@ def time_of_impact(
 ) -> Impact:
     """First time at which two moving bodies penetrate, and where they meet.
 
-    Both methods search only the broad-phase intervals
-    (:func:`polycontact.broad_phase_intervals`, paper Eq. 5).
+    Both bodies move rigidly over [0, ``t_max``] (:class:`Motion`: velocity,
+    acceleration, spin and angular acceleration about the area centroid). Only the
+    broad-phase intervals (:func:`polycontact.broad_phase_intervals`, paper Eq. 5) are
+    searched. ``method="exact"`` (default) is continuous and cannot miss a penetration
+    deeper than the contact resolution; ``method="sampled"`` is the paper's §3 and can
+    tunnel. Lengths and times are in any consistent units (those of the coordinates
+    and of the motions); the contract, the proof and the tolerances are under Notes.
 
+    Parameters
+    ----------
+    a, b : body
+        The bodies at t = 0, holes allowed, in any form :func:`polycontact.bodies.as_shape`
+        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, body mapping, WKT, WKB).
+    motion_a, motion_b : Motion
+        Their motions about their area centroids.
+    t_max : float
+        End of the time window searched, in the motions' time unit: the search covers
+        [0, ``t_max``]; a number >= 0.
+    method : {"exact", "sampled"}
+        "exact": conservative advancement, never tunnels (see Notes). "sampled": the
+        paper's §3 steps 3–6, ``samples`` points per round.
+    time_tolerance : float
+        Accuracy of ``time`` (the paper's threshold, 1e-4); any value > 0. Below what
+        float64 resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there,
+        and the result's ``time_tolerance`` says so.
+    samples : int
+        Points per round of the sampled method (>= 2); ignored by "exact".
+    max_iterations : int
+        Budget of the exact method; when spent, the status is OUT_OF_ITERATIONS (no
+        verdict), never a hang.
+
+    Returns
+    -------
+    Impact
+        ``collides``, ``time``, ``first_contact``, ``status``, and at the event the
+        ``features``, ``point`` and ``normal``.
+
+    Raises
+    ------
+    TypeError
+        A body, a motion or a number of the wrong type (the message names it).
+    ValueError
+        An invalid body (:class:`~polycontact.InvalidShapeError`), a bad ``t_max``,
+        ``time_tolerance``, ``method``, ``samples`` or ``max_iterations``, or
+        coordinates, speeds or accelerations that would overflow float64 within
+        [0, ``t_max``] (see ``tolerances.COORDINATE_LIMIT``).
+
+    Examples
+    --------
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                      t_max=5)
+    >>> hit.collides, abs(hit.time - 2.0) < 1e-4, hit.status.value
+    (True, True, 'hit')
+    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((1.9, 1)), Motion(),
+    ...                        t_max=1)                     # slides along from t = 0.9
+    >>> slide.collides, round(slide.first_contact, 4), slide.state.value
+    (False, 0.9, 'contact')
+    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
+    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
+    (True, True)
+
+    Notes
+    -----
     ``method="sampled"`` is the paper's §3 steps 3–6, literally: n = ``samples`` time
     points over [T1, T2] including both ends (spacing (T2 − T1)/(n − 1)), the first
     penetrating one t0, the new interval [t0 − (T2 − T1)/n, t0], until it is shorter
@@ -336,14 +398,14 @@ def time_of_impact(
 
     ``method="exact"`` (default) is continuous, by conservative advancement.
     Why it cannot skip a contact: a point p of A moves as
-    p(t) = c_A(t) + R(θ_A(t)) r with |r| ≤ L_A, so for points p of A and q of B
+    p(t) = c_A(t) + R(θ_A(t)) r with ‖r‖ ≤ L_A, so for points p of A and q of B
 
-        |ṗ − q̇| ≤ |Δv + Δa t| + |ω_A + α_A t| L_A + |ω_B + α_B t| L_B =: s(t),
+        ‖ṗ − q̇‖ ≤ ‖Δv + Δa t‖ + abs(ω_A + α_A t) L_A + abs(ω_B + α_B t) L_B =: s(t),
 
     and each term is the norm of an affine function of t, so its maximum S over a
     window [t, t + H] is at an end of the window (accelerations included, however
     many turns the bodies make). The distance d(t) between the boundaries is a minimum
-    of distances |p(t) − q(t)| of material points, hence S-Lipschitz on the window:
+    of distances ‖p(t) − q(t)‖ of material points, hence S-Lipschitz on the window:
     the boundaries cannot meet before t + d(t)/S, and interiors cannot begin to overlap
     without the boundaries meeting (at the first overlap the boundaries touch). So
     each step min(H, d/S) lands no later than the first contact. The step actually
@@ -354,7 +416,7 @@ def time_of_impact(
     second-order bound: along its fixed normal n (from the nearest point of e to p),
     dist(p, e) ≥ min over the ends x of e of n·(p − x) (a straight edge lies between
     its ends), and each n·(p − x) has its slope now known exactly (the velocities at t)
-    and its second derivative bounded by |Δa| + (|α_A| + ω_A²)|r_p| + (|α_B| + ω_B²)|r_x|
+    and its second derivative bounded by ‖Δa‖ + (abs(α_A) + ω_A²)‖r_p‖ + (abs(α_B) + ω_B²)‖r_x‖
     over the window (p̈ = a + (α J − ω²) R r for a point of a turning body), so it
     stays positive until the first root of g + r τ − K τ²/2; when p is outside the
     edge's line, its distance to the line turning with e's body (in that body's frame,
@@ -383,11 +445,11 @@ def time_of_impact(
     **Tolerances are local to the time examined**, never scaled by ``t_max`` or by the
     length of the travel: at time t the distance tolerance is
     ``tolerance_for(extent, magnitude)`` (:mod:`polycontact.tolerances`) with the
-    bodies' size and a bound of their |coordinates| over the step; the contact
+    bodies' size and a bound of their absolute coordinates over the step; the contact
     resolution is λ = max(:data:`CONTACT_RESOLUTION` · (L_A + L_B), 128 · eps,
-    S · 4 · 2⁻⁵² · |t|) (well above the rounding of the coordinates, and at least the
+    S · 4 · 2⁻⁵² · abs(t)) (well above the rounding of the coordinates, and at least the
     distance moved in one float step of t); the time tolerance used at t is
-    max(``time_tolerance``, 4 · 2⁻⁵² · |t|) — a tolerance float64 cannot resolve at t is
+    max(``time_tolerance``, 4 · 2⁻⁵² · abs(t)) — a tolerance float64 cannot resolve at t is
     clamped there, and :attr:`Impact.time_tolerance` says which one was honoured.
 
     **Contract** (``method="exact"``): whatever the speed, spin, acceleration, travel
@@ -426,44 +488,6 @@ def time_of_impact(
     contact that lasts while the bodies turn), the touch is stepped through by probes;
     the number of iterations is bounded by ``max_iterations`` (status
     OUT_OF_ITERATIONS, never a hang).
-
-    Parameters
-    ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
-        The bodies at t = 0 (holes allowed).
-    motion_a, motion_b : Motion
-        Their motions about their area centroids.
-    t_max : float
-        End of the time window (>= 0).
-    method : {"exact", "sampled"}
-    time_tolerance : float
-        Accuracy of ``time`` (the paper's threshold, 1e-4 s); any value > 0. Below
-        what float64 resolves at the time examined (4 · 2⁻⁵² · |t|) it is clamped
-        there, and the result's ``time_tolerance`` says so.
-    samples : int
-        Points per round of the sampled method (>= 2); ignored by "exact".
-    max_iterations : int
-        Budget of the exact method.
-
-    Returns
-    -------
-    Impact
-
-    Examples
-    --------
-    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
-    ...                      t_max=5)
-    >>> hit.collides, abs(hit.time - 2.0) < 1e-4, hit.status.value
-    (True, True, 'hit')
-    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((1.9, 1)), Motion(),
-    ...                        t_max=1)                     # slides along from t = 0.9
-    >>> slide.collides, round(slide.first_contact, 4), slide.state.value
-    (False, 0.9, 'contact')
-    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
-    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
-    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
-    (True, True)
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
