@@ -61,7 +61,7 @@ class Element(NamedTuple):
     body: str
     kind: str
     loop: int | None
-    index: int | None
+    index: int | None  # type: ignore[assignment]  # shadows tuple.index, on purpose
 
     def __str__(self) -> str:
         where = ("" if self.loop == 0 else " of a loop made by the repair"

@@ -27,7 +27,7 @@ import numpy as np
 from ._checks import finite_number
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
-from .relation import Feature, State, classify
+from .relation import Feature, Relation, State, classify
 from .bodies import as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
@@ -132,7 +132,7 @@ class Impact:
     iterations: int = field(repr=False)
     searched_to: float = field(repr=False)
     time_tolerance: float = field(repr=False)
-    _bodies: tuple = field(repr=False, compare=False, default=())
+    _bodies: tuple[Any, ...] = field(repr=False, compare=False, default=())
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
@@ -140,6 +140,7 @@ class Impact:
             return (), None, None
         a, ma, b, mb, eps_rel = self._bodies
         if self.status is ImpactStatus.HIT:
+            assert self.time_bracket is not None  # a hit always has its bracket
             t_lo, t_hi = self.time_bracket
             if self.method == "exact":
                 t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps_rel)
@@ -163,6 +164,7 @@ class Impact:
                            tolerance=_eps_at(a, ma, b, mb, 0.0, eps_rel))
             features, point, normal = rel.features, rel.point, rel.normal
         else:
+            assert self.first_contact is not None  # a state without a hit is a contact
             rel = _relation_at(a, ma, b, mb, self.first_contact, eps_rel)
             features, point, normal = rel.features, rel.point, rel.normal
         return (
@@ -278,7 +280,7 @@ def _extent(shape: Shape) -> float:
     """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
     kept with the shape's body frame (:func:`body_frame`)."""
     body_frame(shape, tables=False)
-    return shape._frame[2]
+    return shape._frame[2] if shape._frame is not None else 0.0
 
 
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
@@ -291,7 +293,7 @@ def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float
 
 
 def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
-                 reach: float = 0.0):
+                 reach: float = 0.0) -> Relation:
     """classify at time t, the tolerance (local to t) widened to the gap and to ``reach``.
 
     ``reach`` is how far the bodies can still move relative to each other before the
@@ -530,7 +532,7 @@ def time_of_impact(
 
 
 def body_frame(shape: Shape, tables: bool = True,
-               what: str = "shape") -> tuple[np.ndarray, tuple | None]:
+               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None]:
     """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
     for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
     sampled method does not need it). Built on first use and kept with the shape (it
@@ -552,8 +554,9 @@ def body_frame(shape: Shape, tables: bool = True,
     return r, tab
 
 
-def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
-            t_max, eps_rel, tol) -> Impact:
+def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, status: ImpactStatus,
+            t_hi: float, t_lo: float, t_contact: float, iters: int, reached: float,
+            intervals: np.ndarray, t_max: float, eps_rel: float, tol: float) -> Impact:
     from ._kernels.impact import effective_time_tolerance
 
     first_contact = t_contact if t_contact >= 0.0 else None

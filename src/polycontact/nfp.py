@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import functools
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -380,8 +381,8 @@ def _polygon_from_rings(
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
         header = _WKB_POLYGON.pack(1, 3, 1, len(xy))
         return shapely.from_wkb(header + xy.astype("<f8", copy=False).tobytes())
-    shells = []
-    holes = []
+    shells: list[Any] = []
+    holes: list[Any] = []
     for k in range(len(starts) - 1):
         area, length = stats[k]
         if 2.0 * abs(area) <= width * length:
@@ -427,7 +428,9 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
     return out[0] if len(out) == 1 else shapely.MultiPolygon(out)
 
 
-def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
+def _touching(
+    a: Shape, b: Shape, a0: np.ndarray, eps: float
+) -> Callable[[np.ndarray], bool]:
     """Check that A with its reference at p touches B without overlapping (classifier)."""
     relate_state = _kernels().relate_state
     xa, sa = a.packed
@@ -449,7 +452,7 @@ def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> float:
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: tuple, eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, pieces: tuple[Any, ...], eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
 

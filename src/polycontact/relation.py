@@ -155,7 +155,7 @@ class Relation:
 
     state: State
     tolerance: float
-    _pair: tuple = field(repr=False)
+    _pair: tuple[Any, ...] = field(repr=False)
 
     def __repr__(self) -> str:
         # Only what is already decided: the lazy parts (a depth can be costly) stay lazy.
@@ -254,7 +254,7 @@ class Relation:
         return np.array(self._penetration[1:])
 
     @cached_property
-    def _raw_features(self) -> tuple:
+    def _raw_features(self) -> tuple[Any, ...]:
         from ._kernels import relation as kr
 
         return kr.features(*self._packed, self.tolerance)
@@ -475,7 +475,7 @@ class RelationBatch:
 
     states: np.ndarray
     tolerances: np.ndarray
-    _pack: Callable[[], tuple] = field(repr=False)  # the packed pairs, built on demand
+    _pack: Callable[[], tuple[Any, ...]] = field(repr=False)  # the packed pairs, built on demand
 
     def __len__(self) -> int:
         return int(self.states.shape[0])
@@ -513,7 +513,7 @@ def _raw_array(arr: Any) -> np.ndarray | None:
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
-def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple:
+def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any, ...]:
     """Packed batch form of P validated rings ``arr`` (P, N, 2), ``used[p]`` vertices each."""
     p_count, n = arr.shape[0], arr.shape[1]
     lo = np.arange(p_count, dtype=np.int64) * n
@@ -542,7 +542,7 @@ def _classify_arrays(
     )
 
 
-def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
+def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, ...]:
     """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel."""
     from ._kernels import relation_many as km
 
@@ -590,7 +590,7 @@ def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def _pack(items: Any, what: str) -> tuple:
+def _pack(items: Any, what: str) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):

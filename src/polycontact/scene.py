@@ -127,7 +127,7 @@ class Scene:
 def _event_order(imp: Impact) -> tuple[float, float]:
     if imp.status is ImpactStatus.PENETRATING_AT_START:
         return (0.0, 0.0)
-    if imp.status is ImpactStatus.HIT:
+    if imp.status is ImpactStatus.HIT and imp.time is not None:
         return (imp.time, 0.0)
     if imp.status is ImpactStatus.OUT_OF_ITERATIONS:
         return (imp.searched_to, 0.0)
@@ -184,13 +184,13 @@ def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) ->
         raise InvalidSceneError(f"{path}: {exc}") from None
 
 
-def _required(data: dict, key: str, where: str) -> Any:
+def _required(data: dict[str, Any], key: str, where: str) -> Any:
     if key not in data:
         raise InvalidSceneError(f"{where}{key}: missing")
     return data[key]
 
 
-def _no_unknown(data: dict, allowed: set[str], where: str) -> None:
+def _no_unknown(data: dict[str, Any], allowed: set[str], where: str) -> None:
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise InvalidSceneError(f"{where}{unknown[0]}: unknown key")
@@ -217,7 +217,7 @@ def _ring(value: Any, what: str) -> list[tuple[float, float]]:
     return [_vector(p, f"{what}[{i}]") for i, p in enumerate(value)]
 
 
-def _angle(data: dict, key: str, where: str) -> float:
+def _angle(data: dict[str, Any], key: str, where: str) -> float:
     deg = f"{key}_deg"
     if key in data and deg in data:
         raise InvalidSceneError(f"{where}{deg}: give {key} or {deg}, not both")

@@ -220,7 +220,7 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
-        self._frame = None        # body-frame tables of the time-of-impact search
+        self._frame: tuple[Any, Any, float] | None = None  # body-frame tables of the time-of-impact search
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
         # contribute negative area, which removes them. Coordinates are taken relative to
@@ -366,7 +366,7 @@ class Shape:
         """
         return self._lookup(loop, i, 1)
 
-    def _to_input(self, packed: Sequence[int], column: int) -> tuple[list, list]:
+    def _to_input(self, packed: Sequence[int], column: int) -> tuple[list[Any], list[Any]]:
         """Caller's loops and indices (None where there is none) of the vertices
         (``column`` 0) or edges (1) at rows ``packed`` of :attr:`packed`, in bulk."""
         rows = np.asarray(packed, dtype=np.int64)
@@ -486,7 +486,7 @@ class Shape:
         return self.to_shapely().wkt
 
     @classmethod
-    def from_geojson(cls, data: str | dict, *, repair: bool = False) -> Shape:
+    def from_geojson(cls, data: str | dict[str, Any], *, repair: bool = False) -> Shape:
         """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
         if isinstance(data, str):
             try:
@@ -507,11 +507,11 @@ class Shape:
         return cls(rings[0], rings[1:], repair=repair)
 
     @property
-    def __geo_interface__(self) -> dict:
+    def __geo_interface__(self) -> dict[str, Any]:
         """GeoJSON-like mapping (the Python geo interface), closed rings."""
         return self.to_geojson()
 
-    def to_geojson(self) -> dict:
+    def to_geojson(self) -> dict[str, Any]:
         """The shape as a GeoJSON Polygon mapping with closed rings."""
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
@@ -558,7 +558,7 @@ def _ring_map(raw: np.ndarray, reverse: bool) -> np.ndarray:
 
 def _input_maps(
     rings: Sequence[ArrayLike], cleaned: Sequence[np.ndarray], stored: Sequence[np.ndarray]
-) -> tuple:
+) -> tuple[Any, ...]:
     """``(loop map, packed (n, 2) vertex and edge map)`` of the ``stored`` loops built
     from the caller's ``rings`` through ``cleaned`` (:func:`_clean_ring`); a stored loop
     that differs from its cleaned ring is its reversal."""
@@ -574,7 +574,7 @@ def _input_maps(
     return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
 
 
-def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple:
+def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
     """The map of a repaired shape to the caller's ``rings``.
 
     A stored loop belongs to the caller's loop that shares most of its vertices; a stored
@@ -583,9 +583,9 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple:
     within the tolerance. What the repair created maps to -1.
     """
     raws = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
-    where: list[dict[tuple[float, float], list[int]]] = []
+    where: list[dict[tuple[float, ...], list[int]]] = []
     for raw in raws:
-        found: dict[tuple[float, float], list[int]] = {}
+        found: dict[tuple[float, ...], list[int]] = {}
         for c, p in enumerate(map(tuple, raw.tolist())):
             found.setdefault(p, []).append(c)
         where.append(found)

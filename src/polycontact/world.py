@@ -118,7 +118,7 @@ class Contacts:
     tolerances: np.ndarray
     container_ids: np.ndarray
     container_states: np.ndarray
-    _store: tuple = field(repr=False)  # the coordinates as they were
+    _store: tuple[Any, ...] = field(repr=False)  # the coordinates as they were
     _tolerance: float | None = field(repr=False)
     ids: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64), repr=False)
     container: Shape | None = field(default=None, repr=False)
@@ -296,7 +296,7 @@ class World:
     def __init__(self, container: Any = None) -> None:
         # id -> [name, base, position, angle, motion, shape]; base, position and shape
         # are None until asked for (bodies added by add_many are kept as coordinates).
-        self._records: dict[int, list] = {}
+        self._records: dict[int, list[Any]] = {}
         self._shared = False  # a Contacts holds self._xy: copy it before writing in place
         self._next = 0
         cap = 64
@@ -321,7 +321,7 @@ class World:
         self._heads = np.full(64, -1, np.int64)
         self._filled = 0
         self._lvl_count = np.zeros(1024, np.int64)
-        self._nfp_cache: dict = {}
+        self._nfp_cache: dict[Any, Any] = {}
         self._container: Shape | None = None
         if container is not None:
             self._set_container(as_shape(container, "container"))
@@ -336,7 +336,10 @@ class World:
         frame = np.array([[lo[0] - margin, lo[1] - margin], [hi[0] + margin, lo[1] - margin],
                           [hi[0] + margin, hi[1] + margin], [lo[0] - margin, hi[1] + margin]])
         hazards = [[frame, c.exterior[::-1]]] + [[h[::-1]] for h in c.holes]
-        rows, starts, lo_h, nl_h = [], [], [], []
+        rows: list[Any] = []
+        starts: list[int] = []
+        lo_h: list[int] = []
+        nl_h: list[int] = []
         top = 0
         for loops in hazards:
             lo_h.append(len(starts))
@@ -535,7 +538,7 @@ class World:
             loops.append((old_xy[st[0] : st[-1]], st - st[0]))
         self._store_many(ids, loops)
 
-    def _store_many(self, ids: np.ndarray, loops: list) -> None:
+    def _store_many(self, ids: np.ndarray, loops: list[Any]) -> None:
         """Append bodies given as (rows, local loop starts), and set boxes and tolerances."""
         if not loops:
             return
@@ -624,11 +627,11 @@ class World:
             )
         return tol
 
-    def _grid(self) -> tuple:
+    def _grid(self) -> tuple[Any, ...]:
         return (self._keys, self._heads, self._nxt, self._level, self._lvl_count,
                 self._levels(), self._origin if self._origin is not None else np.zeros(2))
 
-    def _hazards(self) -> tuple:
+    def _hazards(self) -> tuple[Any, ...]:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
 
     # -- queries ---------------------------------------------------------------------
@@ -803,12 +806,12 @@ class World:
                                                   np.concatenate(slides) if len(s)]
         lines += [g for g in shapely.get_parts(ifp) if g.geom_type == "LineString"]
         cand = shapely.union_all(lines).intersection(ifp).difference(free)
-        segs = []
+        segs: Any = []
         for g in shapely.get_parts(cand):
             if g.geom_type == "LineString":
                 xy = np.asarray(g.coords)
                 segs.extend(np.stack([xy[:-1], xy[1:]], axis=1))
-        pts = [np.asarray(g.coords)[0] for g in shapely.get_parts(ifp)
+        pts: Any = [np.asarray(g.coords)[0] for g in shapely.get_parts(ifp)
                if g.geom_type == "Point"]
         pts += list(fits) + [s[0] for s in segs] + [s[1] for s in segs]
         keep = [free] if not free.is_empty else []

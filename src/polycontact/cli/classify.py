@@ -32,7 +32,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def relation_text(rep: dict) -> list[str]:
+def relation_text(rep: dict[str, Any]) -> list[str]:
     """The relation as lines of text (``rep`` is :meth:`Relation.to_dict`)."""
     lines = [f"state: {rep['state']}", f"distance: {rep['distance']:.12g}",
              "features:" if rep["features"] else "features: none"]

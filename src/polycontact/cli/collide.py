@@ -42,7 +42,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _text(rep: dict) -> str:
+def _text(rep: dict[str, Any]) -> str:
     a, b = rep["pair"]
     lines = [f"pair: {a} and {b} ({rep['method']} method)"]
     lines.append("broad phase: " + (", ".join(f"[{s:.6g}, {e:.6g}]" for s, e in

@@ -31,7 +31,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def read_layout(path: str) -> tuple[Any, list, list[str]]:
+def read_layout(path: str) -> tuple[Any, list[Any], list[str]]:
     """(container Shape or None, bodies, names) of a layout file; errors name the file
     and the entry."""
     from ..bodies import as_shape
@@ -68,7 +68,7 @@ def read_layout(path: str) -> tuple[Any, list, list[str]]:
     return container, bodies, names
 
 
-def text(rep: dict) -> list[str]:
+def text(rep: dict[str, Any]) -> list[str]:
     pen = sum(p["state"] == "penetrating" for p in rep["contacts"])
     lines = [f"bodies: {rep['bodies']}" + (", in a container" if rep["container"] else ""),
              f"pairs: {len(rep['contacts'])} ({len(rep['contacts']) - pen} in contact, "

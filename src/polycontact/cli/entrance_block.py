@@ -47,7 +47,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _text(rep: dict, a: str, b: str) -> str:
+def _text(rep: dict[str, Any], a: str, b: str) -> str:
     x, y = rep["reference"]
     counts = rep["components"]
     lines = [

@@ -64,7 +64,8 @@ def plot_contacts(contacts: Any, ax: Any = None) -> Any:
         ax.add_patch(_patch(contacts.shape(i), facecolor=_COLOURS[kind], edgecolor="0.3",
                             lw=0.5, alpha=0.6, label=None if kind in labelled else kind))
         labelled.add(kind)
-    touch, deep = [], []
+    touch: list[Any] = []
+    deep: list[Any] = []
     for k, state in enumerate(contacts.states.tolist()):
         point = contacts.relation(k).point
         if point is not None:
