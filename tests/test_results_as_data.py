@@ -13,8 +13,10 @@ import shapely.geometry
 import polycontact as pc
 from polycontact.cli import main
 
-A = {"vertices": [[0, 0], [10, 0], [10, 10], [0, 10]], "holes": [[[2, 2], [2, 4], [4, 4], [4, 2]]]}
-B = {"vertices": [[10, 2], [13, 2], [13, 5], [10, 5]], "holes": [[[11, 3], [11, 4], [12, 4], [12, 3]]]}
+A = {"vertices": [[0, 0], [10, 0], [10, 10], [0, 10]],
+     "holes": [[[2, 2], [2, 4], [4, 4], [4, 2]]]}
+B = {"vertices": [[10, 2], [13, 2], [13, 5], [10, 5]],
+     "holes": [[[11, 3], [11, 4], [12, 4], [12, 3]]]}
 B_SEPARATE = {"vertices": [[11, 2], [14, 2], [14, 5], [11, 5]]}
 B_PENETRATING = {"vertices": [[9, 2], [12, 2], [12, 5], [9, 5]]}
 

@@ -80,11 +80,12 @@ def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) ->
     """The intervals as a (k, 2) float64 array (the form the kernels take)."""
     from ._kernels.broad_phase import overlap_intervals
 
-    return overlap_intervals(
+    intervals: np.ndarray = overlap_intervals(
         np.asarray(a.centroid, dtype=np.float64), ma.array, a.bounding_radius,
         np.asarray(b.centroid, dtype=np.float64), mb.array, b.bounding_radius,
         t_max, BROAD_PHASE_INFLATION,
     )
+    return intervals
 
 
 def broad_phase_intervals(

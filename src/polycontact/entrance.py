@@ -32,7 +32,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -471,7 +471,7 @@ def _edges(s: Shape) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
+    return cast("np.ndarray", u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0])
 
 
 def _signed_area(ring: np.ndarray) -> float:
@@ -484,11 +484,11 @@ def _translated_polygons(loops: list[np.ndarray], offsets: np.ndarray) -> np.nda
 
     shells = shapely.linearrings(loops[0][None] + offsets[:, None])
     if len(loops) == 1:
-        return shapely.polygons(shells)
+        return cast("np.ndarray", shapely.polygons(shells))
     holes = np.stack(
         [shapely.linearrings(h[None] + offsets[:, None]) for h in loops[1:]], axis=1
     )
-    return shapely.polygons(shells, holes=holes)
+    return cast("np.ndarray", shapely.polygons(shells, holes=holes))
 
 
 def _parallelograms(corners: np.ndarray, eps: float) -> np.ndarray:
@@ -529,7 +529,7 @@ def _flat(corners: np.ndarray, eps: float) -> np.ndarray:
     d1 = corners[:, 1] - corners[:, 0]
     d2 = corners[:, 3] - corners[:, 0]
     longest = np.maximum(np.hypot(d1[:, 0], d1[:, 1]), np.hypot(d2[:, 0], d2[:, 1]))
-    return np.abs(_cross(d1, d2)) <= eps * longest
+    return cast("np.ndarray", np.abs(_cross(d1, d2)) <= eps * longest)
 
 
 def _polygonal(geom: Any) -> Any:
@@ -553,7 +553,7 @@ def _without_specks(geom: Any, eps: float) -> Any:
     def wide(ring_or_poly: Any) -> bool:
         poly = shapely.Polygon(ring_or_poly) if ring_or_poly.geom_type == "LinearRing" \
             else ring_or_poly
-        return shapely.maximum_inscribed_circle(poly, eps / 4).length > eps
+        return bool(shapely.maximum_inscribed_circle(poly, eps / 4).length > eps)
 
     pieces = [shapely.Polygon(p.exterior, [r for r in p.interiors if wide(r)])
               for p in shapely.get_parts(geom)]

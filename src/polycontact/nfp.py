@@ -280,7 +280,7 @@ def inner_fit_polygon(
     def fits(p: np.ndarray) -> bool:
         placed = shapely.affinity.translate(a_poly, *(p - a0))
         spill = placed.difference(c_poly)
-        return spill.area <= eps * (placed.length + c_poly.length)
+        return bool(spill.area <= eps * (placed.length + c_poly.length))
 
     fit_pts, slide_segs = _clean_degenerate(pts, segs, (fxy, fst, r, ast), eps, lambda: fits)
     parts = [free] if not free.is_empty else []
@@ -342,8 +342,9 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
     # GEOS adds no vertex: triangles share exact coordinates, hence vertex indices
     vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
-    return _kernels().decompose.convex_pieces(
+    pieces: tuple[np.ndarray, np.ndarray] = _kernels().decompose.convex_pieces(
         vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE, ROUNDING_ULPS)
+    return pieces
 
 
 def _entrance(
@@ -438,7 +439,7 @@ def _touching(
     tol = HOLE_WIDTH_FACTOR * eps
 
     def check(p: np.ndarray) -> bool:
-        return relate_state(xa + (p - a0), sa, xb, sb, tol) == 1
+        return bool(relate_state(xa + (p - a0), sa, xb, sb, tol) == 1)
 
     return check
 

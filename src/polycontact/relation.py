@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -229,13 +229,13 @@ class Relation:
     def _closest(self) -> tuple[float, float, float, float, float]:
         from ._kernels import relation as kr
 
-        return kr.closest_pair(*self._packed)
+        return cast("tuple[float, float, float, float, float]", kr.closest_pair(*self._packed))
 
     @cached_property
     def _penetration(self) -> tuple[float, float, float]:
         from ._kernels import relation as kr
 
-        return kr.penetration(*self._packed, self.tolerance)
+        return cast("tuple[float, float, float]", kr.penetration(*self._packed, self.tolerance))
 
     @cached_property
     def distance(self) -> float:
@@ -257,7 +257,7 @@ class Relation:
     def _raw_features(self) -> tuple[Any, ...]:
         from ._kernels import relation as kr
 
-        return kr.features(*self._packed, self.tolerance)
+        return cast("tuple[Any, ...]", kr.features(*self._packed, self.tolerance))
 
     @cached_property
     def features(self) -> tuple[Feature, ...]:
@@ -289,13 +289,13 @@ class Relation:
             if cross:
                 return np.array(cross[0][2:])
             if a_in:
-                return xa[a_in[0][0]].copy()
+                return cast("np.ndarray", xa[a_in[0][0]].copy())
             if b_in:
-                return xb[b_in[0][0]].copy()
+                return cast("np.ndarray", xb[b_in[0][0]].copy())
         if a_on:
-            return xa[a_on[0][0]].copy()
+            return cast("np.ndarray", xa[a_on[0][0]].copy())
         if b_on:
-            return xb[b_on[0][0]].copy()
+            return cast("np.ndarray", xb[b_on[0][0]].copy())
         return None
 
     @cached_property
@@ -305,7 +305,7 @@ class Relation:
             return None
         if self.state is State.PENETRATING:
             d = -np.asarray(self._penetration[1:])
-            return d / np.hypot(*d) + 0.0
+            return cast("np.ndarray", d / np.hypot(*d) + 0.0)
         xa, sa, xb, sb = self._packed
         a_on, b_on, _, _, _ = self._raw_features
         best = None
@@ -489,7 +489,7 @@ class RelationBatch:
         """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
         from ._kernels import relation_many as km
 
-        return km.many_distances(*self._pack(), self.states, self.tolerances)
+        return cast("np.ndarray", km.many_distances(*self._pack(), self.states, self.tolerances))
 
 
 def _split(count: int, fn: Any) -> list[Any]:
@@ -650,10 +650,11 @@ def classify_many(
     xb, lsb, bsb, fb = pb
 
     def chunk(p0: int, p1: int) -> tuple[np.ndarray, np.ndarray]:
-        return km.many_states(
+        out: tuple[np.ndarray, np.ndarray] = km.many_states(
             xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
             RELATIVE_TOLERANCE, ROUNDING_ULPS,
         )
+        return out
 
     parts = _split(len(fa), chunk)
     states = np.concatenate([st for st, _ in parts])

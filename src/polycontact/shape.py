@@ -220,7 +220,8 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
-        self._frame: tuple[Any, Any, float] | None = None  # body-frame tables of the time-of-impact search
+        # body-frame tables of the time-of-impact search
+        self._frame: tuple[Any, Any, float] | None = None
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
         # contribute negative area, which removes them. Coordinates are taken relative to
@@ -483,7 +484,7 @@ class Shape:
 
     def to_wkt(self) -> str:
         """The shape as WKT text."""
-        return self.to_shapely().wkt
+        return str(self.to_shapely().wkt)
 
     @classmethod
     def from_geojson(cls, data: str | dict[str, Any], *, repair: bool = False) -> Shape:

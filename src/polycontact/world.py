@@ -31,7 +31,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -140,7 +140,7 @@ class Contacts:
     @property
     def penetrating(self) -> np.ndarray:
         """The pairs that penetrate, (P, 2)."""
-        return self.pairs[self.states == 2]
+        return cast("np.ndarray", self.pairs[self.states == 2])
 
     def shape(self, id: int) -> Shape:
         """The Shape of body ``id`` as it was when the contacts were found."""
@@ -260,7 +260,7 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     of its two bodies' (a maximum of per-body terms), which the kernels take."""
     extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
-    return np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude)
+    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude))
 
 
 def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int) -> Shape:
@@ -741,12 +741,13 @@ class World:
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
                                             np.zeros(4), 0.0)
-        return _k().query_many(
+        states: np.ndarray = _k().query_many(
             sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
             RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
             self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
             *hz, self._hmax if has_c else 0, _chunks(len(pos)),
         )
+        return states
 
     def feasible_region(self, shape: Any, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
