@@ -45,7 +45,6 @@ import shapely.affinity
 
 from ._checks import finite_number
 from ._checks import point as point_arg
-from .errors import InvalidShapeError
 from .bodies import as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
@@ -133,7 +132,7 @@ class NoFitPolygon:
         """
         from .relation import classify
 
-        p = point_arg(point, "point", error=InvalidShapeError)
+        p = point_arg(point, "point")
         moved = self.a.moved(p - self.reference)
         return classify(moved, self.b, tolerance=tolerance).state
 
@@ -300,17 +299,17 @@ def _reference(a: Shape, reference: Any) -> np.ndarray:
     if isinstance(reference, str):
         if reference == "origin":
             return np.zeros(2)
-        raise InvalidShapeError(
+        raise ValueError(
             f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
         )
-    return point_arg(reference, "reference", error=InvalidShapeError)
+    return point_arg(reference, "reference")
 
 
 def _tolerance(tolerance: float | None) -> float:
     """The tolerance for the kernel: -1 asks it for the default of the sums' coordinates."""
     if tolerance is None:
         return -1.0
-    return finite_number(tolerance, "tolerance", positive=True, error=InvalidShapeError)
+    return finite_number(tolerance, "tolerance", positive=True)
 
 
 def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
