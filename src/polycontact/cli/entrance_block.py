@@ -84,4 +84,6 @@ def run(args: argparse.Namespace) -> int:
             fig.savefig(args.plot, dpi=110, bbox_inches="tight")
         except OSError as exc:
             raise CommandError(f"{args.plot}: cannot write ({exc.strerror})") from None
+        except ValueError as exc:  # an image format matplotlib does not know
+            raise CommandError(f"{args.plot}: cannot write the plot ({exc})") from None
     return 0
