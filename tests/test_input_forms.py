@@ -197,3 +197,12 @@ def test_wrong_value_is_value_error_naming_the_argument(entry, kind):
     with pytest.raises(ValueError, match=f"^{what}: ") as err:
         call(WRONG_VALUES[kind])
     assert not isinstance(err.value, TypeError)
+
+
+@pytest.mark.parametrize("form", ["shapely", "geo_interface", "geojson", "body-dict", "wkt",
+                                  "wkb", "Shape"])
+def test_shape_constructor_points_to_as_shape(form):
+    # Shape() takes arrays; another form is a TypeError that says where to go (issue 13:
+    # Shape(shapely_polygon) failed with "coordinates are not numbers")
+    with pytest.raises(TypeError, match="^vertices: .*bodies.as_shape"):
+        pc.Shape(forms(B_OUTER, [])[form])

@@ -16,7 +16,7 @@ and with repeated or closing points counted; :meth:`Shape.input_vertex`,
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -135,7 +135,9 @@ class Shape:
         shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
         message then says which, how far apart, and the float spacing.
     TypeError
-        Coordinates that are not real numbers (strings, booleans, complex numbers).
+        Coordinates that are not real numbers (strings, booleans, complex numbers), or
+        a body in another form (a Shapely polygon, a mapping, text): pass those to
+        :func:`polycontact.bodies.as_shape`, which takes every form.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
 
@@ -166,6 +168,12 @@ class Shape:
     def __init__(
         self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
     ) -> None:
+        if isinstance(vertices, (str, bytes, Mapping)) or hasattr(vertices, "__geo_interface__"):
+            raise TypeError(
+                f"vertices: expected an (N, 2) array-like, got {type(vertices).__name__}; "
+                "polycontact.bodies.as_shape takes every form of a body (Shape, Shapely, "
+                "GeoJSON, body mapping, WKT, WKB)"
+            )
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
             raise InvalidShapeError(
                 "holes: expected a sequence of (M, 2) loops, got a single (M, 2) array; "
