@@ -43,14 +43,27 @@ from __future__ import annotations
 import json
 import re
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, Protocol, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import InvalidShapeError
 from .shape import Shape
 
-__all__ = ["as_shape", "BODY_FORMS"]
+__all__ = ["as_shape", "BODY_FORMS", "BodyLike", "GeoInterface"]
+
+
+class GeoInterface(Protocol):
+    """Anything with ``__geo_interface__`` (the Python geo interface)."""
+
+    @property
+    def __geo_interface__(self) -> Mapping[str, Any]: ...
+
+
+#: The type of a body argument: every form :func:`as_shape` takes (WKT and JSON text are
+#: ``str``, WKB ``bytes``; Shapely geometries have ``__geo_interface__``).
+BodyLike = Union[Shape, GeoInterface, Mapping[str, Any], npt.ArrayLike]
 
 #: The forms a body may take, as error messages list them.
 BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"

@@ -22,7 +22,7 @@ import numpy as np
 
 from ._checks import finite_number
 from .motion import Motion
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import COORDINATE_LIMIT, check_range
 
@@ -89,7 +89,7 @@ def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) ->
 
 
 def broad_phase_intervals(
-    a: Any, motion_a: Motion, b: Any, motion_b: Motion, *, t_max: float
+    a: BodyLike, motion_a: Motion, b: BodyLike, motion_b: Motion, *, t_max: float
 ) -> tuple[tuple[float, float], ...]:
     """Closed time intervals within ``[0, t_max]`` when the bounding circles overlap.
 

@@ -35,9 +35,10 @@ from functools import cached_property
 from typing import Any, NamedTuple, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import point as point_arg
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import default_tolerance
 
@@ -303,7 +304,8 @@ class EntranceBlock:
 
 
 def entrance_block(
-    a: Any, b: Any, reference: Any = None, *, method: str = "swept"
+    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    method: str = "swept"
 ) -> EntranceBlock:
     """The entrance block of A to B and its components (paper §2.3–2.4).
 

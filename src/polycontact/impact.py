@@ -28,7 +28,7 @@ from ._checks import finite_number
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
 
@@ -310,9 +310,9 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
 
 
 def time_of_impact(
-    a: Any,
+    a: BodyLike,
     motion_a: Motion,
-    b: Any,
+    b: BodyLike,
     motion_b: Motion,
     *,
     t_max: float,

@@ -40,12 +40,13 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import shapely
 import shapely.affinity
 
 from ._checks import finite_number
 from ._checks import point as point_arg
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
 
@@ -185,7 +186,8 @@ class NoFitPolygon:
 
 
 def no_fit_polygon(
-    a: Any, b: Any, reference: Any = None, *, tolerance: float | None = None
+    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    tolerance: float | None = None
 ) -> NoFitPolygon:
     """No-fit polygon of ``a`` orbiting the fixed ``b``.
 
@@ -226,7 +228,8 @@ def no_fit_polygon(
 
 
 def inner_fit_polygon(
-    a: Any, container: Any, reference: Any = None, *, tolerance: float | None = None
+    a: BodyLike, container: BodyLike, reference: npt.ArrayLike | None = None, *,
+    tolerance: float | None = None
 ) -> Any:
     """Reference positions at which ``a`` lies inside ``container`` (touching allowed).
 

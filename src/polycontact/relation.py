@@ -31,7 +31,7 @@ import numpy as np
 
 from ._checks import finite_number
 from .errors import InvalidShapeError
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import (
     COORDINATE_LIMIT,
@@ -387,7 +387,7 @@ def _shapes_tolerance(sa: Shape, sb: Shape) -> float:
     return tolerance_for(max(sa._extent, sb._extent), max(sa._magnitude, sb._magnitude))
 
 
-def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
+def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
 
     Parameters
@@ -602,7 +602,8 @@ def _pack(items: Any, what: str) -> tuple[Any, ...]:
 
 
 def classify_many(
-    shapes_a: Any, shapes_b: Any, *, tolerance: float | None = None
+    shapes_a: Sequence[BodyLike] | np.ndarray, shapes_b: Sequence[BodyLike] | np.ndarray, *,
+    tolerance: float | None = None
 ) -> RelationBatch:
     """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.
 

@@ -34,12 +34,13 @@ from dataclasses import dataclass, field
 from typing import Any, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import finite_number
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .bodies import as_shape
+from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_tolerance
 
@@ -293,7 +294,7 @@ class World:
     0
     """
 
-    def __init__(self, container: Any = None) -> None:
+    def __init__(self, container: BodyLike | None = None) -> None:
         # id -> [name, base, position, angle, motion, shape]; base, position and shape
         # are None until asked for (bodies added by add_many are kept as coordinates).
         self._records: dict[int, list[Any]] = {}
@@ -392,7 +393,7 @@ class World:
             rec[2] = rec[1].centroid.copy()
         return WorldBody(int(id), rec[0], rec[5], rec[1], rec[2], rec[3], rec[4])
 
-    def add(self, shape: Any, position: Any = None, angle: float = 0.0, *,
+    def add(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
         """Add a body; returns its id (ids are never reused).
 
@@ -675,7 +676,7 @@ class World:
         return Contacts(pairs, states, used, c_ids, c_states, store,
                         None if tolerance is None else tol, alive, self._container)
 
-    def query(self, shape: Any, position: Any = None, angle: float = 0.0, *,
+    def query(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
         """How ``shape``, placed like :meth:`add` would place it, lies among the bodies.
 
@@ -704,7 +705,7 @@ class World:
             cstate = int(k.query_container(qxy, qs, qeps, tol, *self._hazards()))
         return Query(ids, states, cstate, placed)
 
-    def query_many(self, shape: Any, positions: Any, angles: Any = 0.0, *,
+    def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
                    tolerance: float | None = None) -> np.ndarray:
         """Worst state over every body and the container (outside counts as 2) of
         ``shape`` placed at each of P poses, in one compiled call.
@@ -749,7 +750,7 @@ class World:
         )
         return states
 
-    def feasible_region(self, shape: Any, angle: float = 0.0) -> Any:
+    def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
         the container and penetrates no body: the container's inner-fit polygon minus
         the union of the bodies' no-fit polygons, with exact fits and slides kept.
