@@ -13,7 +13,7 @@ def run(monkeypatch, capsys):
     # only this subcommand: the test does not depend on the other subcommands' modules
     monkeypatch.setattr(cli, "_SUBCOMMANDS", ("collide",))
     # a cold cache adds the first-run notice to stderr (tested in test_compiling.py)
-    compiling.warmup(["classification", "time of impact"])
+    compiling.warmup(["classification", "time of impact", "many moving bodies"])
 
     def _run(*argv):
         code = cli.main(["collide", *map(str, argv)])
@@ -116,3 +116,29 @@ def test_bad_options_exit_2(run):
     with pytest.raises(SystemExit) as exc:
         run("examples/paper-case-1.json", "--samples", "1")
     assert exc.value.code == 2
+
+
+THREE = {"t_max": 5, "bodies": [
+    {"name": "a", "vertices": SQ, "velocity": [1, 0]},
+    {"name": "b", "vertices": [[x + 3, y] for x, y in SQ]},
+    {"name": "c", "vertices": [[x + 1.5, y + 1] for x, y in SQ]},
+    {"name": "far", "vertices": [[x + 40, y] for x, y in SQ]},
+]}
+
+
+def test_all_lists_every_pair_that_meets_by_time(run, tmp_path):
+    code, out, err = run(scene_file(tmp_path, THREE), "--all", "--json")
+    assert code == 0
+    events = json.loads(out)["events"]
+    assert [e["pair"] for e in events] == [["a", "c"], ["a", "b"]]
+    assert events[0]["status"] == "no-hit" and events[0]["state"] == "contact"
+    assert events[1]["collides"] and events[1]["time"] == pytest.approx(2.0, abs=1e-4)
+    code, out, _ = run(scene_file(tmp_path, THREE), "--all")
+    assert code == 0 and out.startswith("2 pair(s) meet within t_max = 5")
+    assert "pair: a and c" in out and "pair: a and b" in out
+
+
+def test_three_bodies_first_impact_is_the_earliest_collision(run, tmp_path):
+    code, out, _ = run(scene_file(tmp_path, THREE), "--json")
+    rep = json.loads(out)
+    assert code == 0 and rep["pair"] == ["a", "b"] and rep["collides"]

@@ -356,6 +356,8 @@ def test_pair_tolerance_is_default_tolerance(pair):
 
 def test_raw_ring_refuses_out_of_range_without_overflow():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    # (as plain Python, CI's NUMBA_DISABLE_JIT run: the star-shaped check squared cross
+    # products of coordinates, which overflowed at 1e90 and underflowed at 1e-90)
     with np.errstate(all="raise"):
         for ring in (sq * 1e200, sq * 1e-300, sq + [np.nan, 0.0], sq + [0.0, np.inf]):
             assert kr._raw_ring(ring, *RING)[0] == -1

@@ -405,3 +405,39 @@ def test_feasible_region_avoids_the_container_holes():
     world.add(TEMPLATES[0], (2, 2))
     region = world.feasible_region(TEMPLATES[3])
     assert not region.contains(shapely.Point(2, 2)) and len(world._nfp_cache) == 1
+
+
+class _Terminal:
+    """A stderr that says it is a terminal (tqdm draws its bar only there)."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def write(self, s: str) -> int:
+        self.text += s
+        return len(s)
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_contacts_cli_shows_progress_reading_a_long_layout_on_a_terminal(tmp_path, monkeypatch):
+    import sys
+
+    from polycontact.cli import contacts as cli_contacts
+
+    sq = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    path = tmp_path / "layout.json"
+    path.write_text(json.dumps({"placed": [{"item": k, "vertices": [[x + 2 * k, y] for x, y in sq]}
+                                           for k in range(5)]}))
+    monkeypatch.setattr(cli_contacts, "PROGRESS_MIN_BODIES", 3)
+    term = _Terminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    _, quiet, _ = cli_contacts.read_layout(str(path), progress=False)
+    assert term.text == ""
+    _, bodies, names = cli_contacts.read_layout(str(path), progress=True)
+    assert "reading bodies" in term.text and len(bodies) == len(quiet) == 5
+    assert names == [f"{k} ({k})" for k in range(5)]

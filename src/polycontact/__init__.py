@@ -46,6 +46,12 @@ _LAZY = {
     "Impact": "impact",
     "ImpactStatus": "impact",
     "time_of_impact": "impact",
+    # many moving bodies
+    "time_of_impact_many": "impacts",
+    "ImpactBatch": "impacts",
+    "first_impacts": "impacts",
+    "first_impact": "impacts",
+    "PairImpact": "impacts",
     "Scene": "scene",
     "Body": "scene",
     "load_scene": "scene",

@@ -20,7 +20,7 @@ Examples
 --------
 >>> from polycontact import compiling
 >>> sorted(compiling.FAMILIES)
-['classification', 'entrance block', 'no-fit polygon', 'time of impact']
+['classification', 'entrance block', 'many moving bodies', 'no-fit polygon', 'time of impact']
 >>> compiling.cache_directory().is_absolute()
 True
 """
@@ -41,6 +41,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "time of impact": ("impact.exact_query", "impact.sampled_query"),
     "no-fit polygon": ("nfp.entrance_region", "nfp.convex_sums"),
     "entrance block": ("relation.relate_state",),
+    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
 }
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -164,6 +165,13 @@ def _run(family: str) -> None:
         from .entrance import entrance_block
 
         entrance_block(Shape(sq), Shape(sq + 0.5)).to_shapely()
+    elif family == "many moving bodies":
+        from .impacts import first_impacts
+        from .motion import Motion
+
+        for method in ("exact", "sampled"):
+            first_impacts([Shape(sq), Shape(sq + (3.0, 0.0))], [Motion(velocity=(1.0, 0.0)),
+                          Motion()], 5.0, method=method, threads=1)
     else:
         raise ValueError(f"family: expected one of {', '.join(FAMILIES)}, got {family!r}")
 

@@ -113,6 +113,19 @@ class Scene:
         else the first pair.
         """
         tol = time_tolerance if time_tolerance is not None else self.time_tolerance
+        tol_ = 1e-4 if tol is None else tol
+        if len(self.bodies) >= 3:
+            # only the pairs whose swept bounds meet are searched (same answer as the
+            # loop over all pairs below: tests/test_impacts_many.py)
+            from .impacts import first_impact
+
+            ev = first_impact([b.shape for b in self.bodies], [b.motion for b in self.bodies],
+                              self.t_max, method=method, time_tolerance=tol_, samples=samples)
+            if ev is not None:
+                return self.bodies[ev.i], self.bodies[ev.j], ev.impact
+            a, b = self.bodies[0], self.bodies[1]  # nothing meets: the first pair
+            return a, b, time_of_impact(a.shape, a.motion, b.shape, b.motion, t_max=self.t_max,
+                                        method=method, time_tolerance=tol_, samples=samples)
         results = []
         for i, a in enumerate(self.bodies):
             for b in self.bodies[i + 1:]:
@@ -122,6 +135,36 @@ class Scene:
                 )
                 results.append((a, b, imp))
         return min(results, key=lambda r: _event_order(r[2]))
+
+
+    def impacts(
+        self,
+        *,
+        method: str = "exact",
+        time_tolerance: float | None = None,
+        samples: int = 10,
+    ) -> list[tuple[Body, Body, Impact]]:
+        """Every pair that meets within ``[0, t_max]`` (touches, penetrates, or has no
+        verdict), sorted by time: ``(body_a, body_b, impact)`` in file order
+        (:func:`polycontact.first_impacts`; what ``polycontact collide --all`` lists).
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> scene = Scene((Body("a", sq, Motion(velocity=(1, 0))),
+        ...                Body("b", sq.moved((3, 0)), Motion()),
+        ...                Body("c", sq.moved((1.5, 1)), Motion())), t_max=5)
+        >>> [(a.name, b.name, imp.status.value) for a, b, imp in scene.impacts()]
+        [('a', 'c', 'no-hit'), ('a', 'b', 'hit')]
+        """
+        from .impacts import first_impacts
+
+        tol = time_tolerance if time_tolerance is not None else self.time_tolerance
+        events = first_impacts([b.shape for b in self.bodies], [b.motion for b in self.bodies],
+                               self.t_max, method=method,
+                               time_tolerance=1e-4 if tol is None else tol, samples=samples)
+        return [(self.bodies[e.i], self.bodies[e.j], e.impact) for e in events]
 
 
 def _event_order(imp: Impact) -> tuple[float, float]:

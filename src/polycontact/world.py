@@ -750,6 +750,48 @@ class World:
         )
         return states
 
+    # -- moving bodies ---------------------------------------------------------------
+    def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:
+        """Every pair of bodies that meets within ``[0, t_max]`` as they follow their
+        motions (the ``motion`` given to :meth:`add`; a body without one stays put),
+        sorted by time: ``(id_a, id_b, impact)`` with ``id_a < id_b``.
+
+        ``impact`` equals :func:`polycontact.time_of_impact` of the two bodies as placed
+        now; only pairs whose swept bounds meet are searched
+        (:func:`polycontact.first_impacts`, whose ``options`` these are). The container
+        is not a moving hazard: leaving it is not reported here.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> w = pc.World()
+        >>> a = w.add(sq, (0.5, 0.5), motion=pc.Motion(velocity=(1, 0)))
+        >>> b = w.add(sq, (3.5, 0.5))
+        >>> [(i, j, round(imp.time, 3)) for i, j, imp in w.first_impacts(5)]
+        [(0, 1, 2.0)]
+        """
+        from .impacts import first_impacts
+
+        ids, shapes, motions = self._moving()
+        return [(ids[e.i], ids[e.j], e.impact)
+                for e in first_impacts(shapes, motions, t_max, **options)]
+
+    def first_impact(self, t_max: float, **options: Any) -> tuple[int, int, Any] | None:
+        """The first event among the moving bodies, ``(id_a, id_b, impact)``: the
+        earliest collision, else the earliest touch; None when no pair meets (the order
+        of :func:`polycontact.first_impact`, whose ``options`` these are)."""
+        from .impacts import first_impact
+
+        ids, shapes, motions = self._moving()
+        e = first_impact(shapes, motions, t_max, **options)
+        return None if e is None else (ids[e.i], ids[e.j], e.impact)
+
+    def _moving(self) -> tuple[list[int], list[Shape], list[Motion]]:
+        ids = sorted(self._records)
+        bodies = [self.body(k) for k in ids]
+        return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
+
     def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
         the container and penetrates no body: the container's inner-fit polygon minus

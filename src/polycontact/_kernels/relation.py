@@ -753,10 +753,13 @@ def _star_ring_is_simple(xy, n, eps):
             changes += 1
         ex = wx - ux
         ey = wy - uy
-        c2 = cr * cr
-        h2 = min(h2, c2 / (ex * ex + ey * ey))
+        # ratios before squares: a squared cross product of coordinates near the
+        # limits (1e100, 1e-100) would overflow or underflow float64
+        h = cr / np.sqrt(ex * ex + ey * ey)
+        h2 = min(h2, h * h)
         if ux * wx + uy * wy > 0.0:
-            s2 = min(s2, c2 / (u2 * w2))
+            sn = cr / (np.sqrt(u2) * np.sqrt(w2))
+            s2 = min(s2, sn * sn)
         ux = wx
         uy = wy
         u2 = w2
@@ -904,20 +907,13 @@ def _ring_summary(xy, rel, ulps, limit, floor):
         return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
     # One pass: range (which also refuses NaN and infinities), bounding box and twice
     # the signed area (taken relative to the first vertex, so a small ring far from the
-    # origin keeps its digits; the two terms at vertex 0 are zero). A vertex is checked
-    # before it enters a product, so nothing overflows on the way to a refusal.
-    ox = xy[0, 0]
-    oy = xy[0, 1]
-    if not (abs(ox) <= limit and abs(oy) <= limit):
-        return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
-    x0 = ox
-    x1 = ox
-    y0 = oy
-    y1 = oy
-    a2 = 0.0
-    jx = ox
-    jy = oy
-    for i in range(1, n):
+    # origin keeps its digits). Out of range, the products below could overflow: the
+    # area is summed only once every coordinate is known to be in range.
+    x0 = np.inf
+    x1 = -np.inf
+    y0 = np.inf
+    y1 = -np.inf
+    for i in range(n):
         x = xy[i, 0]
         y = xy[i, 1]
         if not (abs(x) <= limit and abs(y) <= limit):
@@ -926,12 +922,20 @@ def _ring_summary(xy, rel, ulps, limit, floor):
         x1 = max(x1, x)
         y0 = min(y0, y)
         y1 = max(y1, y)
-        a2 += (jx - ox) * (y - oy) - (x - ox) * (jy - oy)
-        jx = x
-        jy = y
     extent, magnitude = box_extent_magnitude(x0, x1, y0, y1)
     if extent < floor:
         return -1, 1.0, 0.0, (0.0, 0.0, 0.0, 0.0)
+    a2 = 0.0
+    ox = xy[0, 0]
+    oy = xy[0, 1]
+    jx = xy[n - 1, 0]
+    jy = xy[n - 1, 1]
+    for i in range(n):
+        x = xy[i, 0]
+        y = xy[i, 1]
+        a2 += (jx - ox) * (y - oy) - (x - ox) * (jy - oy)
+        jx = x
+        jy = y
     eps = tolerance_for(extent, magnitude, rel, ulps)
     # An area compared with an area: eps times the ring's extent.
     if abs(0.5 * a2) <= eps * extent:

@@ -26,7 +26,7 @@ _SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "co
 #: The kernel families (polycontact.compiling.FAMILIES) each command runs.
 _NEEDS = {
     "classify": ("classification",),
-    "collide": ("classification", "time of impact"),
+    "collide": ("classification", "time of impact", "many moving bodies"),
     "entrance-block": ("classification", "entrance block"),
     "nfp": ("no-fit polygon",),
     "contacts": ("classification",),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from ..bodies import as_shape
@@ -35,6 +36,23 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
         return as_shape(data, str(path), repair=repair)
     except (InvalidShapeError, TypeError) as exc:  # TypeError: coordinates not numbers
         raise CommandError(str(exc)) from None
+
+
+def integer_at_least(minimum: int) -> Callable[[str], int]:
+    """An argparse ``type`` for an integer option >= ``minimum``."""
+
+    def parse(text: str) -> int:
+        import argparse
+
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {minimum}, got {value}")
+        return value
+
+    return parse
 
 
 def _number_option(text: str, *, zero_allowed: bool) -> float:

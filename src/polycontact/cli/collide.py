@@ -7,17 +7,7 @@ import json
 import sys
 from typing import Any
 
-from ._io import CommandError, index_text, positive_number
-
-
-def _samples(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 2, got {value}")
-    return value
+from ._io import CommandError, index_text, integer_at_least, positive_number
 
 
 def add_parser(subparsers: Any) -> None:
@@ -31,14 +21,18 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("scene", metavar="SCENE.json", help="scene file (see the README)")
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
-    p.add_argument("--samples", type=_samples, default=10,
+    p.add_argument("--samples", type=integer_at_least(2), default=10,
                    help="time points per round of the sampled method (default 10)")
     p.add_argument("--time-tolerance", type=positive_number, default=None,
                    help="accuracy of the time (default: the scene's, else 1e-4)")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
+    p.add_argument("--all", action="store_true",
+                   help="list every pair that meets within t_max, by time (not only the "
+                   "first impact)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="OUT.png", help="draw the bodies, paths and contact")
+    p.add_argument("--plot", metavar="OUT.png",
+                   help="draw the bodies, paths and contact (with --all: the earliest event)")
     p.set_defaults(func=run)
 
 
@@ -79,11 +73,25 @@ def run(args: argparse.Namespace) -> int:
         for note in body.shape.repairs:
             print(f"polycontact collide: repaired {body.name}: {note}",
                   file=sys.stderr)
-    body_a, body_b, impact = scene.first_impact(
-        method=args.method, time_tolerance=args.time_tolerance, samples=args.samples
-    )
-    rep = impact.to_dict((body_a.name, body_b.name))
-    print(json.dumps(rep) if args.json else _text(rep))
+    options = {"method": args.method, "time_tolerance": args.time_tolerance,
+               "samples": args.samples}
+    if args.all:
+        events = scene.impacts(**options)
+        reps = [imp.to_dict((a.name, b.name)) for a, b, imp in events]
+        if args.json:
+            print(json.dumps({"events": reps}))
+        else:
+            print(f"{len(reps)} pair(s) meet within t_max = {scene.t_max:g}" +
+                  "".join("\n\n" + _text(r) for r in reps))
+        if not events:
+            if args.plot:
+                raise CommandError("--plot: no pair meets, nothing to draw")
+            return 0
+        body_a, body_b, impact = events[0]
+    else:
+        body_a, body_b, impact = scene.first_impact(**options)
+        rep = impact.to_dict((body_a.name, body_b.name))
+        print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
         import matplotlib
 

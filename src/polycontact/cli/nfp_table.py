@@ -8,7 +8,7 @@ import math
 import sys
 from typing import Any
 
-from ._io import CommandError
+from ._io import CommandError, integer_at_least
 
 
 def _angle(text: str) -> float:
@@ -18,16 +18,6 @@ def _angle(text: str) -> float:
         raise argparse.ArgumentTypeError(f"expected an angle in degrees, got {text!r}") from None
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"expected a finite angle, got {text!r}")
-    return value
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
     return value
 
 
@@ -44,13 +34,13 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("instance", metavar="INSTANCE.json", help="ESICUP instance")
     p.add_argument("--out", required=True, metavar="DIR", help="cache directory")
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=_count, default=None, metavar="N",
+    where.add_argument("--workers", type=integer_at_least(1), default=None, metavar="N",
                        help="local processes (default: one per CPU for large tables)")
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="run on this Dask scheduler (needs polycontact[dask])")
     p.add_argument("--orientations", type=_angle, nargs="+", metavar="DEG",
                    help="allowed angles for every piece, instead of the instance's")
-    p.add_argument("--chunk-size", type=_count, default=None, metavar="N",
+    p.add_argument("--chunk-size", type=integer_at_least(1), default=None, metavar="N",
                    help="entries per task and per cache file")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")

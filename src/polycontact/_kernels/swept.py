@@ -1,0 +1,221 @@
+"""Kernels: many moving bodies at once — swept bounds and batched time of impact.
+
+Swept bounds (design.md §3 for every body at once). A body moving with constant
+acceleration and spin stays within its bounding circle (radius ``L``) about its
+centroid, and its centroid follows ``c(t) = c0 + v t + a t²/2``. Over a time slice
+``[t0, t1]`` each coordinate of that path is a parabola, so its range is spanned by the
+slice's ends and the apex ``t* = −v/a`` when it falls inside; the box of that range
+grown by ``L`` (widened as the pairwise broad phase widens the radii, see
+:func:`swept_boxes`) holds the body for the whole slice, whatever its spin. Each body
+gets enough slices that its centroid moves at most about ``L`` per slice (at most
+``max_slices``), so the boxes hug the path. Two bodies can touch at
+time t only if the boxes of the slices holding t overlap in x, in y and in time:
+a sort-and-sweep over the space–time boxes (on the axis where the boxes spread most)
+lists every such pair once.
+
+Batched search. :func:`impacts_chunk` runs, for a list of pairs, exactly what
+``polycontact.time_of_impact`` runs for one (``_kernels.impact.exact_query`` or
+``sampled_query``) on the bodies' tables packed one after another, without the GIL.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .impact import exact_query, sampled_query
+
+
+@njit(cache=True, nogil=True)
+def _coordinate_range(c, v, a, t0, t1):
+    """Range of ``c + v t + a t²/2`` over ``[t0, t1]``: the ends and, inside, the apex."""
+    x0 = c + v * t0 + 0.5 * a * t0 * t0
+    x1 = c + v * t1 + 0.5 * a * t1 * t1
+    lo = min(x0, x1)
+    hi = max(x0, x1)
+    if a != 0.0:
+        ts = -v / a
+        if t0 < ts < t1:
+            xs = c + v * ts + 0.5 * a * ts * ts
+            lo = min(lo, xs)
+            hi = max(hi, xs)
+    return lo, hi
+
+
+@njit(cache=True, nogil=True)
+def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
+    """Space–time boxes bounding each body over ``[0, t_max]``.
+
+    ``c`` (N, 2) centroids at t = 0, ``m`` (N, 6) motion vectors ``[vx, vy, ax, ay, ω,
+    α]``, ``radius`` (N,) bounding radii. Body i gets ``k_i = clamp(ceil(travel_i /
+    radius_i), 1, max_slices)`` slices of ``[0, t_max]`` (``travel_i = |v| t_max +
+    |a| t_max²/2`` bounds its centroid's path length). Each box is grown by the radius
+    times ``1 + inflate`` and by ``ulps`` times the body's reach ``radius + Σ_x,y (|c0| +
+    |v| t_max + |a| t_max²/2)``: the terms whose sum over both bodies, times 16 units of
+    2**-52, the pairwise broad phase adds to the sum of the radii
+    (:func:`polycontact._kernels.broad_phase.rounding_allowance`); ``ulps`` above that
+    covers the rounding of the centre distance there and of the boxes here. Two bodies
+    whose inflated circles the pairwise broad phase sees meeting at some t thus have
+    boxes that meet in x, y and time (slice ends are computed one way for every body,
+    so the slices tile ``[0, t_max]``).
+
+    Returns ``(boxes, owner)``: ``boxes[k] = (x_lo, x_hi, y_lo, y_hi, t_lo, t_hi)`` and
+    the body it bounds.
+    """
+    n = c.shape[0]
+    counts = np.empty(n, np.int64)
+    total = 0
+    for i in range(n):
+        travel = np.sqrt(m[i, 0] ** 2 + m[i, 1] ** 2) * t_max + \
+            0.5 * np.sqrt(m[i, 2] ** 2 + m[i, 3] ** 2) * t_max * t_max
+        k = 1
+        if radius[i] > 0.0 and travel > radius[i]:
+            k = int(min(float(max_slices), np.ceil(travel / radius[i])))
+        k = max(1, min(k, max_slices))
+        counts[i] = k
+        total += k
+    boxes = np.empty((total, 6))
+    owner = np.empty(total, np.int64)
+    b = 0
+    for i in range(n):
+        k = counts[i]
+        vx, vy, ax, ay = m[i, 0], m[i, 1], m[i, 2], m[i, 3]
+        reach = radius[i] + abs(c[i, 0]) + abs(c[i, 1]) + \
+            (abs(vx) + abs(vy)) * t_max + 0.5 * (abs(ax) + abs(ay)) * t_max * t_max
+        grow = radius[i] * (1.0 + inflate) + ulps * reach
+        for s in range(k):
+            t0 = t_max * s / k
+            t1 = t_max if s == k - 1 else t_max * (s + 1) / k
+            xlo, xhi = _coordinate_range(c[i, 0], vx, ax, t0, t1)
+            ylo, yhi = _coordinate_range(c[i, 1], vy, ay, t0, t1)
+            boxes[b, 0] = xlo - grow
+            boxes[b, 1] = xhi + grow
+            boxes[b, 2] = ylo - grow
+            boxes[b, 3] = yhi + grow
+            if not (boxes[b, 0] <= boxes[b, 1] and boxes[b, 2] <= boxes[b, 3]):
+                # the path overflowed float64 (inf − inf): the box is the whole plane,
+                # so that the pair goes on to the search, which says what it can
+                boxes[b, 0] = -np.inf
+                boxes[b, 1] = np.inf
+                boxes[b, 2] = -np.inf
+                boxes[b, 3] = np.inf
+            boxes[b, 4] = t0
+            boxes[b, 5] = t1
+            owner[b] = i
+            b += 1
+    return boxes, owner
+
+
+@njit(cache=True, nogil=True)
+def box_pairs(boxes, owner, n_bodies):
+    """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
+    time (closed intervals), once each, sorted; shape (K, 2).
+
+    Sort and sweep on the axis (x or y) along which the boxes' centres spread most.
+    """
+    nb = boxes.shape[0]
+    if nb == 0:
+        return np.empty((0, 2), np.int64)
+    mx = 0.0
+    my = 0.0
+    for k in range(nb):
+        mx += boxes[k, 0] + boxes[k, 1]
+        my += boxes[k, 2] + boxes[k, 3]
+    mx /= 2.0 * nb
+    my /= 2.0 * nb
+    vx = 0.0
+    vy = 0.0
+    for k in range(nb):
+        vx += (0.5 * (boxes[k, 0] + boxes[k, 1]) - mx) ** 2
+        vy += (0.5 * (boxes[k, 2] + boxes[k, 3]) - my) ** 2
+    ax = 0 if vx >= vy else 2          # sweep axis: columns ax, ax + 1
+    ox = 2 - ax                        # the other axis
+    order = np.argsort(boxes[:, ax], kind="mergesort")
+    cap = 4 * nb + 16
+    keys = np.empty(cap, np.int64)
+    nk = 0
+    for p in range(nb):
+        a = order[p]
+        hi = boxes[a, ax + 1]
+        ia = owner[a]
+        for q in range(p + 1, nb):
+            b = order[q]
+            if boxes[b, ax] > hi:
+                break
+            ib = owner[b]
+            if ia == ib:
+                continue
+            if boxes[b, ox] > boxes[a, ox + 1] or boxes[a, ox] > boxes[b, ox + 1]:
+                continue
+            if boxes[b, 4] > boxes[a, 5] or boxes[a, 4] > boxes[b, 5]:
+                continue
+            if nk == cap:
+                grown = np.empty(2 * cap, np.int64)
+                grown[:cap] = keys
+                keys = grown
+                cap *= 2
+            i = min(ia, ib)
+            j = max(ia, ib)
+            keys[nk] = i * n_bodies + j
+            nk += 1
+    uniq = np.unique(keys[:nk])
+    out = np.empty((uniq.shape[0], 2), np.int64)
+    for k in range(uniq.shape[0]):
+        out[k, 0] = uniq[k] // n_bodies
+        out[k, 1] = uniq[k] % n_bodies
+    return out
+
+
+@njit(cache=True, nogil=True)
+def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles, r_len, v_off,
+                  s_off, n_off, cent, rad, t_max, inflate, time_tol, ulps, contact_resolution,
+                  max_iter, exact, samples, code, t_hi, t_lo, contact, iters, reached,
+                  n_iv, iv):
+    """Time of impact of the pairs ``todo`` (indices into the pair arrays), results
+    written in place at those indices.
+
+    Pair p is shape ``sa[p]`` moving with ``ma[p]`` against shape ``sb[p]`` moving with
+    ``mb[p]``, the size term of its distance tolerance ``eps_rel[p]`` (the kernels add
+    ``ulps`` times the largest |coordinate| at each time they examine). Shape s is
+    packed as rows ``v_off[s]:v_off[s + 1]`` of ``r`` (vertices about its centroid),
+    ``nxt`` and ``r_len``; loop starts ``starts[s_off[s]:s_off[s + 1]]``; circle tree
+    rows ``n_off[s]:n_off[s + 1]`` of ``links`` and ``circles`` (the ``edge_table`` of
+    :mod:`polycontact._kernels.advance`, body-local indices); centroid ``cent[s]``,
+    bounding radius ``rad[s]``. Each pair runs ``exact_query`` (``exact``) or
+    ``sampled_query`` with the same arguments as ``polycontact.time_of_impact``
+    (contact resolution ``contact_resolution * (rad[a] + rad[b])``); its outputs go to
+    ``code``, ``t_hi``, ``t_lo``, ``contact``, ``iters``, ``reached``, and its broad-phase
+    intervals to ``iv[p, :n_iv[p]]``.
+    """
+    for k in range(todo.shape[0]):
+        p = todo[k]
+        a = sa[p]
+        b = sb[p]
+        ra = r[v_off[a]:v_off[a + 1]]
+        rb = r[v_off[b]:v_off[b + 1]]
+        sta = starts[s_off[a]:s_off[a + 1]]
+        stb = starts[s_off[b]:s_off[b + 1]]
+        la = rad[a]
+        lb = rad[b]
+        if exact:
+            ea = (nxt[v_off[a]:v_off[a + 1]], links[n_off[a]:n_off[a + 1]],
+                  circles[n_off[a]:n_off[a + 1]], r_len[v_off[a]:v_off[a + 1]])
+            eb = (nxt[v_off[b]:v_off[b + 1]], links[n_off[b]:n_off[b + 1]],
+                  circles[n_off[b]:n_off[b + 1]], r_len[v_off[b]:v_off[b + 1]])
+            out = exact_query(ra, sta, cent[a], ma[p], la, ea, rb, stb, cent[b], mb[p], lb, eb,
+                              t_max, inflate, time_tol, eps_rel[p], ulps,
+                              contact_resolution * (la + lb), max_iter)
+        else:
+            out = sampled_query(ra, sta, cent[a], ma[p], la, rb, stb, cent[b], mb[p], lb, t_max,
+                                inflate, time_tol, eps_rel[p], ulps, samples)
+        intervals, c, hi, lo, ct, its, got = out
+        code[p] = c
+        t_hi[p] = hi
+        t_lo[p] = lo
+        contact[p] = ct
+        iters[p] = its
+        reached[p] = got
+        n_iv[p] = intervals.shape[0]            # the caller checks it fits in iv
+        for q in range(min(intervals.shape[0], iv.shape[1])):
+            iv[p, q, 0] = intervals[q, 0]
+            iv[p, q, 1] = intervals[q, 1]

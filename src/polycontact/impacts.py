@@ -1,0 +1,579 @@
+"""Time of impact for many pairs, and the first impacts among many moving bodies.
+
+:func:`time_of_impact_many` answers a list of pairs the caller chose; :func:`first_impacts`
+finds, among N moving bodies, every pair that meets within ``[0, t_max]`` without
+looking at all N(N − 1)/2 pairs: each body's swept region over ``[0, t_max]`` is bounded
+by space–time boxes (its bounding circle along its centroid's path, one box per time
+slice, :func:`polycontact._kernels.swept.swept_boxes`), a compiled sort-and-sweep lists
+the pairs whose boxes meet, and only those go to the exact search. Both run the pairs on
+threads (the compiled searches release the GIL), and every answer is the one
+:func:`polycontact.time_of_impact` gives for that pair: the same kernel with the same
+arguments, and pairs the boxes leave out are pairs whose bounding circles never meet in
+``[0, t_max]`` (``time_of_impact`` reports nothing for them either).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ._checks import finite_number
+from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
+from .errors import InvalidShapeError
+from .impact import (_METHODS, _STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
+                     ImpactStatus, _extent, _result, body_frame)
+from .motion import Motion
+from .bodies import as_shape
+from .shape import Shape
+from .tolerances import RELATIVE_TOLERANCE
+
+__all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
+           "candidate_pairs", "event_time"]
+
+#: At most this many time slices (space–time boxes) per body in the swept bounds. A
+#: body gets one slice per bounding radius its centroid travels; past this many the
+#: boxes of a long, fast path grow longer instead of more numerous.
+MAX_SLICES = 16
+
+#: The swept boxes are grown beyond each body's bounding radius as the circle-overlap
+#: broad phase of ``time_of_impact`` grows the sum of the radii: by
+#: ``BROAD_PHASE_INFLATION`` of the radius, and by this many units of 2**-52 of the
+#: body's reach (its radius plus the |terms| of its centroid's path over [0, t_max]:
+#: position, travel at the initial speed, travel by the acceleration, summed over x
+#: and y). 16 of them are the pairwise call's own widening
+#: (``_kernels.broad_phase.rounding_allowance``, which sums the same terms of both
+#: bodies), the rest cover the rounding of |c_A(t) − c_B(t)| there and of the boxes
+#: here (a few units each), so the boxes never leave out a pair the pairwise call
+#: would search. Far from the origin this is the float spacing of the positions, not a
+#: fraction of them: a unit body at 1e9 is grown by ~3e-5 (1e-6 of the reach, the
+#: margin before, was 1e3: every body within a thousand units was a candidate).
+SWEPT_ROUNDING_ULPS = 64.0
+
+#: Width of the broad-phase interval table per pair (a quartic is <= 0 on at most 3
+#: disjoint intervals).
+_MAX_INTERVALS = 6
+
+
+@dataclass(frozen=True)
+class ImpactBatch:
+    """The results of :func:`time_of_impact_many`, as arrays, with each pair's full
+    :class:`~polycontact.Impact` on demand.
+
+    Attributes
+    ----------
+    status : ndarray of shape (P,), int8
+        0 no hit, 1 hit, 2 penetrating at the start, 3 out of iterations (the codes
+        of the compiled search; ``impact(k).status`` is the matching
+        :class:`~polycontact.ImpactStatus`).
+    collides : ndarray of shape (P,), bool
+        ``status == 1``.
+    times : ndarray of shape (P,), float64
+        First penetration time of a hit, NaN otherwise.
+    first_contacts : ndarray of shape (P,), float64
+        ``Impact.first_contact`` (0 when penetrating at the start), NaN when None.
+    """
+
+    status: np.ndarray
+    collides: np.ndarray
+    times: np.ndarray
+    first_contacts: np.ndarray
+    _make: Callable[[int], Impact] = field(repr=False, compare=False)
+
+    def __len__(self) -> int:
+        return int(self.status.shape[0])
+
+    def impact(self, k: int) -> Impact:
+        """The :class:`~polycontact.Impact` of pair ``k``, equal to what
+        :func:`polycontact.time_of_impact` returns for it."""
+        n = len(self)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
+            raise IndexError(f"k: expected a pair index in [0, {n}), got {k!r}")
+        return self._make(int(k) % n)
+
+    def __iter__(self) -> Iterator[Impact]:
+        return (self.impact(k) for k in range(len(self)))
+
+
+class PairImpact(NamedTuple):
+    """One pair's first impact in :func:`first_impacts`: the two bodies' indices in the
+    caller's numbering (``i < j``; body i is ``a`` of the impact) and the
+    :class:`~polycontact.Impact` of ``time_of_impact(shapes[i], motions[i], shapes[j],
+    motions[j])``."""
+
+    i: int
+    j: int
+    impact: Impact
+
+
+# -- validation ------------------------------------------------------------------------
+def _sequence(items: Any, what: str) -> list[Any]:
+    if isinstance(items, (str, bytes, dict)) or not isinstance(items, (Sequence, np.ndarray)):
+        raise TypeError(f"{what}: expected a sequence, got {type(items).__name__}")
+    return list(items)
+
+
+def _shapes(items: Any, what: str) -> list[Shape]:
+    out = []
+    for k, obj in enumerate(_sequence(items, what)):
+        name = f"{what}[{k}]"
+        try:
+            shape = as_shape(obj, name)
+        except InvalidShapeError as exc:
+            if str(exc).startswith(name):
+                raise
+            raise InvalidShapeError(f"{name}: {exc}") from None
+        out.append(shape)
+    return out
+
+
+def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion]:
+    motions = _sequence(items, what)
+    if len(motions) != count:
+        raise ValueError(f"{what}: expected {count} motions (one per shape of {shapes_what}), "
+                         f"got {len(motions)}")
+    return [check_motion(m, f"{what}[{k}]") for k, m in enumerate(motions)]
+
+
+def _options(t_max: float, method: str, time_tolerance: float, samples: int,
+             max_iterations: int, threads: int | None) -> tuple[float, float, int, int, int]:
+    t_max = check_t_max(t_max)
+    tol = finite_number(time_tolerance, "time_tolerance", positive=True)
+    if method not in _METHODS:
+        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
+            or max_iterations < 1:
+        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
+    if threads is None:
+        threads = os.cpu_count() or 1
+    elif isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads: expected an integer >= 1 or None, got {threads!r}")
+    return t_max, tol, int(samples), int(max_iterations), int(threads)
+
+
+# -- the batched search ----------------------------------------------------------------
+def _pack(shapes: list[Shape], exact: bool) -> tuple[Any, ...]:
+    """The shapes' body-frame tables one after another (see ``impacts_chunk``)."""
+    frames: list[Any] = [body_frame(s, tables=exact) for s in shapes]
+    n = len(shapes)
+    nv = np.array([len(r) for r, _ in frames], dtype=np.int64)
+    v_off = np.zeros(n + 1, np.int64)
+    np.cumsum(nv, out=v_off[1:])
+    s_off = np.zeros(n + 1, np.int64)
+    np.cumsum([len(s.packed[1]) for s in shapes], out=s_off[1:])
+    n_off = np.zeros(n + 1, np.int64)
+    np.cumsum(2 * nv - 1 if exact else np.zeros(n, np.int64), out=n_off[1:])
+    r = np.concatenate([f[0] for f in frames]) if n else np.empty((0, 2))
+    starts = np.concatenate([s.packed[1] for s in shapes]) if n else np.empty(0, np.int64)
+    if exact and n:
+        nxt = np.concatenate([f[1][0] for f in frames])
+        links = np.concatenate([f[1][1] for f in frames])
+        circles = np.concatenate([f[1][2] for f in frames])
+        r_len = np.concatenate([f[1][3] for f in frames])
+    else:
+        nxt = np.empty(0, np.int64)
+        links = np.empty((0, 3), np.int64)
+        circles = np.empty((0, 4))
+        r_len = np.empty(0)
+    cent = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2)
+    rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
+    return (r, starts.astype(np.int64), nxt, links, circles, r_len, v_off, s_off, n_off, cent,
+            rad)
+
+
+def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
+            mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
+            samples: int, max_iterations: int, threads: int) -> tuple[Any, ...]:
+    """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
+    search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
+    of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
+    from ._kernels.swept import impacts_chunk
+
+    exact = method == "exact"
+    tables = _pack(shapes, exact)
+    p_count = len(sa)
+    code = np.zeros(p_count, np.int8)
+    t_hi = np.empty(p_count)
+    t_lo = np.empty(p_count)
+    contact = np.empty(p_count)
+    iters = np.empty(p_count, np.int64)
+    reached = np.empty(p_count)
+    n_iv = np.empty(p_count, np.int64)
+    iv = np.empty((p_count, _MAX_INTERVALS, 2))
+    out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
+
+    def run(todo: np.ndarray) -> None:
+        impacts_chunk(todo, sa, sb, ma, mb, eps_rel, *tables, t_max, BROAD_PHASE_INFLATION,
+                      tol, _ULPS, CONTACT_RESOLUTION, max_iterations, exact, samples, *out)
+
+    # many small interleaved chunks: the cost of a pair varies a thousandfold (an
+    # empty broad phase against a long slide), so the threads take chunks as they go
+    order = np.arange(p_count, dtype=np.int64)
+    if threads == 1 or p_count < 64:
+        run(order)
+    else:
+        n_chunks = min(p_count // 16, 16 * threads)
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(run, [order[c::n_chunks].copy() for c in range(n_chunks)]))
+    if p_count and int(n_iv.max()) > _MAX_INTERVALS:  # a quartic has at most 3
+        raise AssertionError("broad phase returned more intervals than a quartic has")
+    return out
+
+
+def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
+           raw: tuple[Any, ...], t_max: float, method: str, eps_rel: np.ndarray,
+           tol: float) -> Callable[[int], Impact]:
+    code, t_hi, t_lo, contact, iters, reached, n_iv, iv = raw
+
+    def make(p: int) -> Impact:
+        a, ma = shape_of(p, 0), motion_of(p, 0)
+        b, mb = shape_of(p, 1), motion_of(p, 1)
+        return _result(a, ma, b, mb, method, _STATUS[int(code[p])], float(t_hi[p]),
+                       float(t_lo[p]), float(contact[p]), int(iters[p]), float(reached[p]),
+                       iv[p, :n_iv[p]], t_max, float(eps_rel[p]), tol)
+
+    return make
+
+
+def _unique(shapes: list[Shape]) -> tuple[list[Shape], np.ndarray]:
+    """Distinct shape objects (a shape used by many pairs is packed once) and each
+    input's index among them."""
+    seen: dict[int, int] = {}
+    uniq: list[Shape] = []
+    index = np.empty(len(shapes), np.int64)
+    for k, s in enumerate(shapes):
+        u = seen.get(id(s))
+        if u is None:
+            u = seen[id(s)] = len(uniq)
+            uniq.append(s)
+        index[k] = u
+    return uniq, index
+
+
+def _motion_array(motions: list[Motion]) -> np.ndarray:
+    """The rows ``Motion.array`` of every motion, in one NumPy call."""
+    return np.array([(*m.velocity, *m.acceleration, m.angular_velocity, m.angular_acceleration)
+                     for m in motions], dtype=np.float64).reshape(len(motions), 6)
+
+
+def _extents(shapes: list[Shape], motions: list[Motion], names: list[tuple[str, str]],
+             t_max: float) -> np.ndarray:
+    """Each body's extent (:func:`polycontact.impact._extent`: its pairs' distance
+    tolerance has the size term ``RELATIVE_TOLERANCE * max(extent_a, extent_b)``, as in
+    ``time_of_impact``), after the checks ``time_of_impact`` makes: the coordinates
+    (once per shape, with its body frame), then motions that would carry coordinates,
+    speeds or accelerations beyond float64's safe range within [0, t_max]. Errors name
+    the body's arguments, ``names[k] = (shape's, motion's)``."""
+    for s, (what, _) in zip(shapes, names):
+        body_frame(s, tables=False, what=what)
+    for s, m, (_, what) in zip(shapes, motions, names):
+        check_reach(s, m, t_max, what)
+    return np.array([_extent(s) for s in shapes], dtype=np.float64)
+
+
+def time_of_impact_many(
+    shapes_a: Any,
+    motions_a: Any,
+    shapes_b: Any,
+    motions_b: Any,
+    *,
+    t_max: float,
+    method: str = "exact",
+    time_tolerance: float = 1e-4,
+    samples: int = 10,
+    max_iterations: int = MAX_ITERATIONS,
+    threads: int | None = None,
+) -> ImpactBatch:
+    """Time of impact of many pairs ``(shapes_a[k], motions_a[k])`` against
+    ``(shapes_b[k], motions_b[k])``, in parallel.
+
+    Pair k's answer is the one ``time_of_impact(shapes_a[k], motions_a[k], shapes_b[k],
+    motions_b[k], t_max=..., ...)`` gives (the same kernel with the same arguments,
+    bit for bit); the pairs are shared among ``threads`` threads, since the compiled
+    search releases the GIL. A shape that appears in many pairs (the same object) has
+    its tables built once.
+
+    The result is a batch of arrays (``status``, ``collides``, ``times``,
+    ``first_contacts``), what one filters and sorts over many pairs, with
+    ``batch.impact(k)`` giving pair k's full :class:`~polycontact.Impact` (features,
+    point, normal) on demand: building the P result objects is left to the pairs the
+    caller looks at.
+
+    Parameters
+    ----------
+    shapes_a, shapes_b : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
+        The bodies at t = 0, P of each.
+    motions_a, motions_b : sequence of Motion
+        Their motions, one per shape.
+    t_max, method, time_tolerance, samples, max_iterations
+        As for :func:`polycontact.time_of_impact`, for every pair.
+    threads : int, optional
+        Threads to use (default: one per CPU).
+
+    Returns
+    -------
+    ImpactBatch
+
+    Raises
+    ------
+    TypeError, ValueError, InvalidShapeError
+        Naming the argument and the index: ``shapes_b[3]: outer loop: ...``,
+        ``motions_a[2]: expected a polycontact.Motion, got tuple``,
+        ``motions_b: expected 4 motions (one per shape of shapes_b), got 3``, or a
+        motion ``time_of_impact`` refuses because the body's coordinates, speeds or
+        accelerations would overflow float64 within ``[0, t_max]``
+        (``motions_b[1]: the body's coordinates reach ...``).
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
+    ...                             [sq.moved((3, 0)), sq.moved((0, 5))], [Motion()] * 2,
+    ...                             t_max=5)
+    >>> batch.collides.tolist(), batch.times.round(3).tolist(), batch.status.tolist()
+    ([True, False], [2.0, nan], [1, 0])
+    >>> batch.impact(0).status.value
+    'hit'
+    """
+    a = _shapes(shapes_a, "shapes_a")
+    b = _shapes(shapes_b, "shapes_b")
+    if len(a) != len(b):
+        raise ValueError(f"shapes_a and shapes_b differ in length ({len(a)} and {len(b)})")
+    ma = _motions(motions_a, "motions_a", len(a), "shapes_a")
+    mb = _motions(motions_b, "motions_b", len(b), "shapes_b")
+    t_max, tol, samples, max_iterations, threads = _options(
+        t_max, method, time_tolerance, samples, max_iterations, threads)
+    # a body (the same shape and motion objects) in many pairs is prepared once
+    p_count = len(a)
+    seen: dict[tuple[int, int], int] = {}
+    body = np.empty(2 * p_count, np.int64)
+    b_shapes: list[Shape] = []
+    b_motions: list[Motion] = []
+    names: list[tuple[str, str]] = []          # where each body first appears
+    for k, (s, m) in enumerate(zip(a + b, ma + mb)):
+        u = seen.setdefault((id(s), id(m)), len(b_shapes))
+        if u == len(b_shapes):
+            b_shapes.append(s)
+            b_motions.append(m)
+            side, q = ("a", k) if k < p_count else ("b", k - p_count)
+            names.append((f"shapes_{side}[{q}]", f"motions_{side}[{q}]"))
+        body[k] = u
+    extent = _extents(b_shapes, b_motions, names, t_max)
+    uniq, index = _unique(b_shapes)
+    rows = _motion_array(b_motions)
+    ba, bb = body[:p_count], body[p_count:]
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[ba], extent[bb])
+    raw = _search(uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel, t_max, method, tol,
+                  samples, max_iterations, threads)
+    code, t_hi, _, contact, *_ = raw
+    collides = code == 1
+    pairs = (a, b)
+    moves = (ma, mb)
+    make = _maker(lambda p, s: pairs[s][p], lambda p, s: moves[s][p], raw, t_max, method,
+                  eps_rel, tol)
+    return ImpactBatch(
+        status=code,
+        collides=collides,
+        times=np.where(collides, t_hi, np.nan),
+        first_contacts=np.where(code == 2, 0.0, np.where(contact >= 0.0, contact, np.nan)),
+        _make=make,
+    )
+
+
+# -- many moving bodies ----------------------------------------------------------------
+def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
+                    t_max: float) -> np.ndarray:
+    """Pairs ``(i, j)``, i < j, whose swept bounds over ``[0, t_max]`` meet: a superset of
+    the pairs whose bounding circles come within reach of each other in that window,
+    hence of every pair that can touch. Shape (K, 2), sorted, int64. The boxes are
+    widened as :func:`polycontact.time_of_impact`'s broad phase widens the circles (a
+    relative inflation and the rounding of positions far from the origin), so every
+    pair it would search is here. Motions it refuses (coordinates, speeds or
+    accelerations that would overflow float64) are refused here too, naming
+    ``motions[k]``.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> shapes = [sq, sq.moved((3, 0)), sq.moved((0, 30))]
+    >>> candidate_pairs(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5).tolist()
+    [[0, 1]]
+    """
+    shapes = _shapes(shapes, "shapes")
+    motions = _motions(motions, "motions", len(shapes), "shapes")
+    t_max = check_t_max(t_max)
+    _extents(shapes, motions, [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))],
+             t_max)
+    return _candidates(shapes, motions, t_max)
+
+
+def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.ndarray:
+    from ._kernels.swept import box_pairs, swept_boxes
+
+    n = len(shapes)
+    if n < 2:
+        return np.empty((0, 2), np.int64)
+    cent = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2)
+    rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
+    boxes, owner = swept_boxes(cent, _motion_array(motions), rad, t_max, MAX_SLICES,
+                               BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
+    pairs: np.ndarray = box_pairs(boxes, owner, n)
+    return pairs
+
+
+def event_time(impact: Impact) -> float:
+    """When a pair's event happens: 0 when penetrating at the start, the first
+    penetration time of a hit, the time the search stopped when it ran out of
+    iterations, else the first contact (inf when the bodies never touch).
+
+    >>> from polycontact import Motion, Shape, time_of_impact
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> round(event_time(time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)),
+    ...                                 Motion(), t_max=5)), 3)
+    2.0
+    """
+    if impact.status is ImpactStatus.PENETRATING_AT_START:
+        return 0.0
+    if impact.status is ImpactStatus.HIT and impact.time is not None:
+        return impact.time
+    if impact.status is ImpactStatus.OUT_OF_ITERATIONS:
+        return impact.searched_to
+    return impact.first_contact if impact.first_contact is not None else math.inf
+
+
+def first_impacts(
+    shapes: Any,
+    motions: Any,
+    t_max: float,
+    *,
+    method: str = "exact",
+    time_tolerance: float = 1e-4,
+    samples: int = 10,
+    max_iterations: int = MAX_ITERATIONS,
+    threads: int | None = None,
+) -> list[PairImpact]:
+    """Every pair of moving bodies that meets within ``[0, t_max]``, sorted by time.
+
+    A pair meets when its bodies touch or penetrate at some time of the window (an
+    :class:`~polycontact.Impact` with a ``state``), or when its search ran out of
+    iterations (no verdict: reported, never dropped). Each entry is
+    ``(i, j, impact)`` with ``i < j`` in the caller's numbering and ``impact`` equal to
+    ``time_of_impact(shapes[i], motions[i], shapes[j], motions[j], t_max=t_max, ...)``;
+    entries are sorted by :func:`event_time`, then by ``(i, j)``. Pairs that collide
+    have ``impact.collides``; the others only touch (or penetrate from the start, or
+    have no verdict: ``impact.status``).
+
+    Only the pairs whose swept bounds meet are searched (:func:`candidate_pairs`: each
+    body's bounding circle along its centroid's path, boxed over time slices, then a
+    compiled sort-and-sweep), on ``threads`` threads. The others cannot touch: their
+    bounding circles never overlap in the window, and ``time_of_impact`` would find
+    nothing for them either.
+
+    Parameters
+    ----------
+    shapes : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
+        The bodies at t = 0.
+    motions : sequence of Motion
+        One per body.
+    t_max : float
+        End of the time window (>= 0).
+    method, time_tolerance, samples, max_iterations
+        As for :func:`polycontact.time_of_impact`.
+    threads : int, optional
+        Threads for the exact searches (default: one per CPU).
+
+    Returns
+    -------
+    list of PairImpact
+        ``(i, j, impact)`` named tuples.
+
+    Raises
+    ------
+    TypeError, ValueError, InvalidShapeError
+        As :func:`time_of_impact_many`, naming ``shapes[k]`` or ``motions[k]``; every
+        body is checked, whether or not a pair of it is searched.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> shapes = [sq, sq.moved((3, 0)), sq.moved((1.5, 1)), sq.moved((0, 30))]
+    >>> motions = [Motion(velocity=(1, 0)), Motion(), Motion(), Motion()]
+    >>> for i, j, imp in first_impacts(shapes, motions, t_max=5):
+    ...     print(i, j, imp.status.value, imp.state.value, round(event_time(imp), 3))
+    0 2 no-hit contact 0.5
+    0 1 hit penetrating 2.0
+    """
+    shapes = _shapes(shapes, "shapes")
+    motions = _motions(motions, "motions", len(shapes), "shapes")
+    t_max, tol, samples, max_iterations, threads = _options(
+        t_max, method, time_tolerance, samples, max_iterations, threads)
+    # every body is checked as time_of_impact checks it, searched or not
+    extent = _extents(shapes, motions,
+                      [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))], t_max)
+    pairs = _candidates(shapes, motions, t_max)
+    if len(pairs) == 0:
+        return []
+    # only the bodies of candidate pairs are packed and searched
+    used = np.unique(pairs)
+    local = np.empty(len(shapes), np.int64)
+    local[used] = np.arange(len(used))
+    sub_shapes = [shapes[k] for k in used]
+    sub_motions = [motions[k] for k in used]
+    uniq, index = _unique(sub_shapes)
+    m = _motion_array(sub_motions)
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[pairs[:, 0]], extent[pairs[:, 1]])
+    i, j = local[pairs[:, 0]], local[pairs[:, 1]]
+    raw = _search(uniq, index[i], index[j], m[i], m[j], eps_rel, t_max, method, tol, samples,
+                  max_iterations, threads)
+    i, j = pairs[:, 0], pairs[:, 1]
+    code, _, _, contact, *_ = raw
+    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
+                  t_max, method, eps_rel, tol)
+    events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
+              for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
+    events.sort(key=lambda e: (event_time(e.impact), e.i, e.j))
+    return events
+
+
+def _first_order(event: PairImpact) -> tuple[Any, ...]:
+    """:meth:`polycontact.Scene.first_impact`'s order: collisions (penetrating at the
+    start, hits, searches without a verdict) by time before any touch."""
+    imp = event.impact
+    touch_only = imp.status is ImpactStatus.NO_HIT
+    return (math.inf if touch_only else event_time(imp),
+            event_time(imp) if touch_only else 0.0, event.i, event.j)
+
+
+def first_impact(
+    shapes: Any,
+    motions: Any,
+    t_max: float,
+    **options: Any,
+) -> PairImpact | None:
+    """The first event among many moving bodies: the earliest collision (a pair
+    penetrating at the start counts at t = 0, a search without a verdict at the time it
+    stopped), or, if no pair collides, the earliest touch; None when no pair meets.
+    This is the order of :meth:`polycontact.Scene.first_impact`; ties go to the lowest
+    ``(i, j)``. ``options`` are those of :func:`first_impacts`.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> shapes = [sq, sq.moved((3, 0)), sq.moved((1.5, 1))]
+    >>> i, j, imp = first_impact(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5)
+    >>> i, j, round(imp.time, 3)
+    (0, 1, 2.0)
+    """
+    events = first_impacts(shapes, motions, t_max, **options)
+    return min(events, key=_first_order) if events else None

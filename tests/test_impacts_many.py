@@ -1,0 +1,443 @@
+"""Many moving bodies: time_of_impact_many and first_impacts against the pairwise calls.
+
+The oracle is the pairwise ``time_of_impact`` itself (its own correctness is checked
+against Shapely in test_impact.py): every batched answer must be *equal* to it (the
+same Impact, field by field), and ``first_impacts`` must find exactly the pairs that
+the brute force over all pairs finds. The swept bounds are checked on their own: no
+pair whose bounding circles meet in the window (what ``time_of_impact`` searches) is
+ever left out, at any scale, offset, speed and acceleration.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from catalogue import shapes as star_shapes
+from catalogue import translated
+from hypothesis import assume, given
+from hypothesis import strategies as st
+from profiles import examples
+
+import polycontact as pc
+from polycontact import ImpactStatus, InvalidShapeError, Motion, Shape
+from polycontact._kernels.swept import swept_boxes
+from polycontact.broad_phase import BROAD_PHASE_INFLATION, intervals_array
+from polycontact.impacts import (MAX_SLICES, SWEPT_ROUNDING_ULPS, candidate_pairs, event_time,
+                                 first_impact, first_impacts, time_of_impact_many)
+
+SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+STATUS_CODES = {ImpactStatus.NO_HIT: 0, ImpactStatus.HIT: 1,
+                ImpactStatus.PENETRATING_AT_START: 2, ImpactStatus.OUT_OF_ITERATIONS: 3}
+#: A small budget keeps long slides short in the property tests; both sides use it.
+BUDGET = 20_000
+
+
+def brute(shapes, motions, t_max, **kw):
+    """Every pair that meets, by the pairwise call: {(i, j): Impact}."""
+    out = {}
+    for i in range(len(shapes)):
+        for j in range(i + 1, len(shapes)):
+            imp = pc.time_of_impact(shapes[i], motions[i], shapes[j], motions[j], t_max=t_max,
+                                    **kw)
+            if imp.state is not None or imp.status is ImpactStatus.OUT_OF_ITERATIONS:
+                out[i, j] = imp
+    return out
+
+
+# -- strategies ------------------------------------------------------------------------
+@st.composite
+def motions(draw, grid: bool) -> Motion:
+    """Axis-aligned integer velocities on the grid (exact grazes and flush hits), or
+    any velocity, acceleration and spin."""
+    if grid:
+        axis = draw(st.sampled_from([(1, 0), (0, 1), (1, 1), (0, 0)]))
+        speed = draw(st.integers(-4, 4))
+        return Motion(velocity=(axis[0] * speed, axis[1] * speed))
+    f = st.floats(-8, 8)
+    return Motion(velocity=(draw(f), draw(f)),
+                  acceleration=draw(st.sampled_from([(0.0, 0.0), (draw(f), draw(f))])),
+                  angular_velocity=draw(st.floats(-3, 3)),
+                  angular_acceleration=draw(st.sampled_from([0.0, draw(st.floats(-2, 2))])))
+
+
+@st.composite
+def scenes(draw, n_max: int = 5):
+    """2..n_max concave bodies (some with holes) in slots along a row, on the integer grid
+    or not: apart, touching (a vertex placed on another's vertex), penetrating at the
+    start, or aimed at another body (where it will be at a chosen time, give or take
+    their radii: hits, grazes and near misses)."""
+    grid = draw(st.booleans())
+    n = draw(st.integers(2, n_max))
+    t_max = float(draw(st.sampled_from([0.0, 0.5, 1.0, 2.0, 3.0]) if grid else st.floats(0, 3)))
+    bodies, moves = [], []
+    for _ in range(n):
+        s = draw(star_shapes(grid=grid, n_max=8))
+        m = draw(motions(grid))
+        how = draw(st.sampled_from(["random", "aim", "aim", "aim", "vertex", "overlap"]))
+        if how != "random" and bodies:
+            k = draw(st.integers(0, len(bodies) - 1))
+            other, mo = bodies[k], moves[k]
+            if how == "vertex":
+                va = other.loops[0][draw(st.integers(0, len(other.loops[0]) - 1))]
+                vb = s.loops[0][draw(st.integers(0, len(s.loops[0]) - 1))]
+                d = va - vb
+            elif how == "overlap":
+                d = other.centroid - s.centroid + np.round(draw(st.floats(-2, 2)))
+            else:
+                tau = t_max * draw(st.floats(0, 1))
+                reach = other.bounding_radius + s.bounding_radius
+                off = reach * draw(st.floats(0.7, 1.3)) * np.array(
+                    [math.cos(draw(st.floats(0, 6.3))), math.sin(draw(st.floats(0, 6.3)))])
+                d = other.centroid + mo.pose(tau)[0] - m.pose(tau)[0] + off - s.centroid
+                if grid:
+                    d = np.round(d)
+        else:   # spread out along a row of slots 25 apart, with some play
+            d = np.array([25.0 * len(bodies), 0.0]) + (
+                np.array(draw(st.lists(st.integers(-8, 8), min_size=2, max_size=2)), float)
+                if grid else np.array(draw(st.lists(st.floats(-8, 8), min_size=2, max_size=2))))
+        bodies.append(translated(s, d))
+        moves.append(m)
+    return bodies, moves, t_max
+
+
+# -- time_of_impact_many ----------------------------------------------------------------
+@examples(60)
+@given(scenes(n_max=4), st.sampled_from(["exact", "sampled"]))
+def test_time_of_impact_many_equals_time_of_impact_per_pair(scene, method):
+    bodies, moves, t_max = scene
+    idx = [(i, j) for i in range(len(bodies)) for j in range(len(bodies)) if i != j]
+    a = [bodies[i] for i, _ in idx]
+    b = [bodies[j] for _, j in idx]
+    ma = [moves[i] for i, _ in idx]
+    mb = [moves[j] for _, j in idx]
+    batch = time_of_impact_many(a, ma, b, mb, t_max=t_max, method=method,
+                                max_iterations=BUDGET)
+    assert len(batch) == len(idx)
+    for k in range(len(idx)):
+        want = pc.time_of_impact(a[k], ma[k], b[k], mb[k], t_max=t_max, method=method,
+                                 max_iterations=BUDGET)
+        got = batch.impact(k)
+        assert got == want
+        assert got.features == want.features
+        assert STATUS_CODES[want.status] == int(batch.status[k])
+        assert bool(batch.collides[k]) == want.collides
+        assert (math.isnan(batch.times[k]) if want.time is None
+                else batch.times[k] == want.time)
+        assert (math.isnan(batch.first_contacts[k]) if want.first_contact is None
+                else batch.first_contacts[k] == want.first_contact)
+
+
+def test_time_of_impact_many_threads_give_the_same_answers():
+    rng = np.random.default_rng(3)
+    a = [SQ.moved(rng.uniform(-3, 3, 2), rng.uniform(0, 6)) for _ in range(300)]
+    ma = [Motion(velocity=rng.uniform(-2, 2, 2), angular_velocity=rng.uniform(-2, 2))
+          for _ in a]
+    b = [SQ] * len(a)
+    mb = [Motion()] * len(a)
+    one = time_of_impact_many(a, ma, b, mb, t_max=2, threads=1)
+    two = time_of_impact_many(a, ma, b, mb, t_max=2, threads=2)
+    assert one.status.tolist() == two.status.tolist() and one.collides.any()
+    assert list(one) == list(two)
+    assert np.array_equal(one.times, two.times, equal_nan=True)
+
+
+def test_time_of_impact_many_empty_and_arrays_untouched():
+    empty = time_of_impact_many([], [], [], [], t_max=1)
+    assert len(empty) == 0 and empty.times.shape == (0,)
+    ring = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    other = ring + [3.0, 0.0]
+    keep = ring.copy(), other.copy()
+    batch = time_of_impact_many([ring], [Motion(velocity=(1, 0))], [other], [Motion()], t_max=5)
+    assert batch.collides.tolist() == [True]
+    assert np.array_equal(ring, keep[0]) and np.array_equal(other, keep[1])
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ, SQ], [Motion()] * 2, t_max=1),
+     ValueError, r"shapes_a and shapes_b differ in length \(1 and 2\)"),
+    (lambda: time_of_impact_many([SQ, SQ], [Motion(), (1, 0)], [SQ, SQ], [Motion()] * 2,
+                                 t_max=1),
+     TypeError, r"motions_a\[1\]: expected a polycontact.Motion, got tuple"),
+    (lambda: time_of_impact_many([SQ] * 3, [Motion()] * 3, [SQ] * 3, [Motion()] * 2, t_max=1),
+     ValueError, r"motions_b: expected 3 motions \(one per shape of shapes_b\), got 2"),
+    (lambda: time_of_impact_many([SQ] * 3, [Motion()] * 3, [SQ, SQ, [(0, 0), (1, 1)]],
+                                 [Motion()] * 3, t_max=1),
+     InvalidShapeError, r"shapes_b\[2\]: .*fewer than 3"),
+    (lambda: time_of_impact_many([SQ, SQ.to_shapely().buffer(-0.6)], [Motion()] * 2, [SQ] * 2,
+                                 [Motion()] * 2, t_max=1),
+     InvalidShapeError, r"shapes_a\[1\]: "),
+    (lambda: time_of_impact_many("abc", [], [], [], t_max=1),
+     TypeError, "shapes_a: expected a sequence, got str"),
+    (lambda: time_of_impact_many([SQ], Motion(), [SQ], [Motion()], t_max=1),
+     TypeError, "motions_a: expected a sequence, got Motion"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=-1),
+     ValueError, "t_max"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1,
+                                 time_tolerance=0), ValueError, "time_tolerance"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1, method="fast"),
+     ValueError, "method: expected one of exact, sampled"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1, threads=0),
+     ValueError, "threads: expected an integer >= 1"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1, samples=1),
+     ValueError, "samples"),
+    (lambda: first_impacts([SQ, SQ, SQ], [Motion()] * 2, 1),
+     ValueError, r"motions: expected 3 motions \(one per shape of shapes\), got 2"),
+    (lambda: first_impacts([SQ, 3], [Motion()] * 2, 1), TypeError,
+     r"shapes\[1\]: expected a body \(.*\), got int"),
+    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), ValueError,
+     r"shapes\[1\]: "),  # text is WKT (bodies.as_shape): a wrong value, not type
+    (lambda: first_impacts([SQ, SQ], [Motion(), None], 1), TypeError, r"motions\[1\]: "),
+    (lambda: first_impacts([SQ, SQ], [Motion()] * 2, math.nan), ValueError, "t_max"),
+    (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1).impact(1),
+     IndexError, r"k: expected a pair index in \[0, 1\), got 1"),
+])
+def test_bad_arguments_are_named_with_their_index(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+# -- first_impacts ---------------------------------------------------------------------
+@examples(60)
+@given(scenes(), st.sampled_from(["exact", "exact", "sampled"]))
+def test_first_impacts_equals_brute_force_over_all_pairs(scene, method):
+    bodies, moves, t_max = scene
+    want = brute(bodies, moves, t_max, max_iterations=BUDGET, method=method)
+    events = first_impacts(bodies, moves, t_max, max_iterations=BUDGET, method=method)
+    assert {(e.i, e.j): e.impact for e in events} == want
+    keys = [(event_time(e.impact), e.i, e.j) for e in events]
+    assert keys == sorted(keys)
+    if method == "sampled":
+        return
+    first = first_impact(bodies, moves, t_max, max_iterations=BUDGET)
+    if not want:
+        assert first is None
+        return
+    # Scene.first_impact, the all-pairs loop, picks the same pair and the same impact
+    scene_obj = pc.Scene(tuple(pc.Body(str(k), s, m) for k, (s, m) in
+                               enumerate(zip(bodies, moves))), t_max)
+    a, b, imp = _scene_first(scene_obj)
+    assert (first.i, first.j) == (int(a.name), int(b.name)) and first.impact == imp
+
+
+def _scene_first(scene_obj):
+    from polycontact import scene as sc
+
+    results = []
+    for i, a in enumerate(scene_obj.bodies):
+        for b in scene_obj.bodies[i + 1:]:
+            results.append((a, b, pc.time_of_impact(a.shape, a.motion, b.shape, b.motion,
+                                                    t_max=scene_obj.t_max,
+                                                    max_iterations=BUDGET)))
+    return min(results, key=lambda r: sc._event_order(r[2]))
+
+
+def test_first_impacts_reports_hits_touches_and_start_overlaps_in_time_order():
+    shapes = [SQ, SQ.moved((3, 0)), SQ.moved((1.5, 1)), SQ.moved((0, 30)),
+              SQ.moved((0, 30.5)), SQ.moved((10, 10))]
+    moves = [Motion(velocity=(1, 0)), Motion(), Motion(), Motion(), Motion(), Motion()]
+    events = first_impacts(shapes, moves, 5)
+    assert [(e.i, e.j, e.impact.status.value) for e in events] == [
+        (3, 4, "penetrating-at-start"), (0, 2, "no-hit"), (0, 1, "hit")]
+    assert events[1].impact.state is pc.State.CONTACT
+    assert first_impact(shapes, moves, 5)[:2] == (3, 4)
+    # without the overlapping pair the hit comes first, although the touch is earlier
+    assert first_impact(shapes[:3], moves[:3], 5)[:2] == (0, 1)
+    assert first_impact(shapes[:1] + shapes[3:4], moves[:2], 5) is None
+    assert first_impacts([SQ], [Motion()], 5) == [] and first_impacts([], [], 5) == []
+
+
+# -- the swept bounds -------------------------------------------------------------------
+@st.composite
+def swarms(draw):
+    """Bodies whose bounding circles come close to one meeting point at chosen times:
+    near misses, exact grazes (centre distance = sum of radii at that time) and
+    overlaps, for any size (1e-4..1e4), offset (up to 1e9), speed, acceleration, spin
+    and window (long travel: up to 1e4 radii)."""
+    scale = 10.0 ** draw(st.integers(-4, 4))
+    offset = draw(st.sampled_from([0.0, 1e3, 1e6, 1e9])) * np.array(
+        [draw(st.floats(-1, 1)), draw(st.floats(-1, 1))])
+    t_max = draw(st.sampled_from([1e-3, 1.0, 10.0, 1e3]))
+    n = draw(st.integers(2, 8))
+    shapes, moves, centres = [], [], []
+    for _ in range(n):
+        size = scale * draw(st.floats(0.1, 3))
+        shape = SQ.moved((0, 0), draw(st.floats(0, 1.5)))
+        ring = (shape.loops[0] - shape.centroid) * size
+        speed = scale * draw(st.sampled_from([0.0, 1.0, 100.0, 1e4])) / t_max
+        v = speed * np.array([draw(st.floats(-1, 1)), draw(st.floats(-1, 1))])
+        acc = 2 * speed / t_max * np.array([draw(st.floats(-1, 1)), draw(st.floats(-1, 1))]) \
+            if draw(st.booleans()) else np.zeros(2)
+        m = Motion(velocity=v, acceleration=acc, angular_velocity=draw(st.floats(-50, 50)),
+                   angular_acceleration=draw(st.floats(-50, 50)))
+        tau = draw(st.floats(0, 1)) * t_max
+        translation, _ = m.pose(tau)
+        # a point near the meeting point, at a distance of 0..2 radii (the circles of
+        # two bodies meet there when the distances add up)
+        where = offset + scale * draw(st.floats(0, 2)) * np.array(
+            [math.cos(draw(st.floats(0, 6.3))), math.sin(draw(st.floats(0, 6.3)))])
+        try:
+            body = Shape(ring + (where - translation))
+        except InvalidShapeError:
+            assume(False)
+        shapes.append(body)
+        moves.append(m)
+        centres.append(where)
+    return shapes, moves, t_max
+
+
+@examples(400)
+@given(swarms())
+def test_swept_bounds_never_drop_a_pair_the_pairwise_call_searches(swarm):
+    shapes, moves, t_max = swarm
+    found = {tuple(p) for p in candidate_pairs(shapes, moves, t_max).tolist()}
+    for i in range(len(shapes)):
+        for j in range(i + 1, len(shapes)):
+            if len(intervals_array(shapes[i], moves[i], shapes[j], moves[j], t_max)):
+                assert (i, j) in found
+
+
+@examples(200)
+@given(swarms(), st.floats(0, 1))
+def test_swept_boxes_hold_each_bounding_circle_at_every_time(swarm, frac):
+    shapes, moves, t_max = swarm
+    cent = np.array([s.centroid for s in shapes])
+    m = np.array([mo.array for mo in moves])
+    rad = np.array([s.bounding_radius for s in shapes])
+    boxes, owner = swept_boxes(cent, m, rad, t_max, MAX_SLICES, BROAD_PHASE_INFLATION,
+                               SWEPT_ROUNDING_ULPS * 2.0**-52)
+    t = frac * t_max
+    for k, (s, mo) in enumerate(zip(shapes, moves)):
+        translation, _ = mo.pose(t)
+        c = s.centroid + translation
+        mine = boxes[(owner == k) & (boxes[:, 4] <= t) & (t <= boxes[:, 5])]
+        assert len(mine) >= 1
+        r = s.bounding_radius
+        assert any(b[0] <= c[0] - r and c[0] + r <= b[1] and b[2] <= c[1] - r
+                   and c[1] + r <= b[3] for b in mine)
+
+
+def test_swept_bounds_keep_a_grazing_pass_and_drop_far_pairs():
+    # circles of radius sqrt(1/2) each: centre distance sqrt(2) is an exact graze
+    r = math.sqrt(0.5)
+    a = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])
+    b = a.moved((5, 2 * r))
+    far = a.moved((0, 50))
+    pairs = candidate_pairs([a, b, far], [Motion(velocity=(1, 0)), Motion(), Motion()], 10)
+    assert pairs.tolist() == [[0, 1]]
+
+
+def test_swept_bounds_far_from_the_origin_grow_by_the_float_spacing():
+    # unit squares at 1e9, 10 apart, at rest: the boxes are grown by the rounding of
+    # positions there (~3e-5), as the pairwise broad phase is, not by a fraction of the
+    # offset (1e-6 of it made every body within 1e3 a candidate)
+    far = [SQ.moved((1e9 + 10.0 * k, -1e9)) for k in range(3)]
+    assert candidate_pairs(far, [Motion()] * 3, 1e3).tolist() == []
+    # ...and a grazing pass there is kept (circles of radius sqrt(1/2), sqrt(2) apart
+    # as a passes b: the pairwise broad phase sees them meet)
+    a = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]).moved((1e9, 1e9))
+    pair = [a, a.moved((5, math.sqrt(2)))]
+    moves = [Motion(velocity=(1, 0)), Motion()]
+    assert len(intervals_array(pair[0], moves[0], pair[1], moves[1], 10.0))
+    assert candidate_pairs(pair, moves, 10.0).tolist() == [[0, 1]]
+
+
+@examples(200)
+@given(st.sampled_from([1e3, 1e6, 1e9]), st.floats(-1, 1), st.floats(-1, 1), st.floats(0, 6.3),
+       st.floats(0, 1.5), st.sampled_from([1e-2, 1.0, 1e2]), st.floats(0.05, 1.5),
+       st.sampled_from([0.0, 1.0, 100.0]), st.floats(0, 6.3), st.sampled_from([1e-3, 1.0, 1e3]))
+def test_swept_bounds_keep_pairs_within_the_pairwise_rounding_allowance(
+        offset, fx, fy, direction, turn, size, frac, speed, heading, t_max):
+    # two bodies travelling together far from the origin, their bounding circles apart
+    # by a fraction of the widening the pairwise broad phase gives them for the rounding
+    # of positions there (rounding_allowance): it searches the pair whenever that
+    # widening covers the gap, so the swept boxes must keep it (boxes grown by the
+    # radius alone drop it)
+    from polycontact._kernels.broad_phase import rounding_allowance
+
+    a = Shape((SQ.moved((0, 0), turn).loops[0] - SQ.centroid) * size + offset * np.array([fx, fy]))
+    b = a.moved((0, 0), 0.7)
+    v = speed * size / t_max * np.array([math.cos(heading), math.sin(heading)])
+    m = Motion(velocity=v)
+    allow = rounding_allowance(a.centroid, m.array, a.centroid, m.array, t_max)
+    d = (a.bounding_radius + b.bounding_radius + frac * allow) * np.array(
+        [math.cos(direction), math.sin(direction)])
+    b = b.moved(a.centroid + d - b.centroid)
+    if not len(intervals_array(a, m, b, m, t_max)):
+        return          # the rounding of the placement took the pair out of reach
+    assert candidate_pairs([a, b], [m, m], t_max).tolist() == [[0, 1]]
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda: candidate_pairs([SQ, SQ.moved((50, 0))],
+                             [Motion(velocity=(1e300, 0), acceleration=(-1e300, 0)), Motion()],
+                             1e10), ValueError, r"motions\[0\]: the body's coordinates reach"),
+    (lambda: first_impacts([SQ, SQ.moved((3, 0)), SQ.moved((9, 0))],
+                           [Motion(), Motion(), Motion(velocity=(1e60, 0))], 1e50),
+     ValueError, r"motions\[2\]: the body's coordinates reach .*overflow"),
+    (lambda: time_of_impact_many([SQ, SQ], [Motion()] * 2, [SQ, SQ.moved((3, 0))],
+                                 [Motion(), Motion(angular_velocity=1e120)], t_max=1),
+     ValueError, r"motions_b\[1\]: the body's (points' speeds|angular speed) reach.*overflow"),
+    (lambda: time_of_impact_many([SQ], [Motion(acceleration=(0, 1e30))], [SQ], [Motion()],
+                                 t_max=1e50),
+     ValueError, r"motions_a\[0\]: .*overflow"),
+])
+def test_motions_that_overflow_float64_are_refused_naming_the_body(call, error, message):
+    # time_of_impact refuses them (check_reach); a pair far apart from the others too,
+    # whether or not the swept bounds would search it
+    with pytest.raises(error, match=message):
+        call()
+
+
+@pytest.mark.parametrize("scale, offset", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e9), (1e-3, 1e6),
+                                           (1e-3, 1e9), (1e6, 1e9)])
+def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset):
+    rng = np.random.default_rng(7)
+    ring = np.array([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)], float)
+    hole = np.array([(1.5, 0.3), (2.5, 0.3), (2.5, 0.7), (1.5, 0.7)])
+    shapes, moves = [], []
+    for k in range(8):
+        d = np.array([5.0 * (k % 4), 4.0 * (k // 4)]) + rng.uniform(-1, 1, 2)
+        shapes.append(Shape((ring + d) * scale + offset, [(hole + d) * scale + offset]))
+        moves.append(Motion(velocity=rng.uniform(-3, 3, 2) * scale,
+                            acceleration=rng.uniform(-1, 1, 2) * scale,
+                            angular_velocity=rng.uniform(-1, 1)))
+    want = brute(shapes, moves, 1.5, max_iterations=BUDGET)
+    events = first_impacts(shapes, moves, 1.5, max_iterations=BUDGET)
+    assert {(e.i, e.j): e.impact for e in events} == want
+    assert any(e.impact.collides for e in events)
+
+
+# the cases of issue 14's defects 3-6 (time of impact), through the batched calls: each
+# answer (time, time_tolerance, bracket, features) is the pairwise call's
+DEFECT_CASES = {
+    "defect3_fast_flush": (SQ, Motion(velocity=(2e6, 0)), SQ.moved((3, 0)), Motion(), 5.0, 1e-4),
+    "defect4_long_travel": (SQ, Motion(velocity=(1, 0)), SQ.moved((1e9, 0.3)), Motion(), 2e9,
+                            1e-4),
+    "defect5_far_away": (SQ.moved((1e9, 0)), Motion(velocity=(1, 0)), SQ.moved((1e9 + 3, 0)),
+                         Motion(), 5.0, 1e-4),
+    "defect5_large_t_max": (SQ, Motion(velocity=(1, 0), angular_velocity=0.5),
+                            SQ.moved((3, 0)), Motion(), 1e13, 1e-4),
+    "defect6_tiny_time_tolerance": (SQ, Motion(velocity=(1, 0)), SQ.moved((3, 0)), Motion(),
+                                    5.0, 1e-300),
+    "defect6_slow_long_window": (SQ, Motion(velocity=(1e-5, 0)), SQ.moved((3, 0)), Motion(),
+                                 1e6, 1e-12),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DEFECT_CASES))
+def test_defects3_to_6_batched_answers_equal_the_pairwise_ones(case):
+    a, ma, b, mb, t_max, tol = DEFECT_CASES[case]
+    want = pc.time_of_impact(a, ma, b, mb, t_max=t_max, time_tolerance=tol)
+    back = pc.time_of_impact(b, mb, a, ma, t_max=t_max, time_tolerance=tol)
+    assert want.collides and back.collides
+    batch = time_of_impact_many([a, b], [ma, mb], [b, a], [mb, ma], t_max=t_max,
+                                time_tolerance=tol)
+    assert list(batch) == [want, back]
+    assert batch.impact(0).time_tolerance == want.time_tolerance
+    assert batch.impact(0).features == want.features
+    # with a bystander far off the path: the one event is the pair's
+    away = SQ.moved((-50, 1e3))
+    events = first_impacts([a, b, away], [ma, mb, Motion()], t_max, time_tolerance=tol)
+    assert [(e.i, e.j) for e in events] == [(0, 1)] and events[0].impact == want

@@ -1,0 +1,64 @@
+"""Kernels of the swept broad phase, on their own (also run as plain Python in CI)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+from profiles import examples
+
+from polycontact._kernels.swept import box_pairs, swept_boxes
+
+
+def test_swept_boxes_of_a_parabola_hold_its_apex():
+    # x(t) = 0 + 2 t − t²: rises to 1 at t = 1, back to 0 at t = 2; radius 0.5, one slice
+    c = np.array([[0.0, 0.0]])
+    m = np.array([[2.0, 0.0, -2.0, 0.0, 7.0, 0.0]])      # the spin plays no part
+    boxes, owner = swept_boxes(c, m, np.array([0.5]), 2.0, 1, 0.0, 0.0)
+    assert owner.tolist() == [0]
+    assert boxes.tolist() == [[-0.5, 1.5, -0.5, 0.5, 0.0, 2.0]]
+    # path length bound 4 + 4 = 8 radii of 0.5 -> 16 slices (the cap)
+    boxes, owner = swept_boxes(c, m, np.array([0.5]), 2.0, 16, 0.0, 0.0)
+    assert len(boxes) == 16 and boxes[0, 4] == 0.0 and boxes[-1, 5] == 2.0
+    assert np.array_equal(boxes[1:, 4], boxes[:-1, 5])      # slices tile [0, t_max]
+
+
+
+def test_swept_boxes_are_grown_as_the_pairwise_broad_phase_grows_the_radii():
+    # radius 0.5 inflated by 1e-3; reach 0.5 + 3 + 4 + 2 t_max + t_max² (t_max = 1)
+    c = np.array([[3.0, -4.0]])
+    m = np.array([[0.0, 2.0, 0.0, 2.0, 0.0, 0.0]])
+    (box,), _ = swept_boxes(c, m, np.array([0.5]), 1.0, 1, 1e-3, 1e-2)
+    grow = 0.5 * 1.001 + 1e-2 * (0.5 + 3.0 + 4.0 + 2.0 + 1.0)
+    assert np.allclose(box, [3.0 - grow, 3.0 + grow, -4.0 - grow, -1.0 + grow, 0.0, 1.0])
+
+
+def test_swept_boxes_of_a_path_that_overflows_are_the_whole_plane():
+    # v t and a t²/2 overflow to +inf and -inf: their sum is NaN; the box must not drop
+    # the body (the public functions refuse such motions before, see check_reach)
+    c = np.array([[0.0, 0.0]])
+    m = np.array([[1e300, 0.0, -1e300, 0.0, 0.0, 0.0]])
+    with np.errstate(all="ignore"):
+        boxes, _ = swept_boxes(c, m, np.array([1.0]), 1e10, 1, 0.0, 0.0)
+    assert boxes[0, :4].tolist() == [-np.inf, np.inf, -np.inf, np.inf]
+
+
+@examples(200)
+@given(st.integers(1, 40), st.integers(1, 12), st.integers(0, 2**32 - 1))
+def test_box_pairs_equal_all_pairs_of_overlapping_boxes(n_boxes, n_bodies, seed):
+    rng = np.random.default_rng(seed)
+    lo = rng.integers(0, 10, (n_boxes, 3)).astype(float)   # integers: touching boxes too
+    size = rng.integers(0, 4, (n_boxes, 3)).astype(float)
+    boxes = np.empty((n_boxes, 6))
+    boxes[:, 0::2] = lo
+    boxes[:, 1::2] = lo + size
+    owner = rng.integers(0, n_bodies, n_boxes).astype(np.int64)
+    want = set()
+    for a in range(n_boxes):
+        for b in range(n_boxes):
+            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
+            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
+            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
+                want.add((int(owner[a]), int(owner[b])))
+    got = box_pairs(boxes, owner, n_bodies)
+    assert got.tolist() == sorted(map(list, want))
