@@ -1,7 +1,8 @@
 """Benchmark: a World of many bodies against Shapely 2 (STRtree + relate).
 
 Run: ``python benchmarks/bench_world.py`` (``--quick``: 10³ and 10⁴ bodies only, fewer
-repeats). Medians of several repeats; the peers are measured in the same run.
+repeats; ``--threads 1``: the parallel kernels on one thread). Medians of several
+repeats; the peers are measured in the same run.
 
 1. All contacts of N random concave 12-gons packed densely (N = 10³, 10⁴, 10⁵): stars
    of radius about 0.6 on a jittered unit grid, so each body meets a few neighbours
@@ -69,13 +70,20 @@ def sweep_and_prune(box: np.ndarray) -> int:
     return n
 
 
-def timed(fn, repeats: int) -> tuple[float, object]:
-    times = []
+CPU = {}  # fn name -> median process time (all threads) of the last timed() call
+
+
+def timed(fn, repeats: int, name: str = "") -> tuple[float, object]:
+    """Median wall time and the last result; the median process time goes to CPU[name]
+    (on a loaded machine it is the fairer measure: waiting for a core is not counted)."""
+    times, cpu = [], []
     out = None
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = fn()
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    CPU[name] = statistics.median(cpu)
     return statistics.median(times), out
 
 
@@ -91,8 +99,9 @@ def shapely_contacts(polys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def bench_contacts(sizes: list[int], repeats: int) -> None:
     print("All contacts of N random concave 12-gons, packed densely (median seconds)")
-    print(f"{'N':>7} {'pairs':>7} {'world.contacts':>15} {'per body':>10} {'Shapely':>10} "
-          f"{'ratio':>7} {'build World':>12} {'same answer':>12}")
+    print(f"{'N':>7} {'pairs':>7} {'world.contacts':>15} {'per body':>10} {'CPU/body':>9} "
+          f"{'Shapely':>10} {'ratio':>7} {'CPU ratio':>10} {'build World':>12} "
+          f"{'same answer':>12}")
     rng = np.random.default_rng(1)
     pc.World().add_many(stars(rng, 10))  # compile / warm
     for n in sizes:
@@ -103,14 +112,16 @@ def bench_contacts(sizes: list[int], repeats: int) -> None:
         build = time.perf_counter() - t0
         world.contacts()  # compile / warm
         reps = repeats if n < 100_000 else max(3, repeats // 2)
-        tw, got = timed(world.contacts, reps)
+        tw, got = timed(world.contacts, reps, "ours")
         polys = shapely.polygons(rings)
-        ts, (sp, ss) = timed(lambda: shapely_contacts(polys), reps)
+        ts, (sp, ss) = timed(lambda: shapely_contacts(polys), reps, "shapely")
         order = np.lexsort((sp[:, 1], sp[:, 0]))
         same = got.pairs.tolist() == sp[order].tolist() and got.states.tolist() == \
             ss[order].tolist()
-        print(f"{n:>7} {len(got):>7} {tw:>15.4f} {1e6 * tw / n:>8.2f}µs {ts:>10.4f} "
-              f"{ts / tw:>6.1f}× {build:>11.3f}s {str(same):>12}")
+        print(f"{n:>7} {len(got):>7} {tw:>15.4f} {1e6 * tw / n:>8.2f}µs "
+              f"{1e6 * CPU['ours'] / n:>7.2f}µs {ts:>10.4f} "
+              f"{ts / tw:>6.1f}× {CPU['shapely'] / CPU['ours']:>9.1f}× {build:>11.3f}s "
+              f"{str(same):>12}")
 
 
 def bench_broad_phase(sizes: list[int], repeats: int) -> None:
@@ -188,8 +199,8 @@ def bench_placements(repeats: int) -> None:
             out.append(worst)
         return out
 
-    tw, got = timed(ours, repeats)
-    ts, ref = timed(theirs, repeats)
+    tw, got = timed(ours, repeats, "ours")
+    ts, ref = timed(theirs, repeats, "shapely")
     count = sum(len(p) for _, p, _ in jobs)
     agree = np.mean(np.concatenate(got) == np.concatenate(ref))
     fits = np.mean(np.concatenate(got) < 2)
@@ -197,18 +208,29 @@ def bench_placements(repeats: int) -> None:
     print("Placement queries, jagua-rs protocol: swim layout, 5 items removed, 1000 random "
           "placements each")
     print(f"  bodies {len(world)}, placements {count}, fitting {100 * fits:.1f}%")
-    print(f"  query_many  {1e9 * tw / count:9.0f} ns/placement")
-    print(f"  Shapely     {1e9 * ts / count:9.0f} ns/placement   ratio {ts / tw:.1f}×")
+    print(f"  query_many  {1e9 * tw / count:9.0f} ns/placement   CPU "
+          f"{1e9 * CPU['ours'] / count:6.0f} ns/placement")
+    print(f"  Shapely     {1e9 * ts / count:9.0f} ns/placement   CPU "
+          f"{1e9 * CPU['shapely'] / count:6.0f} ns/placement   ratio {ts / tw:.1f}× (CPU "
+          f"{CPU['shapely'] / CPU['ours']:.1f}×)")
     print(f"  same worst state as Shapely (touching aside): {100 * agree:.2f}% of placements")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="10³ and 10⁴ only, 3 repeats")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="Numba threads for the parallel kernels (default: all)")
     args = parser.parse_args()
     import numba
 
-    print(f"threads: {numba.get_num_threads()}")
+    if args.threads:
+        numba.set_num_threads(args.threads)
+
+    import os
+
+    print(f"threads: {numba.get_num_threads()}, load average {os.getloadavg()[0]:.1f} on "
+          f"{os.cpu_count()} cores")
     sizes = [1_000, 10_000] if args.quick else [1_000, 10_000, 100_000]
     repeats = 3 if args.quick else 7
     bench_contacts(sizes, repeats)

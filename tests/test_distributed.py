@@ -1,5 +1,6 @@
-"""Dask: a LocalCluster of 2 worker processes gives the same NFP tables and classifications
-as the local run; kernels are warmed once per worker; a killed worker loses nothing."""
+"""Dask: a LocalCluster of 2 worker processes gives the same NFP tables, classifications
+and times of impact as the local run; kernels are warmed once per worker; a killed worker
+loses nothing."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ ANGLES = [[0, 90, 180, 270], [0, 90, 180, 270], [0, 180]]
 @pytest.fixture(scope="module")
 def client():
     # the kernels compiled here first, so the workers load them from Numba's cache
-    pc.warmup(["classification", "no-fit polygon"])
+    pc.warmup(["classification", "no-fit polygon", "many moving bodies"])
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
         with distributed.Client(cluster) as c:
@@ -90,6 +91,107 @@ def test_classify_many_on_the_cluster_is_identical(client):
     shapes_a = [pc.Shape(r) for r in a[:50]]
     listed = pd.classify_many(shapes_a, list(b[:50]), client=client, chunk_size=9)
     assert np.array_equal(listed.states, local.states[:50])
+
+
+def impact_pairs(count: int, seed: int) -> tuple[list, list, list, list]:
+    """Pairs that hit, touch, miss, penetrate at the start, in and around a body with a
+    hole, then ``count`` random ones (some bodies shared by many pairs, some not)."""
+    sq, ell, u = PIECES
+    frame = pc.Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
+    small = pc.Shape([(2.5, 2.5), (3, 2.5), (3, 3), (2.5, 3)])  # inside the hole of frame
+    still = pc.Motion()
+    cases = [
+        (sq, pc.Motion(velocity=(1, 0)), sq.moved((3, 0)), still),           # hit at t=2
+        (sq, pc.Motion(velocity=(0, 1)), sq.moved((1, 2)), still),           # slides flush
+        (sq, pc.Motion(velocity=(1, 0)), sq.moved((0, 5)), still),           # miss
+        (ell, still, sq.moved((0.5, 0.5)), pc.Motion(velocity=(1, 1))),      # overlap at 0
+        (small, pc.Motion(velocity=(0.5, 0)), frame, still),                 # hits the hole
+        (small, still, frame, still),                                        # in the hole
+        (small.moved((1, 0)), pc.Motion(velocity=(0, 0.25)), frame, still),  # slides on it
+        (u, pc.Motion(angular_velocity=1), small.moved((-1.25, -0.5)), still),  # U turns
+    ]
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        a = PIECES[k % 3] if k % 2 else PIECES[k % 3].moved(rng.uniform(-3, 3, 2))
+        b = frame if k % 5 == 0 else PIECES[(k // 3) % 3].moved(rng.uniform(-3, 3, 2),
+                                                                rng.uniform(0, 6.3))
+        ma = pc.Motion(velocity=rng.uniform(-2, 2, 2), angular_velocity=rng.uniform(-1, 1),
+                       acceleration=rng.uniform(-1, 1, 2) if k % 4 == 0 else (0, 0))
+        cases.append((a, ma, b, still if k % 2 else pc.Motion(velocity=rng.uniform(-1, 1, 2))))
+    return tuple(list(c) for c in zip(*cases))
+
+
+def same_batch(x: pc.ImpactBatch, y: pc.ImpactBatch) -> bool:
+    return (np.array_equal(x.status, y.status) and np.array_equal(x.collides, y.collides)
+            and np.array_equal(x.times, y.times, equal_nan=True)
+            and np.array_equal(x.first_contacts, y.first_contacts, equal_nan=True)
+            and all(x.impact(k) == y.impact(k) and x.impact(k).features == y.impact(k).features
+                    for k in range(len(x))))
+
+
+@pytest.mark.parametrize("method", ["exact", "sampled"])
+def test_time_of_impact_many_on_the_cluster_is_identical(client, method):
+    a, ma, b, mb = impact_pairs(400, seed=11)
+    local = pc.time_of_impact_many(a, ma, b, mb, t_max=3, method=method, threads=1)
+    remote = pd.time_of_impact_many(a, ma, b, mb, 3, method=method, client=client,
+                                    chunk_size=37)
+    assert len(remote) == len(a) and same_batch(local, remote)
+    # the chosen cases: hit, slide, miss, overlap at the start, through a hole
+    assert remote.status[:8].tolist() == [1, 0, 0, 2, 1, 0, 0, 1]
+    assert np.isnan(remote.first_contacts[[2, 5]]).all()  # they never touch
+    assert not np.isnan(remote.first_contacts[[1, 6]]).any()  # they slide, touching
+    assert remote.impact(4) == pc.time_of_impact(a[4], ma[4], b[4], mb[4], t_max=3,
+                                                 method=method)
+    assert set(remote.status.tolist()) == {0, 1, 2}
+
+
+def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):
+    a, ma, b, mb = impact_pairs(40, seed=5)
+    arrays = [np.asarray(s.exterior) for s in a]  # every pair its own shape objects
+    local = pc.time_of_impact_many(arrays, ma, b, mb, t_max=2)
+    assert pd.current_client() is client
+    remote = pd.time_of_impact_many(arrays, ma, b, mb, t_max=2)  # a default chunk size
+    assert same_batch(local, remote)
+    name = pd.plugin_name("many moving bodies")
+    assert all(name in p for p in client.run(pd._plugins).values())
+    empty = pd.time_of_impact_many([], [], [], [], 1, client=client)
+    assert len(empty) == 0 and empty.times.shape == (0,)
+
+
+@pytest.mark.parametrize("change, error, message", [
+    (lambda a, ma, b, mb: (a, ma, b[:-1], mb), ValueError,
+     r"shapes_a and shapes_b differ in length \(48 and 47\)"),
+    (lambda a, ma, b, mb: (a, ma[:30] + [(1, 0)] + ma[31:], b, mb), TypeError,
+     r"motions_a\[30\]: expected a polycontact.Motion, got tuple"),
+    (lambda a, ma, b, mb: (a, ma, b[:44] + [[(0, 0), (1, 1)]] + b[45:], mb),
+     pc.InvalidShapeError, r"shapes_b\[44\]: .*fewer than 3"),
+    (lambda a, ma, b, mb: (a, ma, b, mb[:41] + [pc.Motion(angular_velocity=1e120)] + mb[42:]),
+     ValueError, r"motions_b\[41\]: the body's (points' speeds|angular speed) reach"),
+])
+def test_time_of_impact_many_errors_name_the_caller_s_index(client, change, error, message):
+    a, ma, b, mb = change(*impact_pairs(40, seed=5))
+    with pytest.raises(error, match=message) as local:
+        pc.time_of_impact_many(a, ma, b, mb, t_max=1)
+    with pytest.raises(error, match=message) as remote:
+        pd.time_of_impact_many(a, ma, b, mb, 1, client=client, chunk_size=7)
+    assert str(remote.value) == str(local.value)
+    with pytest.raises(ValueError, match="chunk_size: expected a positive integer"):
+        pd.time_of_impact_many(a, ma, b, mb, 1, client=client, chunk_size=0)
+
+
+def test_impact_tasks_send_shapes_of_several_tasks_once():
+    # shape 0 is in every task, shape 1 in the first two, shapes 2.. in one task each
+    sa = np.array([0, 0, 0, 0, 0])
+    sb = np.array([1, 2, 1, 3, 4])
+    uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
+    rows, eps = np.zeros((5, 6)), np.ones(5)
+    shared, tasks = pd._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
+    assert shared.shapes() == [uniq[0], uniq[1]]
+    assert [t[2].shapes() for t in tasks] == [[uniq[2]], [uniq[3]], [uniq[4]]]
+    # a task numbers the shared shapes first, then its own
+    assert [[(shared.shapes() + t[2].shapes())[i] for i in t[1]] for t in tasks] == [
+        [uniq[1], uniq[2]], [uniq[1], uniq[3]], [uniq[4]]]
+    assert [t[0].tolist() for t in tasks] == [[0, 0], [0, 0], [0]]
 
 
 def test_map_batches_keeps_the_order(client):

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from profiles import examples
 
 import polycontact as pc
+import polycontact.world as world_module
 from polycontact.tolerances import default_tolerance
 
 # ../shared/datasets beside the repository (its parent, or the parent of a worktree's
@@ -441,3 +442,103 @@ def test_contacts_cli_shows_progress_reading_a_long_layout_on_a_terminal(tmp_pat
     _, bodies, names = cli_contacts.read_layout(str(path), progress=True)
     assert "reading bodies" in term.text and len(bodies) == len(quiet) == 5
     assert names == [f"{k} ({k})" for k in range(5)]
+
+
+@pytest.mark.parametrize("scan", [0, 10**9], ids=["grid", "box scan"])
+def test_bodies_centred_on_cell_edges_are_found(monkeypatch, scan):
+    # query_many goes through the grid, or (few bodies) tests every body's box: both.
+    monkeypatch.setattr(world_module, "_SCAN_BODIES", scan)
+    # Squares of side 1 and 2 (box side exactly a power of two: half a cell out of their
+    # own cell) with box centres on cell edges and between them, touching and
+    # overlapping: the broad phase's cell range must keep every neighbour.
+    # The first body sets the grid's origin (its centre). Bodies are added from the top
+    # right down, so a pair (i < j) is found from the body up and right: a cell range
+    # cut short on its low side would lose it.
+    world = pc.World()
+    unit = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    two = pc.Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+    world.add(unit, (0.5, 0.5))
+    for x in range(5, -1, -1):
+        for y in range(3, -1, -1):
+            world.add(unit, (0.5 + x, 0.5 + y))
+            world.add(unit, (8.375 + x, 0.375 + y))  # centres just below cell edges
+    for x in range(3):
+        world.add(two, (1.0 + 2 * x, 5.0))
+        world.add(unit, (1.0 + 2 * x, 6.5))
+        world.add(two, (0.5 + 2 * x, -1.0))
+    got = world.contacts()
+    pairs, states = brute_contacts(world)
+    assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    probes = [(unit, (x / 8, y / 8)) for x in range(-8, 120, 3) for y in range(-40, 60, 3)]
+    probes += [(two, (x / 4, y / 4)) for x in range(-4, 60) for y in range(-20, 30)]
+    for shape in (unit, two):
+        pos = [p for s, p in probes if s is shape]
+        many = world.query_many(shape, pos)
+        one = [max([0, *world.query(shape, p).states.tolist()]) for p in pos]
+        assert many.tolist() == one
+
+
+@pytest.mark.parametrize("scan", [0, 10**9], ids=["grid", "box scan"])
+def test_query_many_tests_the_container_last_with_the_same_answer(monkeypatch, scan):
+    monkeypatch.setattr(world_module, "_SCAN_BODIES", scan)
+    # query_many tests the container's box, then the bodies, then (only if no body is
+    # penetrated) the container's outline and holes: every mix of the three gives the
+    # worst state that query gives.
+    world = pc.World(CONTAINER)
+    world.add(TEMPLATES[3], (2.5, 2.5))
+    world.add(TEMPLATES[0], (9.0, 7.0))
+    sq = TEMPLATES[3]
+    cases = {
+        (-1.0, 5.0): 2,   # off the container's box
+        (0.25, 5.0): 2,   # crosses the outline, box inside the container's box
+        (0.5, 5.0): 1,    # touches the outline only
+        (6.0, 5.0): 2,    # in the hole
+        (4.5, 5.0): 1,    # touches the hole only
+        (3.5, 2.5): 1,    # touches a body only
+        (2.75, 2.5): 2,   # penetrates a body
+        (3.5, 3.5): 1,    # corner contact with a body
+        (1.5, 0.5): 1,    # touches a body and the outline
+        (2.0, 0.25): 2,   # penetrates a body and crosses the outline
+        (3.0, 7.0): 0,    # free
+    }
+    pos = list(cases)
+    many = world.query_many(sq, pos)
+    one = []
+    for p in pos:
+        q = world.query(sq, p)
+        one.append(max([q.container_state, *q.states.tolist()]))
+    assert many.tolist() == one == list(cases.values())
+
+
+@pytest.mark.parametrize("count", [3, 40], ids=["level scanned", "cells visited"])
+def test_contacts_each_pair_once_with_a_wide_tolerance(count):
+    # Unit squares with gaps of 0.4 (contact under tolerance 0.5) and 0.6 (apart): the
+    # wide tolerance widens each body's block of cells; with few bodies on the level the
+    # level is scanned body by body instead. Every pair is found, once.
+    world = pc.World()
+    unit = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    side = math.ceil(math.sqrt(count))
+    for k in range(count):
+        x, y = k % side, k // side
+        world.add(unit, (1.4 * x + 0.2 * (y % 2), 1.5 * y + (0.1 if x % 3 == 0 else 0.0)))
+    for tol in (0.5, None):
+        got = world.contacts(tol)
+        pairs, states = brute_contacts(world, tol)
+        assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    assert len(world.contacts(0.5)) > 0
+
+
+def test_contacts_in_merged_far_cells():
+    # Cell indices are clamped 2**25 cells from the first body: these small squares, far
+    # away, share clamped cells; touching and overlapping pairs are still found, once.
+    world = pc.World()
+    world.add(pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    s = 2.0**-10
+    small = pc.Shape(np.array([(0, 0), (1, 0), (1, 1), (0, 1)]) * s)
+    for k in range(12):
+        world.add(small, (1e5 + s * (k % 4) * (1.0 if k < 8 else 0.5), 1e5 + s * (k // 4)))
+        world.add(small, (-1e5 - s * k, -1e5 + s * (k % 3) * 0.75))
+    got = world.contacts()
+    pairs, states = brute_contacts(world)
+    assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
+    assert (got.states == 1).any() and (got.states == 2).any()

@@ -351,6 +351,19 @@ def time_of_impact_many(
     mb = _motions(motions_b, "motions_b", len(b), "shapes_b")
     t_max, tol, samples, max_iterations, threads = _options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
+    uniq, sa, sb, rows_a, rows_b, eps_rel = _prepare(a, b, ma, mb, t_max)
+    raw = _search(uniq, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol, samples,
+                  max_iterations, threads)
+    return _batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
+
+
+def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+             t_max: float) -> tuple[Any, ...]:
+    """Check every body of the pairs as ``time_of_impact`` does (errors naming where it
+    first appears: ``shapes_a[k]``, ``motions_b[k]``, ...), then the inputs of
+    :func:`_search`: the distinct shapes, each pair's two indices among them, its two
+    motion rows and its ``eps_rel``. (:func:`polycontact.distributed.time_of_impact_many`
+    runs this in the caller's process and :func:`_search` on slices.)"""
     # a body (the same shape and motion objects) in many pairs is prepared once
     p_count = len(a)
     seen: dict[tuple[int, int], int] = {}
@@ -371,8 +384,14 @@ def time_of_impact_many(
     rows = _motion_array(b_motions)
     ba, bb = body[:p_count], body[p_count:]
     eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[ba], extent[bb])
-    raw = _search(uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel, t_max, method, tol,
-                  samples, max_iterations, threads)
+    return uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel
+
+
+def _batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+           raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
+           tol: float) -> ImpactBatch:
+    """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
+    the raw result arrays of :func:`_search`."""
     code, t_hi, _, contact, *_ = raw
     collides = code == 1
     pairs = (a, b)

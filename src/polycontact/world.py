@@ -47,6 +47,8 @@ from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_
 __all__ = ["World", "WorldBody", "Contacts", "Query"]
 
 _ULP_FACTOR = ROUNDING_ULPS * 2.0**-52
+#: query_many tests every body's box, not the grid's cells, up to this many bodies.
+_SCAN_BODIES = 64
 
 
 def _k() -> Any:
@@ -659,10 +661,13 @@ class World:
         states, used = k.classify_pairs(self._xy, self._ls, self._lo, self._nl, self._eps,
                                         tol, pi, pj, self._vmax, self._lmax,
                                         _chunks(len(pi)))
-        hit = states > 0
+        hit = np.flatnonzero(states)
+        if self._next < 2**31:  # one key per pair, no overflow: one sort, not a lexsort
+            hit = hit[np.argsort(pi[hit] * self._next + pj[hit], kind="stable")]
+        else:
+            hit = hit[np.lexsort((pj[hit], pi[hit]))]
         pairs = np.stack([pi[hit], pj[hit]], axis=1)
-        order = np.lexsort((pairs[:, 1], pairs[:, 0]))
-        pairs, states, used = pairs[order], states[hit][order], used[hit][order]
+        states, used = states[hit], used[hit]
         if self._container is not None and len(alive):
             cst = k.container_states(self._xy, self._ls, self._lo, self._nl, self._box,
                                      self._eps, tol, alive, *self._hazards()[:4],
@@ -739,6 +744,9 @@ class World:
         sxy, ss = base.packed
         c = base.centroid
         has_c = self._container is not None
+        # A few bodies: testing every box is cheaper than visiting the grid's cells
+        # (measured on the swim layout, 43 bodies: ~140 vs ~270 ns per placement).
+        scan = self._alive() if len(self._records) <= _SCAN_BODIES else np.empty(0, np.int64)
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
                                             np.zeros(4), 0.0)
@@ -746,7 +754,7 @@ class World:
             sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
             RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
             self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
-            *hz, self._hmax if has_c else 0, _chunks(len(pos)),
+            *hz, self._hmax if has_c else 0, scan, _chunks(len(pos)),
         )
         return states
 

@@ -165,9 +165,12 @@ def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, 
         if idx < low:
             continue
         c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
-        ix0 = _cell(q0 - origin[0] - 1.51 * c, c)
+        # A body of this level has its box centre in its cell and a half side <= c / 2,
+        # so it can meet [q0, q1] only if its centre lies in [q0 - c/2, q1 + c/2]
+        # (0.01 c spare for the rounding of the origin's subtraction).
+        ix0 = _cell(q0 - origin[0] - 0.51 * c, c)
         ix1 = _cell(q1 - origin[0] + 0.51 * c, c)
-        iy0 = _cell(q2 - origin[1] - 1.51 * c, c)
+        iy0 = _cell(q2 - origin[1] - 0.51 * c, c)
         iy1 = _cell(q3 - origin[1] + 0.51 * c, c)
         if (ix1 - ix0 + 1) * (iy1 - iy0 + 1) > 2 * lvl_count[idx] + 16:
             for b in range(n_ids):
@@ -241,7 +244,7 @@ def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps
     return pi[:n], pj[:n]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _view(xy, ls, lo, nl, b, buf):
     """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
     first = ls[lo[b]]
@@ -288,8 +291,21 @@ def _container_state(ya, sa, bx0, bx1, by0, by1, e, hxy, hls, hlo, hnl, cbox, hb
                      ids, touch, rays, rord):
     """0 inside, 1 touching the boundary, 2 outside or crossing: A (box bx0..by1) against
     the hazards (the frame around the container's outer loop, and its holes)."""
-    if bx0 < cbox[0] - e or bx1 > cbox[1] + e or by0 < cbox[2] - e or by1 > cbox[3] + e:
+    if _off_box(bx0, bx1, by0, by1, e, cbox):
         return 2
+    return _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, rord)
+
+
+@njit(cache=True, nogil=True)
+def _off_box(bx0, bx1, by0, by1, e, cbox):
+    """Does the box bx0..by1 leave the container's box by more than ``e``?"""
+    return bx0 < cbox[0] - e or bx1 > cbox[1] + e or by0 < cbox[2] - e or by1 > cbox[3] + e
+
+
+@njit(cache=True, nogil=True)
+def _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, rord):
+    """Worst state of A against the container's hazards (its box not left: see
+    :func:`_off_box`)."""
     worst = 0
     for h in range(hnl.shape[0]):
         yh, sh = _view(hxy, hls, hlo, hnl, h, hbuf)
@@ -370,7 +386,7 @@ def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
 @njit(cache=True, nogil=True)
 def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                  level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax,
-                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, p0, p1, out):
+                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, p0, p1, out):
     n = ss[ss.shape[0] - 1]
     qxy = np.empty((n, 2))
     cand = np.empty(n_ids, np.int64)
@@ -383,17 +399,23 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
         mag = max(max(-x0, x1), max(-y0, y1))
         qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
         worst = 0
-        if has_container:
-            e = tol if tol >= 0.0 else max(qeps, ceps)
-            worst = _container_state(qxy, ss, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox,
-                                     hb, bx, ids, touch, rays, rord)
+        ec = tol if tol >= 0.0 else max(qeps, ceps)
+        if has_container and _off_box(x0, x1, y0, y1, ec, cbox):
+            worst = 2
+        # The bodies before the container's hazards: in a dense layout most placements
+        # penetrate a body, and then the hazards (a state kernel call) are not needed.
         if worst < 2:
             e0 = tol if tol >= 0.0 else qeps
             d = e0 + (tol if tol >= 0.0 else emax)
-            m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d,
-                        y0 - d, y1 + d, 0, n_ids, cand)
+            if scan.shape[0]:
+                m = scan.shape[0]
+                src = scan
+            else:
+                m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d,
+                            x1 + d, y0 - d, y1 + d, 0, n_ids, cand)
+                src = cand
             for t in range(m):
-                j = cand[t]
+                j = src[t]
                 e = tol if tol >= 0.0 else max(qeps, eps[j])
                 if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
                     continue
@@ -403,26 +425,31 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
                     worst = s
                     if worst == 2:
                         break
+        if has_container and worst < 2:
+            worst = max(worst, _hazard_state(qxy, ss, ec, hxy, hls, hlo, hnl, hb, bx, ids,
+                                             touch, rays, rord))
         out[p] = worst
 
 
 @njit(cache=True, nogil=True, parallel=True)
 def query_many(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt, level,
                lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax, lmax,
-               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, chunks):
+               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, chunks):
     """Worst state (int8) of the shape (sxy, ss) placed at each (px[p], py[p], angles[p])
-    over every body and the container (outside counts as 2); ``chunks`` = 1: serial."""
+    over every body and the container (outside counts as 2); ``chunks`` = 1: serial.
+    ``scan``: the live bodies, to be tested box by box instead of through the grid (a
+    few bodies), or empty (use the grid)."""
     p_count = px.shape[0]
     out = np.empty(p_count, np.int8)
     if chunks == 1:
         _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                      level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, 0,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, 0,
                      p_count, out)
         return out
     for c in prange(chunks):
         _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
                      level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax,
+                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan,
                      p_count * c // chunks, p_count * (c + 1) // chunks, out)
     return out
