@@ -184,8 +184,10 @@ def test_time_of_impact_many_empty_and_arrays_untouched():
      ValueError, "samples"),
     (lambda: first_impacts([SQ, SQ, SQ], [Motion()] * 2, 1),
      ValueError, r"motions: expected 3 motions \(one per shape of shapes\), got 2"),
-    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), TypeError,
-     r"shapes\[1\]: outer loop: expected an array of real numbers, got str"),
+    (lambda: first_impacts([SQ, 3], [Motion()] * 2, 1), TypeError,
+     r"shapes\[1\]: expected a body \(.*\), got int"),
+    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), ValueError,
+     r"shapes\[1\]: "),  # text is WKT (bodies.as_shape): a wrong value, not type
     (lambda: first_impacts([SQ, SQ], [Motion(), None], 1), TypeError, r"motions\[1\]: "),
     (lambda: first_impacts([SQ, SQ], [Motion()] * 2, math.nan), ValueError, "t_max"),
     (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1).impact(1),

@@ -138,8 +138,10 @@ def test_region_is_valid_and_closed_under_swapping():
      ([["x", 1]], "reference")],
 )
 def test_bad_reference(reference, message):
-    with pytest.raises(pc.InvalidShapeError, match=message):
+    # a bad reference point is a bad argument, not an invalid shape (issue 13)
+    with pytest.raises((ValueError, TypeError), match=message) as err:
         pc.no_fit_polygon(SQ, SQ, reference=reference)
+    assert not isinstance(err.value, pc.InvalidShapeError)
 
 
 def test_bad_shapes_and_tolerance():
@@ -147,9 +149,9 @@ def test_bad_shapes_and_tolerance():
         pc.no_fit_polygon([(0, 0), (1, 1), (1, 0), (0, 1)], SQ)
     with pytest.raises(pc.InvalidShapeError, match="fewer than 3"):
         pc.no_fit_polygon(SQ, [(0, 0), (1, 1)])
-    with pytest.raises(pc.InvalidShapeError, match="tolerance"):
+    with pytest.raises(ValueError, match="^tolerance"):
         pc.no_fit_polygon(SQ, SQ, tolerance=-1.0)
-    with pytest.raises(pc.InvalidShapeError, match="point"):
+    with pytest.raises(ValueError, match="^point"):
         pc.no_fit_polygon(SQ, SQ).contains((0, np.inf))
 
 

@@ -148,7 +148,7 @@ def test_tolerance_is_used():
 def test_classify_many_refuses_mismatch_and_nonsense():
     with pytest.raises(ValueError, match="differ in length"):
         classify_many([SQ, SQ], [SQ])
-    with pytest.raises(InvalidShapeError, match="shapes_a: expected a sequence"):
+    with pytest.raises(TypeError, match="shapes_a: expected a sequence"):
         classify_many(3, [SQ])
 
 

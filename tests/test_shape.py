@@ -280,7 +280,8 @@ def test_cached_tolerance_is_the_default_tolerance_of_the_shape(scale, offset):
     ],
 )
 def test_coordinates_that_are_not_real_numbers_are_refused(vertices, given_type):
-    expected = f"^outer loop: expected (an array of )?real numbers.*{given_type}"
+    expected = (f"^outer loop: expected (an array of )?real numbers.*{given_type}"
+                f"|^vertices: expected an \\(N, 2\\) array-like, got {given_type}")
     with pytest.raises(TypeError, match=expected):
         Shape(vertices)
 

@@ -12,7 +12,7 @@ Everywhere polycontact takes a body (the functions, :class:`Shape` itself,
 - a body mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
   ``"name"`` is ignored), the scene files' form;
 - WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
-  above, or WKB bytes.
+  above, WKB bytes or hex WKB text.
 
 A value of another type raises ``TypeError``; a value of an accepted type that is not a
 valid polygon raises :class:`~polycontact.InvalidShapeError` (a ``ValueError``). Both
@@ -41,20 +41,35 @@ TypeError: a: expected a body (Shape, (N, 2) array, shapely Polygon, GeoJSON or 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, Protocol, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import InvalidShapeError
 from .shape import Shape
 
-__all__ = ["as_shape", "BODY_FORMS"]
+__all__ = ["as_shape", "BODY_FORMS", "BodyLike", "GeoInterface"]
+
+
+class GeoInterface(Protocol):
+    """Anything with ``__geo_interface__`` (the Python geo interface)."""
+
+    @property
+    def __geo_interface__(self) -> Mapping[str, Any]: ...
+
+
+#: The type of a body argument: every form :func:`as_shape` takes (WKT and JSON text are
+#: ``str``, WKB ``bytes``; Shapely geometries have ``__geo_interface__``).
+BodyLike = Union[Shape, GeoInterface, Mapping[str, Any], npt.ArrayLike]
 
 #: The forms a body may take, as error messages list them.
 BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
 
 _BODY_KEYS = {"vertices", "holes", "name"}
+_HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
 
 
 def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
@@ -113,7 +128,7 @@ def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
         unknown = sorted(set(data) - _BODY_KEYS)
         if unknown:
             raise InvalidShapeError(
-                f"body mapping: unknown key {unknown[0]!r} (expected 'vertices', 'holes')"
+                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
             )
         holes = data.get("holes", ())
         if holes is None or isinstance(holes, (str, bytes, Mapping)):
@@ -137,6 +152,8 @@ def _from_text(text: str, repair: bool) -> Shape:
         if not isinstance(data, Mapping):
             raise InvalidShapeError("JSON text: expected an object")
         return _from_mapping(data, repair)
+    if _HEX.fullmatch(stripped.rstrip()):  # hex WKB, as shapely's ``wkb_hex``
+        return Shape.from_shapely(_from_wkb(bytes.fromhex(stripped.rstrip())), repair=repair)
     return Shape.from_wkt(text, repair=repair)
 
 

@@ -21,7 +21,8 @@ import numpy as np
 
 from ._checks import finite_number
 from .motion import Motion
-from .shape import Shape, as_shape
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import COORDINATE_LIMIT, check_range
 
 __all__ = ["broad_phase_intervals", "BROAD_PHASE_INFLATION"]
@@ -80,15 +81,16 @@ def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) ->
     """The intervals as a (k, 2) float64 array (the form the kernels take)."""
     from ._kernels.broad_phase import overlap_intervals
 
-    return overlap_intervals(
+    intervals: np.ndarray = overlap_intervals(
         np.asarray(a.centroid, dtype=np.float64), ma.array, a.bounding_radius,
         np.asarray(b.centroid, dtype=np.float64), mb.array, b.bounding_radius,
         t_max, BROAD_PHASE_INFLATION,
     )
+    return intervals
 
 
 def broad_phase_intervals(
-    a: Any, motion_a: Motion, b: Any, motion_b: Motion, *, t_max: float
+    a: BodyLike, motion_a: Motion, b: BodyLike, motion_b: Motion, *, t_max: float
 ) -> tuple[tuple[float, float], ...]:
     """Closed time intervals within ``[0, t_max]`` when the bounding circles overlap.
 

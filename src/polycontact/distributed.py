@@ -348,8 +348,8 @@ def time_of_impact_many(
     """
     from . import impacts
 
-    options = dict(t_max=t_max, method=method, time_tolerance=time_tolerance,
-                   samples=samples, max_iterations=max_iterations)
+    options: dict[str, Any] = dict(t_max=t_max, method=method, time_tolerance=time_tolerance,
+                                   samples=samples, max_iterations=max_iterations)
     _check_chunk_size(chunk_size)
     client = current_client(client)
     if client is None:
@@ -384,7 +384,7 @@ def time_of_impact_many(
 
 def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
                   rows_b: np.ndarray, eps_rel: np.ndarray,
-                  spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple]]:
+                  spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple[Any, ...]]]:
     """The shapes several tasks use (sent once to every worker) and the tasks: each its
     slice of pairs, with its own shapes, the pairs' shape indices numbering the shared
     shapes first, then the task's own."""
@@ -411,8 +411,9 @@ def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.nd
     return _ShapePack([uniq[u] for u in shared_ids]), tasks
 
 
-def _impact_slice(shared: _ShapePack, task: tuple, t_max: float, method: str, tol: float,
-                  samples: int, max_iterations: int, threads: int) -> tuple:
+def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, method: str,
+                  tol: float, samples: int, max_iterations: int,
+                  threads: int) -> tuple[Any, ...]:
     """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
     (only the shapes it uses are packed for the kernel); the raw result arrays."""
     from .impacts import _search
@@ -451,7 +452,7 @@ class _ShapePack:
 
     def __init__(self, shapes: Sequence[Any]) -> None:
         n = len(shapes)
-        self.arrays = (
+        self.arrays: tuple[np.ndarray, ...] = (
             np.concatenate([s.packed[0] for s in shapes]) if n else np.empty((0, 2)),
             np.concatenate([np.diff(s.packed[1]) for s in shapes]) if n
             else np.empty(0, np.int64),

@@ -29,14 +29,17 @@ tolerance grid (``grid_size``), which is robust where floating-point overlay is 
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import point as point_arg
-from .shape import Shape, as_shape
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import default_tolerance
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]
@@ -59,7 +62,7 @@ class Element(NamedTuple):
     body: str
     kind: str
     loop: int | None
-    index: int | None
+    index: int | None  # type: ignore[assignment]  # shadows tuple.index, on purpose
 
     def __str__(self) -> str:
         where = ("" if self.loop == 0 else " of a loop made by the repair"
@@ -192,6 +195,54 @@ class EntranceBlock:
         """Area of the entrance block."""
         return float(self._union.area)
 
+    @property
+    def __geo_interface__(self) -> dict[str, Any]:
+        """The entrance block as a GeoJSON-like (Multi)Polygon mapping (the union,
+        :meth:`to_shapely`), for Shapely, GeoPandas and other geometry libraries."""
+        return dict(self._union.__geo_interface__)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The entrance block as a JSON-ready dict: the object
+        ``polycontact entrance-block --json`` prints.
+
+        Keys ``method``, ``reference`` (a0 as ``[x, y]``), ``components`` (the count of
+        each family, "A2-B0", "A0-B2", "A1-B1"), ``zero_width_components``, ``area``,
+        ``region`` (GeoJSON of :meth:`to_shapely`) and ``relation`` (the
+        :meth:`Relation.to_dict` of A and B at a0).
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> d = pc.entrance_block(a, a.moved((3, 0))).to_dict()
+        >>> d["components"], d["area"], d["relation"]["state"]
+        ({'A2-B0': 4, 'A0-B2': 4, 'A1-B1': 4}, 4.0, 'separate')
+        """
+        import shapely
+
+        return {
+            "method": self.method,
+            "reference": [float(v) for v in self.reference],
+            "components": {f: len(self.of_family(f)) for f in ("A2-B0", "A0-B2", "A1-B1")},
+            "zero_width_components": sum(c.is_degenerate for c in self.components),
+            "area": self.area,
+            "region": json.loads(shapely.to_geojson(self._union)),
+            "relation": self.classify(self.reference).to_dict(),
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw the entrance block; returns the matplotlib Axes of E(A, B).
+
+        Without ``ax``, the four panels of :func:`polycontact.plotting.plot_entrance_block`
+        (one per family, then the union) and the union's Axes is returned; with ``ax``,
+        only the union panel: B, A, E(A, B) with its outline and a0.
+        """
+        from .plotting.entrance_block import plot_entrance_block, plot_union
+
+        if ax is None:
+            return plot_entrance_block(self).axes[3]
+        return plot_union(self, ax)
+
     def classify(self, point: Any, *, tolerance: float | None = None) -> Any:
         """Relation of A, moved so that its reference point is at ``point``, to B.
 
@@ -253,7 +304,8 @@ class EntranceBlock:
 
 
 def entrance_block(
-    a: Any, b: Any, reference: Any = None, *, method: str = "swept"
+    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    method: str = "swept"
 ) -> EntranceBlock:
     """The entrance block of A to B and its components (paper §2.3–2.4).
 
@@ -421,7 +473,7 @@ def _edges(s: Shape) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
+    return cast("np.ndarray", u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0])
 
 
 def _signed_area(ring: np.ndarray) -> float:
@@ -434,11 +486,11 @@ def _translated_polygons(loops: list[np.ndarray], offsets: np.ndarray) -> np.nda
 
     shells = shapely.linearrings(loops[0][None] + offsets[:, None])
     if len(loops) == 1:
-        return shapely.polygons(shells)
+        return cast("np.ndarray", shapely.polygons(shells))
     holes = np.stack(
         [shapely.linearrings(h[None] + offsets[:, None]) for h in loops[1:]], axis=1
     )
-    return shapely.polygons(shells, holes=holes)
+    return cast("np.ndarray", shapely.polygons(shells, holes=holes))
 
 
 def _parallelograms(corners: np.ndarray, eps: float) -> np.ndarray:
@@ -479,7 +531,7 @@ def _flat(corners: np.ndarray, eps: float) -> np.ndarray:
     d1 = corners[:, 1] - corners[:, 0]
     d2 = corners[:, 3] - corners[:, 0]
     longest = np.maximum(np.hypot(d1[:, 0], d1[:, 1]), np.hypot(d2[:, 0], d2[:, 1]))
-    return np.abs(_cross(d1, d2)) <= eps * longest
+    return cast("np.ndarray", np.abs(_cross(d1, d2)) <= eps * longest)
 
 
 def _polygonal(geom: Any) -> Any:
@@ -503,7 +555,7 @@ def _without_specks(geom: Any, eps: float) -> Any:
     def wide(ring_or_poly: Any) -> bool:
         poly = shapely.Polygon(ring_or_poly) if ring_or_poly.geom_type == "LinearRing" \
             else ring_or_poly
-        return shapely.maximum_inscribed_circle(poly, eps / 4).length > eps
+        return bool(shapely.maximum_inscribed_circle(poly, eps / 4).length > eps)
 
     pieces = [shapely.Polygon(p.exterior, [r for r in p.interiors if wide(r)])
               for p in shapely.get_parts(geom)]

@@ -28,8 +28,9 @@ from ._checks import finite_number
 from ._dispatch import entry_point
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .motion import Motion
-from .relation import Feature, State, classify
-from .shape import Shape, as_shape
+from .relation import Feature, Relation, State, classify
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
 
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
@@ -109,7 +110,7 @@ class Impact:
         How far in time the search got (t_max when it finished).
     time_tolerance : float
         The time tolerance honoured: the one asked for, or what float64 resolves at
-        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · |t|, when that is
+        ``time`` (``searched_to`` without a hit), 4 · 2**-52 · abs(t), when that is
         larger. ``time`` is within it after the first penetration.
     features : tuple of Feature
         At the touching configuration: which vertex of which body meets which edge of
@@ -132,7 +133,7 @@ class Impact:
     iterations: int = field(repr=False)
     searched_to: float = field(repr=False)
     time_tolerance: float = field(repr=False)
-    _bodies: tuple = field(repr=False, compare=False, default=())
+    _bodies: tuple[Any, ...] = field(repr=False, compare=False, default=())
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
@@ -140,6 +141,7 @@ class Impact:
             return (), None, None
         a, ma, b, mb, eps_rel = self._bodies
         if self.status is ImpactStatus.HIT:
+            assert self.time_bracket is not None  # a hit always has its bracket
             t_lo, t_hi = self.time_bracket
             if self.method == "exact":
                 t_lo, t_hi = _fine_bracket(a, ma, b, mb, t_lo, t_hi, eps_rel)
@@ -163,6 +165,7 @@ class Impact:
                            tolerance=_eps_at(a, ma, b, mb, 0.0, eps_rel))
             features, point, normal = rel.features, rel.point, rel.normal
         else:
+            assert self.first_contact is not None  # a state without a hit is a contact
             rel = _relation_at(a, ma, b, mb, self.first_contact, eps_rel)
             features, point, normal = rel.features, rel.point, rel.normal
         return (
@@ -185,6 +188,68 @@ class Impact:
     def normal(self) -> np.ndarray | None:
         """Unit contact normal at the moment of impact, from A towards B."""
         return self._details[2]
+
+    def to_dict(self, names: tuple[str, str] = ("a", "b")) -> dict[str, Any]:
+        """The impact as a JSON-ready dict: the object ``polycontact collide --json``
+        prints.
+
+        Parameters
+        ----------
+        names : (str, str), default ("a", "b")
+            The names of A and B: ``pair``, and each feature's ``body`` and
+            ``other_body``.
+
+        Returns
+        -------
+        dict
+            Every attribute of the class (``state`` and ``status`` as their values,
+            ``point`` and ``normal`` as ``[x, y]`` or None), ``features`` (each as
+            :meth:`Feature.to_dict` with the body names) and ``pair``.
+
+        Examples
+        --------
+        >>> import json
+        >>> from polycontact import Motion, Shape, time_of_impact
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(), t_max=5)
+        >>> d = hit.to_dict(("red", "blue"))
+        >>> d["status"], round(d["time"], 3), d["pair"], d["features"][0]["other_body"]
+        ('hit', 2.0, ['red', 'blue'], 'blue')
+        >>> json.loads(json.dumps(d)) == d
+        True
+        """
+        own = {"a": tuple(names), "b": (names[1], names[0])}
+        features = []
+        for f in self.features:
+            item = f.to_dict()
+            item["body"], item["other_body"] = own[f.body]
+            features.append(item)
+        return {
+            "collides": self.collides,
+            "time": self.time,
+            "first_contact": self.first_contact,
+            "state": None if self.state is None else self.state.value,
+            "features": features,
+            "point": None if self.point is None else [float(v) for v in self.point],
+            "normal": None if self.normal is None else [float(v) for v in self.normal],
+            "method": self.method,
+            "broad_phase": [list(iv) for iv in self.broad_phase],
+            "status": self.status.value,
+            "pair": list(names),
+            "time_bracket": None if self.time_bracket is None else list(self.time_bracket),
+            "time_tolerance": self.time_tolerance,
+            "iterations": self.iterations,
+            "searched_to": self.searched_to,
+        }
+
+    def plot(self, ax: Any = None, *, names: tuple[str, str] = ("A", "B")) -> Any:
+        """Draw both bodies at t = 0 and at the event, their centroid paths and the
+        contact; returns the matplotlib Axes (see
+        :func:`polycontact.plotting.plot_impact`)."""
+        from .plotting.impact import plot_impact
+
+        a, ma, b, mb, _ = self._bodies
+        return plot_impact(a, ma, b, mb, self, names=names, ax=ax)
 
 
 def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi: float,
@@ -215,7 +280,7 @@ _ULPS = ROUNDING_ULPS * 2.0**-52
 def _extent(shape: Shape) -> float:
     """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
     cached on the shape."""
-    return shape._extent
+    return float(shape._extent)
 
 
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
@@ -228,7 +293,7 @@ def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float
 
 
 def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
-                 reach: float = 0.0):
+                 reach: float = 0.0) -> Relation:
     """classify at time t, the tolerance (local to t) widened to the gap and to ``reach``.
 
     ``reach`` is how far the bodies can still move relative to each other before the
@@ -245,9 +310,9 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
 
 
 def time_of_impact(
-    a: Any,
+    a: BodyLike,
     motion_a: Motion,
-    b: Any,
+    b: BodyLike,
     motion_b: Motion,
     *,
     t_max: float,
@@ -258,9 +323,71 @@ def time_of_impact(
 ) -> Impact:
     """First time at which two moving bodies penetrate, and where they meet.
 
-    Both methods search only the broad-phase intervals
-    (:func:`polycontact.broad_phase_intervals`, paper Eq. 5).
+    Both bodies move rigidly over [0, ``t_max``] (:class:`Motion`: velocity,
+    acceleration, spin and angular acceleration about the area centroid). Only the
+    broad-phase intervals (:func:`polycontact.broad_phase_intervals`, paper Eq. 5) are
+    searched. ``method="exact"`` (default) is continuous and cannot miss a penetration
+    deeper than the contact resolution; ``method="sampled"`` is the paper's §3 and can
+    tunnel. Lengths and times are in any consistent units (those of the coordinates
+    and of the motions); the contract, the proof and the tolerances are under Notes.
 
+    Parameters
+    ----------
+    a, b : body
+        The bodies at t = 0, holes allowed, in any form :func:`polycontact.bodies.as_shape`
+        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, body mapping, WKT, WKB).
+    motion_a, motion_b : Motion
+        Their motions about their area centroids.
+    t_max : float
+        End of the time window searched, in the motions' time unit: the search covers
+        [0, ``t_max``]; a number >= 0.
+    method : {"exact", "sampled"}
+        "exact": conservative advancement, never tunnels (see Notes). "sampled": the
+        paper's §3 steps 3–6, ``samples`` points per round.
+    time_tolerance : float
+        Accuracy of ``time`` (the paper's threshold, 1e-4); any value > 0. Below what
+        float64 resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there,
+        and the result's ``time_tolerance`` says so.
+    samples : int
+        Points per round of the sampled method (>= 2); ignored by "exact".
+    max_iterations : int
+        Budget of the exact method; when spent, the status is OUT_OF_ITERATIONS (no
+        verdict), never a hang.
+
+    Returns
+    -------
+    Impact
+        ``collides``, ``time``, ``first_contact``, ``status``, and at the event the
+        ``features``, ``point`` and ``normal``.
+
+    Raises
+    ------
+    TypeError
+        A body, a motion or a number of the wrong type (the message names it).
+    ValueError
+        An invalid body (:class:`~polycontact.InvalidShapeError`), a bad ``t_max``,
+        ``time_tolerance``, ``method``, ``samples`` or ``max_iterations``, or
+        coordinates, speeds or accelerations that would overflow float64 within
+        [0, ``t_max``] (see ``tolerances.COORDINATE_LIMIT``).
+
+    Examples
+    --------
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                      t_max=5)
+    >>> hit.collides, abs(hit.time - 2.0) < 1e-4, hit.status.value
+    (True, True, 'hit')
+    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((1.9, 1)), Motion(),
+    ...                        t_max=1)                     # slides along from t = 0.9
+    >>> slide.collides, round(slide.first_contact, 4), slide.state.value
+    (False, 0.9, 'contact')
+    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
+    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
+    (True, True)
+
+    Notes
+    -----
     ``method="sampled"`` is the paper's §3 steps 3–6, literally: n = ``samples`` time
     points over [T1, T2] including both ends (spacing (T2 − T1)/(n − 1)), the first
     penetrating one t0, the new interval [t0 − (T2 − T1)/n, t0], until it is shorter
@@ -273,14 +400,14 @@ def time_of_impact(
 
     ``method="exact"`` (default) is continuous, by conservative advancement.
     Why it cannot skip a contact: a point p of A moves as
-    p(t) = c_A(t) + R(θ_A(t)) r with |r| ≤ L_A, so for points p of A and q of B
+    p(t) = c_A(t) + R(θ_A(t)) r with ‖r‖ ≤ L_A, so for points p of A and q of B
 
-        |ṗ − q̇| ≤ |Δv + Δa t| + |ω_A + α_A t| L_A + |ω_B + α_B t| L_B =: s(t),
+        ‖ṗ − q̇‖ ≤ ‖Δv + Δa t‖ + abs(ω_A + α_A t) L_A + abs(ω_B + α_B t) L_B =: s(t),
 
     and each term is the norm of an affine function of t, so its maximum S over a
     window [t, t + H] is at an end of the window (accelerations included, however
     many turns the bodies make). The distance d(t) between the boundaries is a minimum
-    of distances |p(t) − q(t)| of material points, hence S-Lipschitz on the window:
+    of distances ‖p(t) − q(t)‖ of material points, hence S-Lipschitz on the window:
     the boundaries cannot meet before t + d(t)/S, and interiors cannot begin to overlap
     without the boundaries meeting (at the first overlap the boundaries touch). So
     each step min(H, d/S) lands no later than the first contact. The step actually
@@ -291,7 +418,7 @@ def time_of_impact(
     second-order bound: along its fixed normal n (from the nearest point of e to p),
     dist(p, e) ≥ min over the ends x of e of n·(p − x) (a straight edge lies between
     its ends), and each n·(p − x) has its slope now known exactly (the velocities at t)
-    and its second derivative bounded by |Δa| + (|α_A| + ω_A²)|r_p| + (|α_B| + ω_B²)|r_x|
+    and its second derivative bounded by ‖Δa‖ + (abs(α_A) + ω_A²)‖r_p‖ + (abs(α_B) + ω_B²)‖r_x‖
     over the window (p̈ = a + (α J − ω²) R r for a point of a turning body), so it
     stays positive until the first root of g + r τ − K τ²/2; when p is outside the
     edge's line, its distance to the line turning with e's body (in that body's frame,
@@ -320,11 +447,11 @@ def time_of_impact(
     **Tolerances are local to the time examined**, never scaled by ``t_max`` or by the
     length of the travel: at time t the distance tolerance is
     ``tolerance_for(extent, magnitude)`` (:mod:`polycontact.tolerances`) with the
-    bodies' size and a bound of their |coordinates| over the step; the contact
+    bodies' size and a bound of their absolute coordinates over the step; the contact
     resolution is λ = max(:data:`CONTACT_RESOLUTION` · (L_A + L_B), 128 · eps,
-    S · 4 · 2⁻⁵² · |t|) (well above the rounding of the coordinates, and at least the
+    S · 4 · 2⁻⁵² · abs(t)) (well above the rounding of the coordinates, and at least the
     distance moved in one float step of t); the time tolerance used at t is
-    max(``time_tolerance``, 4 · 2⁻⁵² · |t|) — a tolerance float64 cannot resolve at t is
+    max(``time_tolerance``, 4 · 2⁻⁵² · abs(t)) — a tolerance float64 cannot resolve at t is
     clamped there, and :attr:`Impact.time_tolerance` says which one was honoured.
 
     **Contract** (``method="exact"``): whatever the speed, spin, acceleration, travel
@@ -363,44 +490,6 @@ def time_of_impact(
     contact that lasts while the bodies turn), the touch is stepped through by probes;
     the number of iterations is bounded by ``max_iterations`` (status
     OUT_OF_ITERATIONS, never a hang).
-
-    Parameters
-    ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
-        The bodies at t = 0 (holes allowed).
-    motion_a, motion_b : Motion
-        Their motions about their area centroids.
-    t_max : float
-        End of the time window (>= 0).
-    method : {"exact", "sampled"}
-    time_tolerance : float
-        Accuracy of ``time`` (the paper's threshold, 1e-4 s); any value > 0. Below
-        what float64 resolves at the time examined (4 · 2⁻⁵² · |t|) it is clamped
-        there, and the result's ``time_tolerance`` says so.
-    samples : int
-        Points per round of the sampled method (>= 2); ignored by "exact".
-    max_iterations : int
-        Budget of the exact method.
-
-    Returns
-    -------
-    Impact
-
-    Examples
-    --------
-    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
-    ...                      t_max=5)
-    >>> hit.collides, abs(hit.time - 2.0) < 1e-4, hit.status.value
-    (True, True, 'hit')
-    >>> slide = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((1.9, 1)), Motion(),
-    ...                        t_max=1)                     # slides along from t = 0.9
-    >>> slide.collides, round(slide.first_contact, 4), slide.state.value
-    (False, 0.9, 'contact')
-    >>> fine = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
-    ...                       t_max=5, time_tolerance=1e-300)   # below float64 at t = 2
-    >>> fine.collides, fine.time_tolerance == 4 * 2.0**-52 * fine.time
-    (True, True)
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
@@ -468,7 +557,7 @@ def _query(method: str, args: tuple, fixed: bool) -> tuple:
 
 
 def body_frame(shape: Shape, tables: bool = True,
-               what: str = "shape") -> tuple[np.ndarray, tuple | None]:
+               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None]:
     """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
     for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
     sampled method does not need it). Built on first use and kept with the shape (it
@@ -493,8 +582,9 @@ def body_frame(shape: Shape, tables: bool = True,
     return r, tab
 
 
-def _result(a, ma, b, mb, method, status, t_hi, t_lo, t_contact, iters, reached, intervals,
-            t_max, eps_rel, tol) -> Impact:
+def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, status: ImpactStatus,
+            t_hi: float, t_lo: float, t_contact: float, iters: int, reached: float,
+            intervals: np.ndarray, t_max: float, eps_rel: float, tol: float) -> Impact:
     if not _TIME_TOLERANCE:
         from ._kernels.impact import effective_time_tolerance
 

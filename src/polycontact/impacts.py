@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -29,7 +29,8 @@ from .errors import InvalidShapeError
 from .impact import (_METHODS, _STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
                      ImpactStatus, _extent, _result, body_frame)
 from .motion import Motion
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE
 
 __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
@@ -82,7 +83,7 @@ class ImpactBatch:
     collides: np.ndarray
     times: np.ndarray
     first_contacts: np.ndarray
-    _make: Any = field(repr=False, compare=False)
+    _make: Callable[[int], Impact] = field(repr=False, compare=False)
 
     def __len__(self) -> int:
         return int(self.status.shape[0])
@@ -95,7 +96,7 @@ class ImpactBatch:
             raise IndexError(f"k: expected a pair index in [0, {n}), got {k!r}")
         return self._make(int(k) % n)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Impact]:
         return (self.impact(k) for k in range(len(self)))
 
 
@@ -111,7 +112,7 @@ class PairImpact(NamedTuple):
 
 
 # -- validation ------------------------------------------------------------------------
-def _sequence(items: Any, what: str) -> list:
+def _sequence(items: Any, what: str) -> list[Any]:
     if isinstance(items, (str, bytes, dict)) or not isinstance(items, (Sequence, np.ndarray)):
         raise TypeError(f"{what}: expected a sequence, got {type(items).__name__}")
     return list(items)
@@ -139,7 +140,8 @@ def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion
     return [check_motion(m, f"{what}[{k}]") for k, m in enumerate(motions)]
 
 
-def _options(t_max, method, time_tolerance, samples, max_iterations, threads):
+def _options(t_max: float, method: str, time_tolerance: float, samples: int,
+             max_iterations: int, threads: int | None) -> tuple[float, float, int, int, int]:
     t_max = check_t_max(t_max)
     tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
@@ -157,9 +159,9 @@ def _options(t_max, method, time_tolerance, samples, max_iterations, threads):
 
 
 # -- the batched search ----------------------------------------------------------------
-def _pack(shapes: list[Shape], exact: bool) -> tuple:
+def _pack(shapes: list[Shape], exact: bool) -> tuple[Any, ...]:
     """The shapes' body-frame tables one after another (see ``impacts_chunk``)."""
-    frames = [body_frame(s, tables=exact) for s in shapes]
+    frames: list[Any] = [body_frame(s, tables=exact) for s in shapes]
     n = len(shapes)
     nv = np.array([len(r) for r, _ in frames], dtype=np.int64)
     v_off = np.zeros(n + 1, np.int64)
@@ -188,7 +190,7 @@ def _pack(shapes: list[Shape], exact: bool) -> tuple:
 
 def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
             mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
-            samples: int, max_iterations: int, threads: int) -> tuple:
+            samples: int, max_iterations: int, threads: int) -> tuple[Any, ...]:
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
     search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
     of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
@@ -225,8 +227,9 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     return out
 
 
-def _maker(shape_of, motion_of, raw, t_max: float, method: str, eps_rel: np.ndarray,
-           tol: float):
+def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
+           raw: tuple[Any, ...], t_max: float, method: str, eps_rel: np.ndarray,
+           tol: float) -> Callable[[int], Impact]:
     code, t_hi, t_lo, contact, iters, reached, n_iv, iv = raw
 
     def make(p: int) -> Impact:
@@ -355,7 +358,7 @@ def time_of_impact_many(
 
 
 def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
-             t_max: float) -> tuple:
+             t_max: float) -> tuple[Any, ...]:
     """Check every body of the pairs as ``time_of_impact`` does (errors naming where it
     first appears: ``shapes_a[k]``, ``motions_b[k]``, ...), then the inputs of
     :func:`_search`: the distinct shapes, each pair's two indices among them, its two
@@ -384,8 +387,9 @@ def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
     return uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel
 
 
-def _batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion], raw: tuple,
-           eps_rel: np.ndarray, t_max: float, method: str, tol: float) -> ImpactBatch:
+def _batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+           raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
+           tol: float) -> ImpactBatch:
     """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
     the raw result arrays of :func:`_search`."""
     code, t_hi, _, contact, *_ = raw
@@ -441,7 +445,8 @@ def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.
     rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
     boxes, owner = swept_boxes(cent, _motion_array(motions), rad, t_max, MAX_SLICES,
                                BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
-    return box_pairs(boxes, owner, n)
+    pairs: np.ndarray = box_pairs(boxes, owner, n)
+    return pairs
 
 
 def event_time(impact: Impact) -> float:
@@ -457,7 +462,7 @@ def event_time(impact: Impact) -> float:
     """
     if impact.status is ImpactStatus.PENETRATING_AT_START:
         return 0.0
-    if impact.status is ImpactStatus.HIT:
+    if impact.status is ImpactStatus.HIT and impact.time is not None:
         return impact.time
     if impact.status is ImpactStatus.OUT_OF_ITERATIONS:
         return impact.searched_to
@@ -553,13 +558,13 @@ def first_impacts(
     code, _, _, contact, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
-    events = [PairImpact(int(i[p]), int(j[p]), make(p))
+    events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
               for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
     events.sort(key=lambda e: (event_time(e.impact), e.i, e.j))
     return events
 
 
-def _first_order(event: PairImpact) -> tuple:
+def _first_order(event: PairImpact) -> tuple[Any, ...]:
     """:meth:`polycontact.Scene.first_impact`'s order: collisions (penetrating at the
     start, hits, searches without a verdict) by time before any touch."""
     imp = event.impact

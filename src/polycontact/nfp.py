@@ -34,18 +34,20 @@ from __future__ import annotations
 
 import functools
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import shapely
 import shapely.affinity
 
 from ._checks import finite_number
 from ._checks import point as point_arg
-from .errors import InvalidShapeError
-from .shape import Shape, as_shape
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]
@@ -131,7 +133,7 @@ class NoFitPolygon:
         """
         from .relation import classify
 
-        p = point_arg(point, "point", error=InvalidShapeError)
+        p = point_arg(point, "point")
         moved = self.a.moved(p - self.reference)
         return classify(moved, self.b, tolerance=tolerance).state
 
@@ -140,9 +142,52 @@ class NoFitPolygon:
         """The region's boundary (every ring) as a shapely geometry."""
         return self.region.boundary
 
+    @property
+    def __geo_interface__(self) -> dict[str, Any]:
+        """The region as a GeoJSON-like (Multi)Polygon mapping, for Shapely, GeoPandas
+        and other geometry libraries (exact fits and slides are in :meth:`to_dict`)."""
+        return dict(self.region.__geo_interface__)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The no-fit polygon as a JSON-ready dict: the object ``polycontact nfp --json``
+        prints.
+
+        Keys ``reference`` (``[x, y]``), ``region`` (GeoJSON), ``area``, ``holes`` (their
+        number), ``exact_fits`` (``[[x, y], ...]``), ``slides`` (``[[[x0, y0], [x1, y1]],
+        ...]``) and ``tolerance``.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> d = pc.no_fit_polygon(sq, sq.moved((3, 0))).to_dict()
+        >>> d["area"], d["holes"], d["region"]["type"]
+        (4.0, 0, 'Polygon')
+        """
+        import json
+
+        return {
+            "reference": self.reference.tolist(),
+            "region": json.loads(shapely.to_geojson(self.region)),
+            "area": float(self.region.area),
+            "holes": sum(len(g.interiors) for g in shapely.get_parts(self.region)),
+            "exact_fits": self.exact_fits.tolist(),
+            "slides": self.slides.tolist(),
+            "tolerance": float(self.tolerance),
+        }
+
+    def plot(self, ax: Any = None, *, placement: Any = None) -> Any:
+        """Draw B, the region with its holes, exact fits and slides, and A at
+        ``placement``; returns the matplotlib Axes (see
+        :func:`polycontact.plotting.plot_nfp`)."""
+        from .plotting.nfp import plot_nfp
+
+        return plot_nfp(self, placement, ax)
+
 
 def no_fit_polygon(
-    a: Any, b: Any, reference: Any = None, *, tolerance: float | None = None
+    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    tolerance: float | None = None
 ) -> NoFitPolygon:
     """No-fit polygon of ``a`` orbiting the fixed ``b``.
 
@@ -183,7 +228,8 @@ def no_fit_polygon(
 
 
 def inner_fit_polygon(
-    a: Any, container: Any, reference: Any = None, *, tolerance: float | None = None
+    a: BodyLike, container: BodyLike, reference: npt.ArrayLike | None = None, *,
+    tolerance: float | None = None
 ) -> Any:
     """Reference positions at which ``a`` lies inside ``container`` (touching allowed).
 
@@ -236,7 +282,7 @@ def inner_fit_polygon(
     def fits(p: np.ndarray) -> bool:
         placed = shapely.affinity.translate(a_poly, *(p - a0))
         spill = placed.difference(c_poly)
-        return spill.area <= eps * (placed.length + c_poly.length)
+        return bool(spill.area <= eps * (placed.length + c_poly.length))
 
     fit_pts, slide_segs = _clean_degenerate(pts, segs, (fxy, fst, r, ast), eps, lambda: fits)
     parts = [free] if not free.is_empty else []
@@ -256,17 +302,17 @@ def _reference(a: Shape, reference: Any) -> np.ndarray:
     if isinstance(reference, str):
         if reference == "origin":
             return np.zeros(2)
-        raise InvalidShapeError(
+        raise ValueError(
             f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
         )
-    return point_arg(reference, "reference", error=InvalidShapeError)
+    return point_arg(reference, "reference")
 
 
 def _tolerance(tolerance: float | None) -> float:
     """The tolerance for the kernel: -1 asks it for the default of the sums' coordinates."""
     if tolerance is None:
         return -1.0
-    return finite_number(tolerance, "tolerance", positive=True, error=InvalidShapeError)
+    return finite_number(tolerance, "tolerance", positive=True)
 
 
 def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
@@ -298,8 +344,9 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
     # GEOS adds no vertex: triangles share exact coordinates, hence vertex indices
     vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
-    return _kernels().decompose.convex_pieces(
+    pieces: tuple[np.ndarray, np.ndarray] = _kernels().decompose.convex_pieces(
         vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE, ROUNDING_ULPS)
+    return pieces
 
 
 def _entrance(
@@ -337,8 +384,8 @@ def _polygon_from_rings(
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
         header = _WKB_POLYGON.pack(1, 3, 1, len(xy))
         return shapely.from_wkb(header + xy.astype("<f8", copy=False).tobytes())
-    shells = []
-    holes = []
+    shells: list[Any] = []
+    holes: list[Any] = []
     for k in range(len(starts) - 1):
         area, length = stats[k]
         if 2.0 * abs(area) <= width * length:
@@ -384,7 +431,9 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
     return out[0] if len(out) == 1 else shapely.MultiPolygon(out)
 
 
-def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
+def _touching(
+    a: Shape, b: Shape, a0: np.ndarray, eps: float
+) -> Callable[[np.ndarray], bool]:
     """Check that A with its reference at p touches B without overlapping (classifier)."""
     relate_state = _kernels().relate_state
     xa, sa = a.packed
@@ -392,7 +441,7 @@ def _touching(a: Shape, b: Shape, a0: np.ndarray, eps: float):
     tol = HOLE_WIDTH_FACTOR * eps
 
     def check(p: np.ndarray) -> bool:
-        return relate_state(xa + (p - a0), sa, xb, sb, tol) == 1
+        return bool(relate_state(xa + (p - a0), sa, xb, sb, tol) == 1)
 
     return check
 
@@ -406,7 +455,7 @@ def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> float:
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: tuple, eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, pieces: tuple[Any, ...], eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
 

@@ -75,7 +75,8 @@ import shapely
 from . import __version__
 from .esicup import Instance, turned
 from .nfp import NoFitPolygon, no_fit_polygon
-from .shape import Shape, as_shape
+from .bodies import as_shape
+from .shape import Shape
 
 __all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_POOL_MIN_ENTRIES"]
 

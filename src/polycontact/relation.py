@@ -25,14 +25,15 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from ._checks import finite_number
 from ._dispatch import entry_point
 from .errors import InvalidShapeError
-from .shape import Shape, as_shape
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,
@@ -101,6 +102,21 @@ class Feature:
     kind: str
     own_edge: int | None = None
 
+    def to_dict(self) -> dict[str, Any]:
+        """The feature as a JSON-ready dict (``own_edge`` only for an edge crossing).
+
+        Examples
+        --------
+        >>> Feature("a", 0, 2, 0, 1, "vertex-on-edge").to_dict()
+        {'body': 'a', 'loop': 0, 'vertex': 2, 'other_loop': 0, 'edge': 1, 'kind': 'vertex-on-edge'}
+        """
+        out: dict[str, Any] = {"body": self.body, "loop": self.loop, "vertex": self.vertex,
+                               "other_loop": self.other_loop, "edge": self.edge,
+                               "kind": self.kind}
+        if self.own_edge is not None:
+            out["own_edge"] = self.own_edge
+        return out
+
 
 @dataclass(frozen=True, eq=False)
 class Relation:
@@ -139,11 +155,64 @@ class Relation:
 
     state: State
     tolerance: float
-    _pair: tuple = field(repr=False)
+    _pair: tuple[Any, ...] = field(repr=False)
 
     def __repr__(self) -> str:
         # Only what is already decided: the lazy parts (a depth can be costly) stay lazy.
         return f"Relation(state={self.state.value!r}, tolerance={self.tolerance:g})"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The relation as a JSON-ready dict: the object ``polycontact classify --json``
+        prints.
+
+        Keys ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
+        ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``. Only what is
+        returned is computed: separate bodies have no features (nothing touches), so
+        their feature search is skipped.
+
+        Examples
+        --------
+        >>> import json
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> d = classify(sq, [(1, 0), (2, 0), (2, 1), (1, 1)]).to_dict()
+        >>> d["state"], len(d["features"]), d["normal"]
+        ('contact', 8, [1.0, 0.0])
+        >>> json.loads(json.dumps(d)) == d
+        True
+        """
+        features = () if self.state is State.SEPARATE else self.features
+        return {
+            "state": self.state.value,
+            "distance": float(self.distance),
+            "features": [f.to_dict() for f in features],
+            "point": _xy(self.point),
+            "normal": _xy(self.normal),
+            "tolerance": float(self.tolerance),
+        }
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw both bodies, the witness point and the normal; returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, it is imported
+            only here: ``pip install polycontact[plot]``).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> ax = classify(sq, [(1, 0), (2, 0), (2, 1), (1, 1)]).plot()
+        >>> ax.get_title()
+        'contact, distance 0'
+        """
+        from .plotting.relation import plot_relation
+
+        return plot_relation(self, ax=ax)
 
     @cached_property
     def shapes(self) -> tuple[Shape, Shape]:
@@ -160,13 +229,13 @@ class Relation:
     def _closest(self) -> tuple[float, float, float, float, float]:
         from ._kernels import relation as kr
 
-        return kr.closest_pair(*self._packed)
+        return cast("tuple[float, float, float, float, float]", kr.closest_pair(*self._packed))
 
     @cached_property
     def _penetration(self) -> tuple[float, float, float]:
         from ._kernels import relation as kr
 
-        return kr.penetration(*self._packed, self.tolerance)
+        return cast("tuple[float, float, float]", kr.penetration(*self._packed, self.tolerance))
 
     @cached_property
     def distance(self) -> float:
@@ -185,10 +254,10 @@ class Relation:
         return np.array(self._penetration[1:])
 
     @cached_property
-    def _raw_features(self) -> tuple:
+    def _raw_features(self) -> tuple[Any, ...]:
         from ._kernels import relation as kr
 
-        return kr.features(*self._packed, self.tolerance)
+        return cast("tuple[Any, ...]", kr.features(*self._packed, self.tolerance))
 
     @cached_property
     def features(self) -> tuple[Feature, ...]:
@@ -220,13 +289,13 @@ class Relation:
             if cross:
                 return np.array(cross[0][2:])
             if a_in:
-                return xa[a_in[0][0]].copy()
+                return cast("np.ndarray", xa[a_in[0][0]].copy())
             if b_in:
-                return xb[b_in[0][0]].copy()
+                return cast("np.ndarray", xb[b_in[0][0]].copy())
         if a_on:
-            return xa[a_on[0][0]].copy()
+            return cast("np.ndarray", xa[a_on[0][0]].copy())
         if b_on:
-            return xb[b_on[0][0]].copy()
+            return cast("np.ndarray", xb[b_on[0][0]].copy())
         return None
 
     @cached_property
@@ -236,7 +305,7 @@ class Relation:
             return None
         if self.state is State.PENETRATING:
             d = -np.asarray(self._penetration[1:])
-            return d / np.hypot(*d) + 0.0
+            return cast("np.ndarray", d / np.hypot(*d) + 0.0)
         xa, sa, xb, sb = self._packed
         a_on, b_on, _, _, _ = self._raw_features
         best = None
@@ -262,6 +331,11 @@ class Relation:
                 if best is None or score > best[0]:
                     best = (score, n)
         return None if best is None else best[1]
+
+
+def _xy(p: np.ndarray | None) -> list[float] | None:
+    """A point or vector as a JSON-ready ``[x, y]`` (None stays None)."""
+    return None if p is None else [float(v) for v in p]
 
 
 def _local(starts: np.ndarray, g: int) -> tuple[int, int]:
@@ -312,7 +386,7 @@ _STATE: list[Any] = []  # [relate_state's entry point for two Shapes], bound on 
 _new = object.__new__
 
 
-def classify(a: Any, b: Any, *, tolerance: float | None = None) -> Relation:
+def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
 
     Parameters
@@ -418,7 +492,7 @@ class RelationBatch:
 
     states: np.ndarray
     tolerances: np.ndarray
-    _pack: Callable[[], tuple] = field(repr=False)  # the packed pairs, built on demand
+    _pack: Callable[[], tuple[Any, ...]] = field(repr=False)  # the packed pairs, built on demand
 
     def __len__(self) -> int:
         return int(self.states.shape[0])
@@ -432,7 +506,7 @@ class RelationBatch:
         """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
         from ._kernels import relation_many as km
 
-        return km.many_distances(*self._pack(), self.states, self.tolerances)
+        return cast("np.ndarray", km.many_distances(*self._pack(), self.states, self.tolerances))
 
 
 def _split(count: int, fn: Any) -> list[Any]:
@@ -456,7 +530,7 @@ def _raw_array(arr: Any) -> np.ndarray | None:
     return np.ascontiguousarray(arr, dtype=np.float64)
 
 
-def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple:
+def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any, ...]:
     """Packed batch form of P validated rings ``arr`` (P, N, 2), ``used[p]`` vertices each."""
     p_count, n = arr.shape[0], arr.shape[1]
     lo = np.arange(p_count, dtype=np.int64) * n
@@ -485,7 +559,7 @@ def _classify_arrays(
     )
 
 
-def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
+def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, ...]:
     """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel."""
     from ._kernels import relation_many as km
 
@@ -533,11 +607,11 @@ def _pack_sequence(items: Sequence[Any], what: str) -> tuple:
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def _pack(items: Any, what: str) -> tuple:
+def _pack(items: Any, what: str) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
-        raise InvalidShapeError(
+        raise TypeError(
             f"{what}: expected a sequence of bodies or an array of shape (P, N, 2), "
             f"got {type(items).__name__}"
         )
@@ -545,7 +619,8 @@ def _pack(items: Any, what: str) -> tuple:
 
 
 def classify_many(
-    shapes_a: Any, shapes_b: Any, *, tolerance: float | None = None
+    shapes_a: Sequence[BodyLike] | np.ndarray, shapes_b: Sequence[BodyLike] | np.ndarray, *,
+    tolerance: float | None = None
 ) -> RelationBatch:
     """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.
 
@@ -593,10 +668,11 @@ def classify_many(
     xb, lsb, bsb, fb = pb
 
     def chunk(p0: int, p1: int) -> tuple[np.ndarray, np.ndarray]:
-        return km.many_states(
+        out: tuple[np.ndarray, np.ndarray] = km.many_states(
             xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
             RELATIVE_TOLERANCE, ROUNDING_ULPS,
         )
+        return out
 
     parts = _split(len(fa), chunk)
     states = np.concatenate([st for st, _ in parts])

@@ -21,8 +21,10 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
+from .bodies import as_shape
 from .errors import InvalidSceneError, InvalidShapeError
 from .impact import Impact, ImpactStatus, time_of_impact
 from .motion import Motion
@@ -68,7 +70,8 @@ class Scene:
 
     @classmethod
     def from_dict(cls, data: Any, *, repair: bool = False) -> Scene:
-        """Build a scene from parsed JSON; ``repair`` is passed to :class:`Shape`."""
+        """Build a scene from parsed JSON (lists or tuples); ``repair`` is passed to
+        :func:`~polycontact.bodies.as_shape`."""
         if not isinstance(data, dict):
             raise InvalidSceneError(f"expected a JSON object, got {type(data).__name__}")
         _no_unknown(data, _TOP_KEYS, "")
@@ -167,7 +170,7 @@ class Scene:
 def _event_order(imp: Impact) -> tuple[float, float]:
     if imp.status is ImpactStatus.PENETRATING_AT_START:
         return (0.0, 0.0)
-    if imp.status is ImpactStatus.HIT:
+    if imp.status is ImpactStatus.HIT and imp.time is not None:
         return (imp.time, 0.0)
     if imp.status is ImpactStatus.OUT_OF_ITERATIONS:
         return (imp.searched_to, 0.0)
@@ -175,15 +178,40 @@ def _event_order(imp: Impact) -> tuple[float, float]:
     return (math.inf, contact)
 
 
-def load_scene(path: str | Path, *, repair: bool = False) -> Scene:
-    """Read a scene JSON file (format in the module docstring).
+def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) -> Scene:
+    """Read a scene JSON file, or take its parsed content (format in the module docstring).
+
+    Parameters
+    ----------
+    path : str, Path or mapping
+        The file's path, or the parsed scene itself (as :meth:`Scene.from_dict`).
+    repair : bool, default False
+        Passed to :func:`polycontact.bodies.as_shape` for every body.
+
+    Returns
+    -------
+    Scene
 
     Raises
     ------
     InvalidSceneError
         Unreadable file, invalid JSON, or a bad key; the message starts with the file
         name and names the key (``bodies[1].velocity: ...``).
+    TypeError
+        ``path`` is neither a path nor a mapping.
+
+    Examples
+    --------
+    >>> sq = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    >>> scene = load_scene({"t_max": 1, "bodies": [{"vertices": sq},
+    ...                     {"vertices": [[x + 2, y] for x, y in sq]}]})
+    >>> [b.name for b in scene.bodies]
+    ['body0', 'body1']
     """
+    if isinstance(path, Mapping):
+        return Scene.from_dict(dict(path), repair=repair)
+    if not isinstance(path, (str, Path)):
+        raise TypeError(f"path: expected a path or a mapping, got {type(path).__name__}")
     path = Path(path)
     try:
         text = path.read_text()
@@ -199,13 +227,13 @@ def load_scene(path: str | Path, *, repair: bool = False) -> Scene:
         raise InvalidSceneError(f"{path}: {exc}") from None
 
 
-def _required(data: dict, key: str, where: str) -> Any:
+def _required(data: dict[str, Any], key: str, where: str) -> Any:
     if key not in data:
         raise InvalidSceneError(f"{where}{key}: missing")
     return data[key]
 
 
-def _no_unknown(data: dict, allowed: set[str], where: str) -> None:
+def _no_unknown(data: dict[str, Any], allowed: set[str], where: str) -> None:
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise InvalidSceneError(f"{where}{unknown[0]}: unknown key")
@@ -220,18 +248,19 @@ def _number(value: Any, what: str) -> float:
 
 
 def _vector(value: Any, what: str) -> tuple[float, float]:
-    if not isinstance(value, list) or len(value) != 2:
-        raise InvalidSceneError(f"{what}: expected [x, y], got {json.dumps(value)}")
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        got = json.dumps(value, default=repr)
+        raise InvalidSceneError(f"{what}: expected [x, y], got {got}")
     return _number(value[0], f"{what}[0]"), _number(value[1], f"{what}[1]")
 
 
 def _ring(value: Any, what: str) -> list[tuple[float, float]]:
-    if not isinstance(value, list):
+    if not isinstance(value, (list, tuple)):
         raise InvalidSceneError(f"{what}: expected a list of [x, y] points")
     return [_vector(p, f"{what}[{i}]") for i, p in enumerate(value)]
 
 
-def _angle(data: dict, key: str, where: str) -> float:
+def _angle(data: dict[str, Any], key: str, where: str) -> float:
     deg = f"{key}_deg"
     if key in data and deg in data:
         raise InvalidSceneError(f"{where}{deg}: give {key} or {deg}, not both")
@@ -257,10 +286,11 @@ def _body(data: Any, i: int, repair: bool) -> Body:
         raise InvalidSceneError(f"{where}holes: expected a list of rings")
     holes = [_ring(h, f"{where}holes[{k}]") for k, h in enumerate(holes_raw)]
     try:
-        shape = Shape(vertices, holes, repair=repair)
+        shape = as_shape({"vertices": vertices, "holes": holes}, f"{where}vertices ({name!r})",
+                         repair=repair)
     except InvalidShapeError as exc:
         hint = "" if repair else " (--repair / repair=True may fix it)"
-        raise InvalidSceneError(f"{where}vertices ({name!r}): {exc}{hint}") from None
+        raise InvalidSceneError(f"{exc}{hint}") from None
     motion = Motion(
         velocity=_vector(data.get("velocity", [0, 0]), f"{where}velocity"),
         acceleration=_vector(data.get("acceleration", [0, 0]), f"{where}acceleration"),

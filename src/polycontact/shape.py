@@ -16,7 +16,7 @@ and with repeated or closing points counted; :meth:`Shape.input_vertex`,
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -33,7 +33,7 @@ from .tolerances import (
     validation_tolerance,
 )
 
-__all__ = ["Shape", "as_shape"]
+__all__ = ["Shape"]
 
 ArrayLike = Any
 
@@ -136,7 +136,9 @@ class Shape:
         shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
         message then says which, how far apart, and the float spacing.
     TypeError
-        Coordinates that are not real numbers (strings, booleans, complex numbers).
+        Coordinates that are not real numbers (strings, booleans, complex numbers), or
+        a body in another form (a Shapely polygon, a mapping, text): pass those to
+        :func:`polycontact.bodies.as_shape`, which takes every form.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
 
@@ -167,6 +169,12 @@ class Shape:
     def __init__(
         self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
     ) -> None:
+        if isinstance(vertices, (str, bytes, Mapping)) or hasattr(vertices, "__geo_interface__"):
+            raise TypeError(
+                f"vertices: expected an (N, 2) array-like, got {type(vertices).__name__}; "
+                "polycontact.bodies.as_shape takes every form of a body (Shape, Shapely, "
+                "GeoJSON, body mapping, WKT, WKB)"
+            )
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
             raise InvalidShapeError(
                 "holes: expected a sequence of (M, 2) loops, got a single (M, 2) array; "
@@ -221,7 +229,8 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
-        self._frame = None        # body-frame tables of the time-of-impact search
+        # body-frame tables of the time-of-impact search
+        self._frame: tuple[Any, Any, float] | None = None
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
         # contribute negative area, which removes them. Coordinates are taken relative to
@@ -370,7 +379,7 @@ class Shape:
         """
         return self._lookup(loop, i, 1)
 
-    def _to_input(self, packed: Sequence[int], column: int) -> tuple[list, list]:
+    def _to_input(self, packed: Sequence[int], column: int) -> tuple[list[Any], list[Any]]:
         """Caller's loops and indices (None where there is none) of the vertices
         (``column`` 0) or edges (1) at rows ``packed`` of :attr:`packed`, in bulk."""
         rows = np.asarray(packed, dtype=np.int64)
@@ -487,10 +496,10 @@ class Shape:
 
     def to_wkt(self) -> str:
         """The shape as WKT text."""
-        return self.to_shapely().wkt
+        return str(self.to_shapely().wkt)
 
     @classmethod
-    def from_geojson(cls, data: str | dict, *, repair: bool = False) -> Shape:
+    def from_geojson(cls, data: str | dict[str, Any], *, repair: bool = False) -> Shape:
         """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
         if isinstance(data, str):
             try:
@@ -511,11 +520,11 @@ class Shape:
         return cls(rings[0], rings[1:], repair=repair)
 
     @property
-    def __geo_interface__(self) -> dict:
+    def __geo_interface__(self) -> dict[str, Any]:
         """GeoJSON-like mapping (the Python geo interface), closed rings."""
         return self.to_geojson()
 
-    def to_geojson(self) -> dict:
+    def to_geojson(self) -> dict[str, Any]:
         """The shape as a GeoJSON Polygon mapping with closed rings."""
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
@@ -523,20 +532,6 @@ class Shape:
     def __repr__(self) -> str:
         holes = f", {len(self.holes)} hole(s)" if self.holes else ""
         return f"<Shape {len(self.exterior)} vertices{holes}, area {self._area:g}>"
-
-
-def as_shape(obj: Any, what: str = "shape") -> Shape:
-    """Coerce a Shape, a shapely Polygon or an (N, 2) array-like to a :class:`Shape`."""
-    if isinstance(obj, Shape):
-        return obj
-    if hasattr(obj, "geom_type"):
-        return Shape.from_shapely(obj)
-    try:
-        return Shape(obj)
-    except InvalidShapeError as exc:
-        raise InvalidShapeError(f"{what}: {exc}") from None
-    except TypeError as exc:  # coordinates that are not real numbers
-        raise TypeError(f"{what}: {exc}") from None
 
 
 def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -576,7 +571,7 @@ def _ring_map(raw: np.ndarray, reverse: bool) -> np.ndarray:
 
 def _input_maps(
     rings: Sequence[ArrayLike], cleaned: Sequence[np.ndarray], stored: Sequence[np.ndarray]
-) -> tuple:
+) -> tuple[Any, ...]:
     """``(loop map, packed (n, 2) vertex and edge map)`` of the ``stored`` loops built
     from the caller's ``rings`` through ``cleaned`` (:func:`_clean_ring`); a stored loop
     that differs from its cleaned ring is its reversal."""
@@ -592,7 +587,7 @@ def _input_maps(
     return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
 
 
-def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple:
+def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
     """The map of a repaired shape to the caller's ``rings``.
 
     A stored loop belongs to the caller's loop that shares most of its vertices; a stored
@@ -601,9 +596,9 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple:
     within the tolerance. What the repair created maps to -1.
     """
     raws = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
-    where: list[dict[tuple[float, float], list[int]]] = []
+    where: list[dict[tuple[float, ...], list[int]]] = []
     for raw in raws:
-        found: dict[tuple[float, float], list[int]] = {}
+        found: dict[tuple[float, ...], list[int]] = {}
         for c, p in enumerate(map(tuple, raw.tolist())):
             found.setdefault(p, []).append(c)
         where.append(found)

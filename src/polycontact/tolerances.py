@@ -67,7 +67,7 @@ EXTENT_FLOOR = 1e-100
 
 #: A polygon is refused as invalid (two of its features meet) only when they are
 #: closer than float64 can tell apart: 4 units in the last place of its largest
-#: |coordinate|, about the rounding of a distance computed from such coordinates. This
+#: absolute coordinate, about the rounding of a distance computed from such coordinates. This
 #: is far below :func:`tolerance_for` on purpose: a valid polygon (GEOS's "very skinny
 #: polygon", 10 wide and 1e15 long) is accepted, and its features closer than the
 #: classification tolerance are then decided as touching.

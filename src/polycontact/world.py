@@ -31,15 +31,17 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import finite_number
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .shape import Shape, as_shape
+from .bodies import BodyLike, as_shape
+from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_tolerance
 
 __all__ = ["World", "WorldBody", "Contacts", "Query"]
@@ -108,6 +110,10 @@ class Contacts:
     container_ids, container_states : ndarray of shape (M,)
         Bodies that touch the container's boundary (1) or leave it / enter a hole (2);
         empty without a container.
+    ids : ndarray of shape (N,), int64
+        Every body of the world when asked, sorted.
+    container : Shape or None
+        The world's container.
     """
 
     pairs: np.ndarray
@@ -115,8 +121,10 @@ class Contacts:
     tolerances: np.ndarray
     container_ids: np.ndarray
     container_states: np.ndarray
-    _store: tuple = field(repr=False)  # the coordinates as they were
+    _store: tuple[Any, ...] = field(repr=False)  # the coordinates as they were
     _tolerance: float | None = field(repr=False)
+    ids: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64), repr=False)
+    container: Shape | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.states)
@@ -135,7 +143,66 @@ class Contacts:
     @property
     def penetrating(self) -> np.ndarray:
         """The pairs that penetrate, (P, 2)."""
-        return self.pairs[self.states == 2]
+        return cast("np.ndarray", self.pairs[self.states == 2])
+
+    def shape(self, id: int) -> Shape:
+        """The Shape of body ``id`` as it was when the contacts were found."""
+        _, _, lo, nl = self._store
+        if id not in set(self.ids.tolist()):
+            raise IndexError(f"id: no body {id} among the contacts' bodies")
+        return _stored_shape(self._store[0], self._store[1], int(lo[id]), int(nl[id]))
+
+    def to_dict(self, names: Any = None) -> dict[str, Any]:
+        """The contacts as a JSON-ready dict: the object ``polycontact contacts --json``
+        prints.
+
+        Parameters
+        ----------
+        names : sequence or mapping of str, optional
+            A name for each body id (``names[id]``); default the id as text.
+
+        Returns
+        -------
+        dict
+            ``bodies`` (their number), ``container`` (whether there is one),
+            ``contacts`` (per pair: ids ``a``, ``b``, their ``names``, ``state``
+            ``"contact"`` or ``"penetrating"``, witness ``point``) and
+            ``container_contacts`` (per body: ``body``, ``name``, ``state``
+            ``"contact"`` or ``"outside"``).
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> w = pc.World()
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> ids = [w.add(sq), w.add(sq, position=(1.5, 0.5))]
+        >>> w.contacts().to_dict()["contacts"]
+        [{'a': 0, 'b': 1, 'names': ['0', '1'], 'state': 'contact', 'point': [1.0, 0.0]}]
+        """
+        def name(i: int) -> str:
+            return str(i) if names is None else str(names[i])
+
+        pairs = []
+        for k, (i, j) in enumerate(self.pairs.tolist()):
+            point = self.relation(k).point
+            pairs.append({"a": i, "b": j, "names": [name(i), name(j)],
+                          "state": "contact" if self.states[k] == 1 else "penetrating",
+                          "point": None if point is None else [float(v) for v in point]})
+        container = [{"body": i, "name": name(i), "state": "contact" if s == 1 else "outside"}
+                     for i, s in zip(self.container_ids.tolist(),
+                                     self.container_states.tolist())]
+        return {"bodies": len(self.ids), "container": self.container is not None,
+                "contacts": pairs, "container_contacts": container}
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw the bodies (penetrating ones red, those leaving the container orange),
+        the container, the contact points and penetrations; returns the matplotlib Axes.
+
+        See :func:`polycontact.plotting.plot_contacts`.
+        """
+        from .plotting.world import plot_contacts
+
+        return plot_contacts(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -196,7 +263,7 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     of its two bodies' (a maximum of per-body terms), which the kernels take."""
     extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
-    return np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude)
+    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude))
 
 
 def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int) -> Shape:
@@ -229,10 +296,10 @@ class World:
     0
     """
 
-    def __init__(self, container: Any = None) -> None:
+    def __init__(self, container: BodyLike | None = None) -> None:
         # id -> [name, base, position, angle, motion, shape]; base, position and shape
         # are None until asked for (bodies added by add_many are kept as coordinates).
-        self._records: dict[int, list] = {}
+        self._records: dict[int, list[Any]] = {}
         self._shared = False  # a Contacts holds self._xy: copy it before writing in place
         self._next = 0
         cap = 64
@@ -257,7 +324,7 @@ class World:
         self._heads = np.full(64, -1, np.int64)
         self._filled = 0
         self._lvl_count = np.zeros(1024, np.int64)
-        self._nfp_cache: dict = {}
+        self._nfp_cache: dict[Any, Any] = {}
         self._container: Shape | None = None
         if container is not None:
             self._set_container(as_shape(container, "container"))
@@ -272,7 +339,10 @@ class World:
         frame = np.array([[lo[0] - margin, lo[1] - margin], [hi[0] + margin, lo[1] - margin],
                           [hi[0] + margin, hi[1] + margin], [lo[0] - margin, hi[1] + margin]])
         hazards = [[frame, c.exterior[::-1]]] + [[h[::-1]] for h in c.holes]
-        rows, starts, lo_h, nl_h = [], [], [], []
+        rows: list[Any] = []
+        starts: list[int] = []
+        lo_h: list[int] = []
+        nl_h: list[int] = []
         top = 0
         for loops in hazards:
             lo_h.append(len(starts))
@@ -325,7 +395,7 @@ class World:
             rec[2] = rec[1].centroid.copy()
         return WorldBody(int(id), rec[0], rec[5], rec[1], rec[2], rec[3], rec[4])
 
-    def add(self, shape: Any, position: Any = None, angle: float = 0.0, *,
+    def add(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
         """Add a body; returns its id (ids are never reused).
 
@@ -471,7 +541,7 @@ class World:
             loops.append((old_xy[st[0] : st[-1]], st - st[0]))
         self._store_many(ids, loops)
 
-    def _store_many(self, ids: np.ndarray, loops: list) -> None:
+    def _store_many(self, ids: np.ndarray, loops: list[Any]) -> None:
         """Append bodies given as (rows, local loop starts), and set boxes and tolerances."""
         if not loops:
             return
@@ -560,11 +630,11 @@ class World:
             )
         return tol
 
-    def _grid(self) -> tuple:
+    def _grid(self) -> tuple[Any, ...]:
         return (self._keys, self._heads, self._nxt, self._level, self._lvl_count,
                 self._levels(), self._origin if self._origin is not None else np.zeros(2))
 
-    def _hazards(self) -> tuple:
+    def _hazards(self) -> tuple[Any, ...]:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
 
     # -- queries ---------------------------------------------------------------------
@@ -609,9 +679,9 @@ class World:
         self._shared = True
         store = (self._xy, self._ls, self._lo.copy(), self._nl.copy())
         return Contacts(pairs, states, used, c_ids, c_states, store,
-                        None if tolerance is None else tol)
+                        None if tolerance is None else tol, alive, self._container)
 
-    def query(self, shape: Any, position: Any = None, angle: float = 0.0, *,
+    def query(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
         """How ``shape``, placed like :meth:`add` would place it, lies among the bodies.
 
@@ -640,7 +710,7 @@ class World:
             cstate = int(k.query_container(qxy, qs, qeps, tol, *self._hazards()))
         return Query(ids, states, cstate, placed)
 
-    def query_many(self, shape: Any, positions: Any, angles: Any = 0.0, *,
+    def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
                    tolerance: float | None = None) -> np.ndarray:
         """Worst state over every body and the container (outside counts as 2) of
         ``shape`` placed at each of P poses, in one compiled call.
@@ -680,12 +750,13 @@ class World:
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
                                             np.zeros(4), 0.0)
-        return _k().query_many(
+        states: np.ndarray = _k().query_many(
             sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
             RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
             self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
             *hz, self._hmax if has_c else 0, scan, _chunks(len(pos)),
         )
+        return states
 
     # -- moving bodies ---------------------------------------------------------------
     def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:
@@ -729,7 +800,7 @@ class World:
         bodies = [self.body(k) for k in ids]
         return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
 
-    def feasible_region(self, shape: Any, angle: float = 0.0) -> Any:
+    def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
         the container and penetrates no body: the container's inner-fit polygon minus
         the union of the bodies' no-fit polygons, with exact fits and slides kept.
@@ -787,12 +858,12 @@ class World:
                                                   np.concatenate(slides) if len(s)]
         lines += [g for g in shapely.get_parts(ifp) if g.geom_type == "LineString"]
         cand = shapely.union_all(lines).intersection(ifp).difference(free)
-        segs = []
+        segs: Any = []
         for g in shapely.get_parts(cand):
             if g.geom_type == "LineString":
                 xy = np.asarray(g.coords)
                 segs.extend(np.stack([xy[:-1], xy[1:]], axis=1))
-        pts = [np.asarray(g.coords)[0] for g in shapely.get_parts(ifp)
+        pts: Any = [np.asarray(g.coords)[0] for g in shapely.get_parts(ifp)
                if g.geom_type == "Point"]
         pts += list(fits) + [s[0] for s in segs] + [s[1] for s in segs]
         keep = [free] if not free.is_empty else []

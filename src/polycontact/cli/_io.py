@@ -1,11 +1,11 @@
-"""Reading shapes for the command line: JSON body, GeoJSON or WKT files."""
+"""Reading shapes for the command line: JSON body, GeoJSON, WKT or WKB files."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from pathlib import Path
 
+from ..bodies import as_shape
 from ..errors import InvalidShapeError, PolycontactError
 from ..shape import Shape
 
@@ -17,34 +17,25 @@ class CommandError(PolycontactError):
 def read_shape(path: str, *, repair: bool = False) -> Shape:
     """Read one shape from ``path``.
 
-    Accepted: a JSON body ``{"vertices": [[x, y], ...], "holes": [...]}``, a GeoJSON
-    Polygon/Feature, or WKT text (``POLYGON ((...))``). Any problem is raised as a
+    Accepted: every text or binary form of :func:`polycontact.bodies.as_shape`: a JSON
+    body ``{"vertices": [[x, y], ...], "holes": [...]}``, a GeoJSON Polygon/Feature, WKT
+    text (``POLYGON ((...))``) or WKB (binary or hex). Any problem is raised as a
     :class:`CommandError` whose message starts with the file name.
     """
     try:
-        text = Path(path).read_text()
+        raw = Path(path).read_bytes()
     except OSError as exc:
         raise CommandError(f"{path}: cannot read ({exc.strerror})") from None
+    data: str | bytes = raw  # binary WKB starts with its byte-order byte, 0 or 1
+    if raw[:1] not in (b"\x00", b"\x01"):
+        try:
+            data = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            pass
     try:
-        stripped = text.lstrip()
-        if stripped.startswith("{"):
-            try:
-                data = json.loads(text)
-            except json.JSONDecodeError as exc:
-                raise CommandError(f"{path}: not valid JSON ({exc})") from None
-            if "vertices" in data:
-                unknown = set(data) - {"vertices", "holes", "name"}
-                if unknown:
-                    raise CommandError(f"{path}: unknown key {sorted(unknown)[0]!r}")
-                return Shape(data["vertices"], data.get("holes", ()), repair=repair)
-            if "type" in data:
-                return Shape.from_geojson(data, repair=repair)
-            raise CommandError(
-                f"{path}: expected a body with 'vertices' or a GeoJSON Polygon"
-            )
-        return Shape.from_wkt(text, repair=repair)
+        return as_shape(data, str(path), repair=repair)
     except (InvalidShapeError, TypeError) as exc:  # TypeError: coordinates not numbers
-        raise CommandError(f"{path}: {exc}") from None
+        raise CommandError(str(exc)) from None
 
 
 def integer_at_least(minimum: int) -> Callable[[str], int]:

@@ -32,27 +32,8 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def relation_report(relation: Any) -> dict:
-    """The relation as a JSON-ready dict (the object printed by ``--json``)."""
-    features = []
-    for f in relation.features:
-        item = {"body": f.body, "loop": f.loop, "vertex": f.vertex,
-                "other_loop": f.other_loop, "edge": f.edge, "kind": f.kind}
-        if f.own_edge is not None:
-            item["own_edge"] = f.own_edge
-        features.append(item)
-    return {
-        "state": relation.state.value,
-        "distance": float(relation.distance),
-        "features": features,
-        "point": None if relation.point is None else [float(v) for v in relation.point],
-        "normal": None if relation.normal is None else [float(v) for v in relation.normal],
-        "tolerance": float(relation.tolerance),
-    }
-
-
-def relation_text(rep: dict) -> list[str]:
-    """The relation as lines of text."""
+def relation_text(rep: dict[str, Any]) -> list[str]:
+    """The relation as lines of text (``rep`` is :meth:`Relation.to_dict`)."""
     lines = [f"state: {rep['state']}", f"distance: {rep['distance']:.12g}",
              "features:" if rep["features"] else "features: none"]
     for f in rep["features"]:
@@ -80,6 +61,6 @@ def run(args: argparse.Namespace) -> int:
     for path, shape in ((args.a, a), (args.b, b)):
         for note in shape.repairs:
             print(f"polycontact classify: repaired {path}: {note}", file=sys.stderr)
-    rep = relation_report(classify(a, b, tolerance=args.tolerance))
+    rep = classify(a, b, tolerance=args.tolerance).to_dict()
     print(json.dumps(rep) if args.json else "\n".join(relation_text(rep)))
     return 0

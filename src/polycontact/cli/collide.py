@@ -36,44 +36,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _features(impact: Any, name_a: str, name_b: str) -> list[dict]:
-    names = {"a": (name_a, name_b), "b": (name_b, name_a)}
-    out = []
-    for f in impact.features:
-        body, other = names[f.body]
-        item = {"body": body, "vertex": f.vertex, "loop": f.loop, "other_body": other,
-                "edge": f.edge, "other_loop": f.other_loop, "kind": f.kind}
-        if f.own_edge is not None:
-            item["own_edge"] = f.own_edge
-        out.append(item)
-    return out
-
-
-def _as_list(x: Any) -> list[float] | None:
-    return None if x is None else [float(v) for v in x]
-
-
-def report(body_a: Any, body_b: Any, impact: Any) -> dict:
-    """The JSON object printed by ``--json``."""
-    return {
-        "collides": impact.collides,
-        "time": impact.time,
-        "first_contact": impact.first_contact,
-        "state": None if impact.state is None else impact.state.value,
-        "features": _features(impact, body_a.name, body_b.name),
-        "point": _as_list(impact.point),
-        "normal": _as_list(impact.normal),
-        "method": impact.method,
-        "broad_phase": [list(iv) for iv in impact.broad_phase],
-        "status": impact.status.value,
-        "pair": [body_a.name, body_b.name],
-        "time_bracket": None if impact.time_bracket is None else list(impact.time_bracket),
-        "time_tolerance": impact.time_tolerance,
-        "iterations": impact.iterations,
-    }
-
-
-def _text(rep: dict) -> str:
+def _text(rep: dict[str, Any]) -> str:
     a, b = rep["pair"]
     lines = [f"pair: {a} and {b} ({rep['method']} method)"]
     lines.append("broad phase: " + (", ".join(f"[{s:.6g}, {e:.6g}]" for s, e in
@@ -114,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
                "samples": args.samples}
     if args.all:
         events = scene.impacts(**options)
-        reps = [report(a, b, imp) for a, b, imp in events]
+        reps = [imp.to_dict((a.name, b.name)) for a, b, imp in events]
         if args.json:
             print(json.dumps({"events": reps}))
         else:
@@ -127,18 +90,17 @@ def run(args: argparse.Namespace) -> int:
         body_a, body_b, impact = events[0]
     else:
         body_a, body_b, impact = scene.first_impact(**options)
-        rep = report(body_a, body_b, impact)
+        rep = impact.to_dict((body_a.name, body_b.name))
         print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..plotting.impact import plot_impact
-
-        ax = plot_impact(body_a.shape, body_a.motion, body_b.shape, body_b.motion, impact,
-                         names=(body_a.name, body_b.name))
+        ax = impact.plot(names=(body_a.name, body_b.name))
         try:
             ax.figure.savefig(args.plot, dpi=120, bbox_inches="tight")
         except OSError as exc:
             raise CommandError(f"{args.plot}: cannot write ({exc.strerror})") from None
+        except ValueError as exc:  # an image format matplotlib does not know
+            raise CommandError(f"{args.plot}: cannot write the plot ({exc})") from None
     return 0

@@ -9,7 +9,7 @@ import sys
 from typing import Any
 
 from ._io import CommandError, read_shape
-from .classify import relation_report, relation_text
+from .classify import relation_text
 
 _FAMILIES = (("A2-B0", "E(A(2), B(0))"), ("A0-B2", "E(A(0), B(2))"), ("A1-B1", "E(A(1), B(1))"))
 
@@ -47,19 +47,7 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def report(block: Any) -> dict:
-    """The JSON object printed by ``--json``."""
-    return {
-        "method": block.method,
-        "reference": [float(v) for v in block.reference],
-        "components": {key: len(block.of_family(key)) for key, _ in _FAMILIES},
-        "zero_width_components": sum(c.is_degenerate for c in block.components),
-        "area": float(block.area),
-        "relation": relation_report(block.classify(block.reference)),
-    }
-
-
-def _text(rep: dict, a: str, b: str) -> str:
+def _text(rep: dict[str, Any], a: str, b: str) -> str:
     x, y = rep["reference"]
     counts = rep["components"]
     lines = [
@@ -83,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
         for note in shape.repairs:
             print(f"polycontact entrance-block: repaired {path}: {note}", file=sys.stderr)
     block = entrance_block(a, b, args.reference, method=args.method)
-    rep = report(block)
+    rep = block.to_dict()
     print(json.dumps(rep) if args.json else _text(rep, args.a, args.b))
     if args.plot:
         import matplotlib
@@ -96,4 +84,6 @@ def run(args: argparse.Namespace) -> int:
             fig.savefig(args.plot, dpi=110, bbox_inches="tight")
         except OSError as exc:
             raise CommandError(f"{args.plot}: cannot write ({exc.strerror})") from None
+        except ValueError as exc:  # an image format matplotlib does not know
+            raise CommandError(f"{args.plot}: cannot write the plot ({exc})") from None
     return 0

@@ -72,19 +72,10 @@ def run(args: argparse.Namespace) -> int:
             print(geom.wkt)
         return 0
     nfp = pc.no_fit_polygon(a, b, args.reference, tolerance=args.tolerance)
-    fits = nfp.exact_fits.tolist()
-    slides = nfp.slides.tolist()
-    holes = sum(len(g.interiors) for g in shapely.get_parts(nfp.region))
+    rep = nfp.to_dict()
+    fits, slides, holes = rep["exact_fits"], rep["slides"], rep["holes"]
     if args.json:
-        print(json.dumps({
-            "reference": nfp.reference.tolist(),
-            "region": json.loads(shapely.to_geojson(nfp.region)),
-            "area": nfp.region.area,
-            "holes": holes,
-            "exact_fits": fits,
-            "slides": slides,
-            "tolerance": nfp.tolerance,
-        }))
+        print(json.dumps(rep))
     elif args.wkt:
         print(nfp.region.wkt)
         if fits:
@@ -106,9 +97,7 @@ def run(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..plotting.nfp import plot_nfp
-
-        ax = plot_nfp(nfp)
+        ax = nfp.plot()
         try:
             ax.figure.savefig(args.plot, dpi=120)
         except (OSError, ValueError) as exc:

@@ -4,6 +4,12 @@
   components and the reference point (like the paper's Fig. 5).
 - :func:`plot_impact`: both bodies at t = 0 and at the impact, centroid paths, contact.
 - :func:`plot_nfp`: B, A at one placement, the no-fit polygon with holes and exact fits.
+- :func:`plot_relation`: two bodies where they stand, the witness point and the normal.
+- :func:`plot_contacts`: the bodies of a World, its contacts and penetrations.
+
+Every result draws itself too: ``.plot(ax=None)`` on :class:`~polycontact.Relation`,
+:class:`~polycontact.Impact`, :class:`~polycontact.EntranceBlock`,
+:class:`~polycontact.NoFitPolygon` and :class:`~polycontact.Contacts` returns the Axes.
 """
 
 from __future__ import annotations
@@ -15,6 +21,8 @@ _LAZY = {
     "plot_entrance_block": "entrance_block",
     "plot_impact": "impact",
     "plot_nfp": "nfp",
+    "plot_relation": "relation",
+    "plot_contacts": "world",
 }
 __all__ = list(_LAZY)
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._style import LENGTH_LABEL, plural
 
-__all__ = ["plot_entrance_block"]
+__all__ = ["plot_entrance_block", "plot_union"]
 
 #: Colour and title of each family (one term of paper Eq. 1).
 FAMILY_STYLE = {
@@ -66,14 +66,7 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
         n = len(block.of_family(family))
         how = f", {block.method}" if family == "A1-B1" else ""
         ax.set_title(f"{text}\n{plural(n, 'component')}{how}", fontsize=10)
-    ax = axes[3]
-    _bodies(ax, block)
-    _union(ax, block)
-    handles = _reference(ax, block)
-    state = block.classify(block.reference).state.value
-    ax.set_title(f"E(A, B), the union of the three; area {block.area:.6g}\n"
-                 f"A and B at a0: {state}", fontsize=10)
-    handles = _legend_handles(handles)
+    handles = _legend_handles(_union_panel(axes[3], block))
     figure.legend(handles=handles, loc="outside lower center", ncol=3, fontsize=9,
                   frameon=False)
     for ax in axes[2:]:
@@ -85,6 +78,41 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
         ax.grid(True, linewidth=0.3, alpha=0.5)
         ax.autoscale_view()
     return figure
+
+
+def plot_union(block: Any, ax: Any) -> Any:
+    """Draw the union panel alone into ``ax``: B, A, E(A, B) with its outline, a0.
+
+    Returns ``ax`` (with axis labels and a legend outside).
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt, polycontact as pc
+    >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> ax = plot_union(pc.entrance_block(a, a.moved((3, 0))), plt.figure().gca())
+    >>> ax.get_title().splitlines()[1]
+    'A and B at a0: separate'
+    """
+    from ._style import label_axes
+
+    handles = _legend_handles(_union_panel(ax, block))[3:]  # no family in this panel
+    label_axes(ax)
+    ax.grid(True, linewidth=0.3, alpha=0.5)
+    ax.autoscale_view()
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),
+              borderaxespad=0.0, fontsize="small", frameon=False)
+    return ax
+
+
+def _union_panel(ax: Any, block: Any) -> list[Any]:
+    """The last panel: bodies, union and a0; returns the reference point's handles."""
+    _bodies(ax, block)
+    _union(ax, block)
+    handles = _reference(ax, block)
+    state = block.classify(block.reference).state.value
+    ax.set_title(f"E(A, B), the union of the three; area {block.area:.6g}\n"
+                 f"A and B at a0: {state}", fontsize=10)
+    return handles
 
 
 def _bodies(ax: Any, block: Any) -> None:

@@ -8,7 +8,8 @@ import numpy as np
 
 from ..impact import Impact
 from ..motion import Motion
-from ..shape import Shape, as_shape
+from ..bodies import BodyLike, as_shape
+from ..shape import Shape
 from ._style import label_axes, legend_outside
 
 __all__ = ["plot_impact"]
@@ -34,9 +35,9 @@ def _draw(ax: Any, shape: Shape, color: str, alpha: float, label: str | None) ->
 
 
 def plot_impact(
-    a: Any,
+    a: BodyLike,
     motion_a: Motion,
-    b: Any,
+    b: BodyLike,
     motion_b: Motion,
     impact: Impact,
     *,
