@@ -25,7 +25,7 @@ from __future__ import annotations
 from typing import Any, Callable
 
 
-def entry_point(dispatcher: Any, args: tuple) -> Callable[..., Any]:
+def entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., Any]:
     """The compiled code of ``dispatcher`` for the types of ``args``, as a callable.
 
     Compiles (or loads from the cache) that specialisation by one call with ``args`` if
@@ -37,7 +37,7 @@ def entry_point(dispatcher: Any, args: tuple) -> Callable[..., Any]:
     try:
         from numba import typeof
 
-        key = tuple(typeof(x) for x in args)
+        key = tuple(typeof(x) for x in args)  # type: ignore[no-untyped-call]
         found = dispatcher.overloads.get(key)
         if found is None:
             dispatcher(*args)
@@ -45,4 +45,5 @@ def entry_point(dispatcher: Any, args: tuple) -> Callable[..., Any]:
         fast = getattr(found, "entry_point", None)
     except Exception:  # noqa: BLE001 - any change in Numba's internals: the safe way
         fast = None
-    return dispatcher if fast is None else fast
+    chosen: Callable[..., Any] = dispatcher if fast is None else fast
+    return chosen

@@ -520,6 +520,7 @@ def time_of_impact(
     eps_rel = RELATIVE_TOLERANCE * max(a._extent, b._extent)
     la, lb = a.bounding_radius, b.bounding_radius
     sa, ca, sb, cb = a.packed[1], a.centroid, b.packed[1], b.centroid
+    args: tuple[Any, ...]
     if exact:
         args = (ra, sa, ca, ma.array, la, ea, rb, sb, cb, mb.array, lb, eb, t_max,
                 BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb),
@@ -538,22 +539,21 @@ def time_of_impact(
 _ENTRY: dict[str, Any] = {}
 
 
-def _query(method: str, args: tuple, fixed: bool) -> tuple:
+def _query(method: str, args: tuple[Any, ...], fixed: bool) -> tuple[Any, ...]:
     """Run the query kernel of ``method`` on ``args``. ``fixed``: the bodies are Shapes
     and the motions Motions, so every argument has the type it always has (read-only
     shape and motion arrays, the body-frame tables, Python floats and ints) and the
     compiled code is called without the dispatcher's type resolution (see
     :mod:`polycontact._dispatch`); otherwise through the dispatcher."""
-    fast = _ENTRY.get(method if fixed else "")
-    if fast is not None:
-        return fast(*args)
-    from ._kernels import impact as ki
+    run = _ENTRY.get(method) if fixed else None
+    if run is None:
+        from ._kernels import impact as ki
 
-    kernel = ki.exact_query if method == "exact" else ki.sampled_query
-    if not fixed:
-        return kernel(*args)
-    fast = _ENTRY[method] = entry_point(kernel, args)
-    return fast(*args)
+        run = ki.exact_query if method == "exact" else ki.sampled_query
+        if fixed:
+            run = _ENTRY[method] = entry_point(run, args)
+    out: tuple[Any, ...] = run(*args)
+    return out
 
 
 def body_frame(shape: Shape, tables: bool = True,

@@ -12,7 +12,7 @@ positive (the frame convention of :mod:`polycontact.shape`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -59,6 +59,9 @@ class Motion:
     acceleration: tuple[float, float] = (0.0, 0.0)
     angular_velocity: float = 0.0
     angular_acceleration: float = 0.0
+    # derived in __post_init__: the kernel vector and |v|, |a|, |ω|, |α|
+    _array: np.ndarray = field(init=False, repr=False, compare=False)
+    _norms: tuple[float, float, float, float] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
