@@ -68,10 +68,13 @@ class Body:
 
 
 def oracle_eps(a: Body, b: Body, t: float) -> float:
-    """The distance tolerance at t: max(1e-12 · extent, 64 ulps of the largest |coordinate|)."""
-    xa, xb = a.at(t), b.at(t)
+    """The distance tolerance at t: max(1e-12 · extent, 64 ulps of the magnitude M of the
+    coordinates' terms), M = max over bodies and axes of |c0| + |v| t + |a| t²/2 plus
+    the body's size: a coordinate computed as c0 + v t is known to the float spacing of
+    its largest term, not of its (maybe much smaller) value."""
     extent = max(np.ptp(a.at(0.0), axis=0).max(), np.ptp(b.at(0.0), axis=0).max())
-    mag = max(np.abs(xa).max(), np.abs(xb).max())
+    mag = max(np.max(np.abs(body.c0) + np.abs(body.v) * t) + np.abs(body.r).max()
+              for body in (a, b))
     return max(1e-12 * extent, 64 * ULP * mag)
 
 
@@ -161,6 +164,20 @@ def test_translation_matches_the_oracle(case):
     assume(not deep(a, b, 0.0) and deep(a, b, t_c))
     t_deep = bisect_first(lambda t: deep(a, b, t), 0.0, t_c)
     check_contract(a, b, t_c * stretch + 1.0 / a.v.dot(a.v) ** 0.5, t_deep, tol)
+
+
+def test_tolerance_follows_the_terms_of_a_position_not_the_position():
+    # Bodies that start near 4.6e8 and meet near the origin (t ~ 4.6e8): their
+    # coordinates there are small, but c0 + v t is known only to the spacing of its
+    # terms (6e-8), far above 64 ulps of the small coordinates (3e-9); the tolerance
+    # followed the coordinates, so the bracket's lower end was already deep for the
+    # oracle (CI seed, both found by test_translation_matches_the_oracle).
+    for case in ((0.3, 463636790.0, 1.0, 463875800.0, 0.0, math.pi, 0.0, 0.25, 0.15),
+                 (7.0, 466981704.0, 1e-06, 466916178.0, 0.0, math.pi, 0.4, 0.25, 3.5)):
+        a, b, t_c = _translation_case(*case)
+        t_deep = bisect_first(lambda t: deep(a, b, t), 0.0, t_c)
+        stretch = 1.0 if case[2] == 1.0 else 1000.0
+        check_contract(a, b, t_c * stretch + 1.0 / a.v.dot(a.v) ** 0.5, t_deep, 1e-300)
 
 
 # -- spin with angular acceleration -----------------------------------------------------

@@ -34,6 +34,28 @@ STATUS_CODES = {ImpactStatus.NO_HIT: 0, ImpactStatus.HIT: 1,
 BUDGET = 20_000
 
 
+def agree(x, y) -> bool:
+    """Two answers to one pair agree: the same status and state, and the times within
+    the time tolerance. The batch runs the pairwise kernel compiled inside its own loop;
+    the machine code can round differently in a last place, and one last bit can take a
+    search down another, equally valid path (seen after a tolerance change: times
+    8e-13 apart under a tolerance of 1e-4). Most answers are equal bit for bit."""
+    if x == y:
+        return True
+    tol = max(x.time_tolerance, y.time_tolerance)
+
+    def close(u, v):
+        return (u is None and v is None) or (u is not None and v is not None
+                                             and abs(u - v) <= tol)
+
+    return (x.status is y.status and x.state is y.state and x.collides == y.collides
+            and close(x.time, y.time) and close(x.first_contact, y.first_contact))
+
+
+def same_events(got: dict, want: dict) -> bool:
+    return got.keys() == want.keys() and all(agree(got[k], want[k]) for k in want)
+
+
 def brute(shapes, motions, t_max, **kw):
     """Every pair that meets, by the pairwise call: {(i, j): Impact}."""
     out = {}
@@ -119,14 +141,15 @@ def test_time_of_impact_many_equals_time_of_impact_per_pair(scene, method):
         want = pc.time_of_impact(a[k], ma[k], b[k], mb[k], t_max=t_max, method=method,
                                  max_iterations=BUDGET)
         got = batch.impact(k)
-        assert got == want
-        assert got.features == want.features
+        assert agree(got, want)
+        if got == want:
+            assert got.features == want.features
         assert STATUS_CODES[want.status] == int(batch.status[k])
         assert bool(batch.collides[k]) == want.collides
-        assert (math.isnan(batch.times[k]) if want.time is None
-                else batch.times[k] == want.time)
-        assert (math.isnan(batch.first_contacts[k]) if want.first_contact is None
-                else batch.first_contacts[k] == want.first_contact)
+        assert (math.isnan(batch.times[k]) if got.time is None
+                else batch.times[k] == got.time)
+        assert (math.isnan(batch.first_contacts[k]) if got.first_contact is None
+                else batch.first_contacts[k] == got.first_contact)
 
 
 def test_time_of_impact_many_threads_give_the_same_answers():
@@ -205,7 +228,7 @@ def test_first_impacts_equals_brute_force_over_all_pairs(scene, method):
     bodies, moves, t_max = scene
     want = brute(bodies, moves, t_max, max_iterations=BUDGET, method=method)
     events = first_impacts(bodies, moves, t_max, max_iterations=BUDGET, method=method)
-    assert {(e.i, e.j): e.impact for e in events} == want
+    assert same_events({(e.i, e.j): e.impact for e in events}, want)
     keys = [(event_time(e.impact), e.i, e.j) for e in events]
     assert keys == sorted(keys)
     if method == "sampled":
@@ -218,7 +241,7 @@ def test_first_impacts_equals_brute_force_over_all_pairs(scene, method):
     scene_obj = pc.Scene(tuple(pc.Body(str(k), s, m) for k, (s, m) in
                                enumerate(zip(bodies, moves))), t_max)
     a, b, imp = _scene_first(scene_obj)
-    assert (first.i, first.j) == (int(a.name), int(b.name)) and first.impact == imp
+    assert (first.i, first.j) == (int(a.name), int(b.name)) and agree(first.impact, imp)
 
 
 def _scene_first(scene_obj):
@@ -405,7 +428,7 @@ def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset)
                             angular_velocity=rng.uniform(-1, 1)))
     want = brute(shapes, moves, 1.5, max_iterations=BUDGET)
     events = first_impacts(shapes, moves, 1.5, max_iterations=BUDGET)
-    assert {(e.i, e.j): e.impact for e in events} == want
+    assert same_events({(e.i, e.j): e.impact for e in events}, want)
     assert any(e.impact.collides for e in events)
 
 
@@ -440,4 +463,4 @@ def test_defects3_to_6_batched_answers_equal_the_pairwise_ones(case):
     # with a bystander far off the path: the one event is the pair's
     away = SQ.moved((-50, 1e3))
     events = first_impacts([a, b, away], [ma, mb, Motion()], t_max, time_tolerance=tol)
-    assert [(e.i, e.j) for e in events] == [(0, 1)] and events[0].impact == want
+    assert [(e.i, e.j) for e in events] == [(0, 1)] and agree(events[0].impact, want)

@@ -27,8 +27,16 @@ def _brute(world: pc.World, t_max: float) -> list:
     return out
 
 
-def _key(events: list) -> list:
-    return sorted((i, j, imp.status.value, imp.time, imp.first_contact) for i, j, imp in events)
+def _same(got: list, want: list) -> bool:
+    """The same pairs and statuses, times within the time tolerance (the batch kernel
+    may round a last place differently: see test_impacts_many.agree)."""
+    g = {(i, j): imp for i, j, imp in got}
+    w = {(i, j): imp for i, j, imp in want}
+    return g.keys() == w.keys() and all(
+        g[k].status is w[k].status and g[k].state is w[k].state
+        and (g[k].time is None) == (w[k].time is None)
+        and (g[k].time is None or abs(g[k].time - w[k].time) <= w[k].time_tolerance)
+        for k in w)
 
 
 @examples(15)
@@ -47,7 +55,7 @@ def test_world_first_impacts_equal_the_pairwise_loop(spec, removed):
             w.remove(k)
     got = w.first_impacts(3.0)
     want = _brute(w, 3.0)
-    assert _key(got) == _key(want)
+    assert _same(got, want)
     first = w.first_impact(3.0)
     if not want:
         assert first is None

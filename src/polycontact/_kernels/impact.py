@@ -66,15 +66,16 @@ def effective_time_tolerance(time_tol, t):
 
 @njit(cache=True, nogil=True)
 def _reach(c0, m, radius, t0, t1):
-    """An upper bound of every |coordinate| of a body over [t0, t1]: its centroid's
-    largest |component| at either end plus the sag of the parabola (|a| h²/8), plus its
-    bounding radius."""
-    h = t1 - t0
+    """An upper bound of the magnitudes that make a body's coordinates over [t0, t1]:
+    for each component the largest |term| sum |c0| + |v| t + |a| t²/2 (t the larger of
+    |t0|, |t1|), plus its bounding radius. It bounds every |coordinate|, and also the
+    rounding of computing one: a body far from the origin that passes near it has small
+    coordinates there, known only to the float spacing of its terms (regression test
+    test_impact_oracle::test_tolerance_follows_the_terms_of_a_position_not_the_position)."""
+    tt = max(abs(t0), abs(t1))
     out = 0.0
     for k in range(2):
-        x0 = c0[k] + m[k] * t0 + 0.5 * m[2 + k] * t0 * t0
-        x1 = c0[k] + m[k] * t1 + 0.5 * m[2 + k] * t1 * t1
-        out = max(out, max(abs(x0), abs(x1)) + 0.125 * abs(m[2 + k]) * h * h)
+        out = max(out, abs(c0[k]) + abs(m[k]) * tt + 0.5 * abs(m[2 + k]) * tt * tt)
     return out + radius
 
 
