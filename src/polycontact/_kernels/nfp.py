@@ -71,9 +71,10 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
                 c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
                     bxy[pn, 1] - bxy[pi, 1]
                 ) * (rxy[qn, 0] - rxy[qj, 0])
-                if c >= 0.0:
+                # (a NaN turn, from non-finite input, advances both: the loop always ends)
+                if not c < 0.0:
                     i += 1
-                if c <= 0.0:
+                if not c > 0.0:
                     j += 1
             k += 1
             starts[k] = w
@@ -616,9 +617,14 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     (R, 2); candidate exact fits then candidate slides as segments (C, 4), an exact
     fit as a zero-length segment; ``meta`` =
     ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
-    did not link into rings (the caller then unions the sums another way).
+    did not link into rings (the caller then unions the sums another way), -1 when the
+    sums are not finite (input beyond float64: the caller refuses it).
     """
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
+    if not np.isfinite(sums).all():
+        # error code, not a crash: the caller refuses the input
+        meta = np.array([1.0, -1.0, 0.0])
+        return sums[:0], np.zeros(1, np.int64), np.empty((0, 2)), np.empty((0, 4)), meta
     if eps <= 0.0:
         eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])
