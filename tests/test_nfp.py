@@ -421,9 +421,20 @@ def test_defect7_huge_squares_are_refused_not_a_segfault(side):
             pc.inner_fit_polygon(sq, 3 * sq)
 
 
-def test_defect7_huge_reference_point_is_refused():
+@pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
+def test_defect7_reference_too_far_for_the_region_is_refused(far):
+    # Before: an empty region (the unit squares' sums vanish in the rounding at 1e17 and
+    # beyond), silently wrong.
     with pytest.raises(pc.InvalidShapeError, match="reference"):
-        pc.no_fit_polygon(SQ, SQ, reference=(1e150, 0.0))
+        pc.no_fit_polygon(SQ, SQ, reference=(far, 0.0))
+    with pytest.raises(pc.InvalidShapeError, match="reference"):
+        pc.inner_fit_polygon(SQ, np.array(SQ) * 3, reference=(0.0, -far))
+
+
+def test_far_reference_that_float64_resolves_is_answered():
+    # at 1e9 the rounding (1.4e-5) is far below the unit bodies: the region is exact
+    nfp = pc.no_fit_polygon(SQ, SQ, reference=(1e9, 0.0))
+    assert nfp.region.area == pytest.approx(4.0, rel=1e-4)
 
 
 def test_defect7_nfp_kernel_reports_non_finite_sums_instead_of_crashing():

@@ -46,7 +46,7 @@ from ._checks import finite_number
 from ._checks import point as point_arg
 from .errors import InvalidShapeError
 from .shape import Shape, as_shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid, tolerance_for
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
 
@@ -195,7 +195,7 @@ def no_fit_polygon(
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
-    a0 = _reference(a, reference)
+    a0 = _reference(a, reference, b)
     bxy, bst = _convex_pieces(b)
     axy, ast = _convex_pieces(a)
     r = a0 - axy
@@ -241,7 +241,7 @@ def inner_fit_polygon(
     """
     a = as_shape(a, "a")
     c = as_shape(container, "container")
-    a0 = _reference(a, reference)
+    a0 = _reference(a, reference, c)
     axy, ast = _convex_pieces(a)
     r = a0 - axy
     span = float(np.max(np.ptp(a.exterior, axis=0)))
@@ -274,17 +274,36 @@ def inner_fit_polygon(
 # -- helpers -----------------------------------------------------------------------------
 
 
-def _reference(a: Shape, reference: Any) -> np.ndarray:
+def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
+    """A's reference point, refused when the region around it cannot be represented.
+
+    The region's coordinates reach about ``|a0| + |A| + |B|``; if the default tolerance
+    there (:func:`polycontact.tolerances.tolerance_for`) is as large as the smaller body,
+    float64 cannot tell the region's features apart (a unit square with its reference
+    at 1e100 had an empty region): the reference is refused, never answered wrongly.
+    """
     if reference is None or (isinstance(reference, str) and reference == "centroid"):
         return np.array(a.centroid, dtype=np.float64)
     if isinstance(reference, str):
         if reference == "origin":
-            return np.zeros(2)
+            a0 = np.zeros(2)
+        else:
+            raise InvalidShapeError(
+                f"reference: expected 'centroid', 'origin' or a point (x, y), "
+                f"got {reference!r}"
+            )
+    else:
+        a0 = point_arg(reference, "reference", error=InvalidShapeError)
+        check_range(a0.reshape(1, 2), "reference")
+    xa, xb = a.packed[0], b.packed[0]
+    reach = float(np.abs(a0).max() + np.abs(xa).max() + np.abs(xb).max())
+    size = min(float(np.ptp(xa, axis=0).max()), float(np.ptp(xb, axis=0).max()))
+    if tolerance_for(0.0, reach) >= size:
         raise InvalidShapeError(
-            f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
+            f"reference ({a0[0]:g}, {a0[1]:g}): the region's coordinates reach {reach:g}, "
+            f"where float64's rounding tolerance {tolerance_for(0.0, reach):g} is not "
+            f"below the bodies' size {size:g}; choose a reference nearer the bodies"
         )
-    a0 = point_arg(reference, "reference", error=InvalidShapeError)
-    check_range(a0.reshape(1, 2), "reference")
     return a0
 
 
