@@ -421,6 +421,15 @@ def test_defect7_huge_squares_are_refused_not_a_segfault(side):
             pc.inner_fit_polygon(sq, 3 * sq)
 
 
+@pytest.mark.parametrize("side", [1e105, 1e154])
+def test_defect7_huge_squares_time_of_impact_is_refused_not_no_hit(side):
+    # Before: "no hit" where there is one (the same squares as the NFP crash above).
+    sq = np.array(SQ, dtype=float) * side
+    with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
+        pc.time_of_impact(sq, pc.Motion(velocity=(side, 0.0)), sq + [3.0 * side, 0.0],
+                          pc.Motion(), t_max=5.0)
+
+
 @pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
 def test_defect7_reference_too_far_for_the_region_is_refused(far):
     # Before: an empty region (the unit squares' sums vanish in the rounding at 1e17 and

@@ -185,6 +185,18 @@ def no_fit_polygon(
     -------
     NoFitPolygon
 
+    Notes
+    -----
+    Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
+    decomposition (ear clipping up to 64 vertices, GEOS's constrained triangulation
+    beyond, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
+    vertices in all, each sum in linear time, then every sum edge clipped by the sums
+    whose boxes reach it (found by a scan of the boxes sorted by their smallest x, O(k)
+    per edge at worst; the sum that covered the previous edge is tried first). When A is
+    convex or small (k_A = O(1)) and each sum meets few others, that is near
+    O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
+    follows that product (figures: ``benchmarks/bench_scaling.py``).
+
     Examples
     --------
     >>> import polycontact as pc
