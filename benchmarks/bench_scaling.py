@@ -111,6 +111,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--max", type=int, default=SIZES[-1], help="largest size measured")
     ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per row")
+    ap.add_argument("--case", action="append", help="only this case (repeatable)")
     ap.add_argument("--row", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.row:
@@ -120,7 +121,7 @@ def main() -> None:
              "nfp, star x square", "nfp, circle x circle"]
     print(f"{'case':24} {'vertices':>9} {'median s':>10} {'min..max s':>17} {'peak MB':>8}"
           f" {'shapely s':>10}")
-    for case in cases:
+    for case in args.case or cases:
         for n in SIZES:
             if n > args.max or (case == "depth, stars deep" and n > 1000):
                 continue
@@ -130,6 +131,10 @@ def main() -> None:
                                      timeout=args.timeout)
             except subprocess.TimeoutExpired:
                 print(f"{case:24} {n:9d} {'> ' + str(int(args.timeout)):>10}", flush=True)
+                continue
+            except subprocess.CalledProcessError as err:
+                why = "killed (memory?)" if err.returncode < 0 else f"failed ({err.returncode})"
+                print(f"{case:24} {n:9d} {why:>28}", flush=True)
                 continue
             row = json.loads(run.stdout.strip().splitlines()[-1])
             spread = f"{row['min']:.3f}..{row['max']:.3f}"

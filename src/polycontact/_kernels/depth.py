@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..errors import PolycontactError
 from .nfp import _bboxes, _clip, _compact, _frames, _lowest, _subtract
 from .relation import PENETRATING, _state
 
@@ -58,8 +59,9 @@ def _in_disk(ax, ay, bx, by, r):
 
 
 @njit(cache=True, nogil=True)
-def _select_pairs(bb_b, bb_r, bound):
-    """Pairs (i, j) of pieces whose sum's bounding box meets [-bound, bound]^2.
+def _select_pairs(bb_b, bb_r, bound, bstarts, rstarts, max_vertices):
+    """Pairs (i, j) of pieces whose sum's bounding box meets [-bound, bound]^2; the one
+    row (-1, -1) when their sums would hold more than ``max_vertices`` vertices.
 
     Pieces of B sorted by their smallest x; for each piece j of R, the pieces i with
     ``x0_i <= bound - x0_j`` and ``x0_i >= -bound - x1_j - w`` (w: widest piece of B) are
@@ -75,6 +77,7 @@ def _select_pairs(bb_b, bb_r, bound):
     cap = 16 + nb + nr
     out = np.empty((cap, 2), np.int64)
     n = 0
+    total = 0
     for j in range(nr):
         lo = -bound - bb_r[j, 2]
         hi = bound - bb_r[j, 0]
@@ -93,6 +96,9 @@ def _select_pairs(bb_b, bb_r, bound):
             out[n, 0] = i
             out[n, 1] = j
             n += 1
+            total += bstarts[i + 1] - bstarts[i] + rstarts[j + 1] - rstarts[j]
+            if total > max_vertices:
+                return np.full((1, 2), -1, np.int64)
     return out[:n]
 
 
@@ -192,13 +198,15 @@ def _escapes(xa, sa, xb, sb, dx, dy, eps):
 
 
 @njit(cache=True, nogil=True)
-def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps):
+def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
+                      max_vertices):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
     bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
     ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap.
-    Returns ``(bound, bdx, bdy)`` when nothing nearer ends it.
+    Returns ``(bound, bdx, bdy)`` when nothing nearer ends it, NaNs when the sums would
+    hold more than ``max_vertices`` vertices (none is built).
 
     Cost: with P pairs of pieces whose sums' boxes meet the disk of radius ``bound`` and
     K edges of those sums nearer than the depth, O((p + q) log(p + q) + P + K log K)
@@ -207,7 +215,10 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
     """
     best = bound
-    pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound)
+    pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound,
+                          bstarts, rstarts, max_vertices)
+    if pairs.shape[0] == 1 and pairs[0, 0] < 0:
+        return np.nan, np.nan, np.nan
     if pairs.shape[0] == 0:
         return best, bdx, bdy
     xy, starts = _pair_sums(bxy, bstarts, rxy, rstarts, pairs)
@@ -357,10 +368,15 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     :func:`depth_from_pieces` looks for a nearer one on the union of the convex sums of
     the pieces of B and −A (decomposed in O(n log n), cached by coordinates).
 
-    Cost: O((m + n) log(m + n)) when the depth is small next to the pieces (few sums
-    reach the disk of the first escape, few of their edges are nearer than the depth);
-    at worst, two deeply interlocked concave bodies, O(P + K log K + K P) for the P
-    sums of pieces that reach the disk and their K edges (P up to about m n / 4).
+    Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
+    pieces whose sums reach the disk of the first escape and their K edges, plus the
+    clipping of each edge nearer than the depth (usually by one sum; by up to P when it
+    is uncovered) and one state check, O((m + n) log(m + n)), per uncovered part nearer
+    than the best escape so far. When one body is small or convex, P = O(m + n) and the
+    whole is near O((m + n) log(m + n)). Two large concave bodies whose pieces are long
+    (stars) make P grow with the product of their piece counts even for a shallow
+    overlap, up to about m n / 4 for deeply interlocked ones: O(P + K P) at worst
+    (figures: ``benchmarks/bench_scaling.py``).
 
     Examples
     --------
@@ -382,4 +398,22 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
             bound, bdx, bdy = float(m), mx * float(m), my * float(m)
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
-    return depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, bound, bdx, bdy, eps)
+    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, bound, bdx, bdy, eps,
+                            MAX_SUM_VERTICES)
+    if np.isnan(got[0]):
+        raise DepthTooLargeError(
+            f"penetration depth: the convex sums of the pieces near the overlap would hold "
+            f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({len(xa)} and "
+            f"{len(xb)} vertices) are too large and interlocked for this depth"
+        )
+    return got
+
+
+#: Most vertices of convex sums the depth builds (about 80 bytes each with their frames
+#: and sort keys: 2.4 GB). Beyond, the depth is refused with an error, not killed by
+#: the system for want of memory.
+MAX_SUM_VERTICES = 30_000_000
+
+
+class DepthTooLargeError(PolycontactError, MemoryError):
+    """The penetration depth of these bodies would need more memory than allowed."""

@@ -303,6 +303,10 @@ def edge_cover(xy, starts, bb, fr, eps):
     nl = 0
     hint = -1
     by_x = np.argsort(bb[:, 0])
+    xs = bb[by_x, 0]
+    wmax = 0.0
+    for q in range(k):
+        wmax = max(wmax, bb[q, 2] - bb[q, 0])
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
@@ -323,12 +327,14 @@ def edge_cover(xy, starts, bb, fr, eps):
             lo0[0] = 0.0
             hi0[0] = 1.0
             # The sum that swallowed the previous edge whole is tried first: an edge
-            # inside the union is then usually done after one test.
-            for qi in range(-1, k):
-                q = hint if qi < 0 else by_x[qi]
-                if qi >= 0 and bb[q, 0] > x1:
+            # inside the union is then usually done after one test. The others by their
+            # smallest x, from the first that can reach x0 (none is wider than wmax).
+            first = np.searchsorted(xs, x0 - wmax)
+            for qi in range(first - 1, k):
+                q = hint if qi < first else by_x[qi]
+                if qi >= first and bb[q, 0] > x1:
                     break  # sums sorted by their smallest x: none further can meet the edge
-                if q < 0 or (qi >= 0 and q == hint):
+                if q < 0 or (qi >= first and q == hint):
                     continue
                 if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
                     continue
