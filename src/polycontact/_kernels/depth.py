@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import PolycontactError
-from .nfp import _bboxes, _clip, _compact, _frames, _lowest, _subtract
+from .nfp import _PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract
 from .relation import PENETRATING, _state
 
 
@@ -149,43 +149,6 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
                 j += 1
         starts[k + 1] = w
     return out[:w].copy(), starts
-
-
-#: Sums remembered per grid cell as containing the whole cell (tried first on an edge).
-_PER_CELL = 4
-
-
-@njit(cache=True, nogil=True)
-def _cell_cover(xy, starts, bb, fr, x0, y0, h, g):
-    """For a g x g grid of cells of side h from (x0, y0): up to ``_PER_CELL`` sums that
-    contain each cell (its four corners inside the closed convex sum), -1 elsewhere."""
-    inside = np.zeros((g + 1, g + 1), np.bool_)
-    cover = np.full((g, g, _PER_CELL), -1, np.int64)
-    cnt = np.zeros((g, g), np.int64)
-    for q in range(starts.shape[0] - 1):
-        i0 = max(0, int(np.ceil((bb[q, 0] - x0) / h)))
-        i1 = min(g, int(np.floor((bb[q, 2] - x0) / h)))
-        j0 = max(0, int(np.ceil((bb[q, 1] - y0) / h)))
-        j1 = min(g, int(np.floor((bb[q, 3] - y0) / h)))
-        if i1 <= i0 or j1 <= j0:
-            continue
-        for i in range(i0, i1 + 1):
-            for j in range(j0, j1 + 1):
-                px = x0 + i * h
-                py = y0 + j * h
-                ok = True
-                for e in range(starts[q], starts[q + 1]):
-                    if fr[e, 3] != 0.0 and fr[e, 0] * py - fr[e, 1] * px - fr[e, 2] < 0.0:
-                        ok = False
-                        break
-                inside[i, j] = ok
-        for i in range(i0, i1):
-            for j in range(j0, j1):
-                if (cnt[i, j] < _PER_CELL and inside[i, j] and inside[i + 1, j]
-                        and inside[i, j + 1] and inside[i + 1, j + 1]):
-                    cover[i, j, cnt[i, j]] = q
-                    cnt[i, j] += 1
-    return cover
 
 
 @njit(cache=True, nogil=True)
