@@ -430,6 +430,17 @@ def test_defect7_huge_squares_time_of_impact_is_refused_not_no_hit(side):
                           pc.Motion(), t_max=5.0)
 
 
+def test_defect7_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
+    # Two large concave bodies make a sum per pair of pieces (1000 x 100 000 vertices:
+    # hundreds of millions of vertices); past its budget the NFP raises a clear error.
+    # The budget is lowered here to reach it with small shapes.
+    monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
+    comb = [(0, 0), (4, 0), (4, 3), (3, 1), (2, 3), (1, 1), (0, 3)]
+    with pytest.raises(nfp_module.NfpTooLargeError, match="memory"):
+        pc.no_fit_polygon(comb, comb)
+    assert issubclass(nfp_module.NfpTooLargeError, (pc.PolycontactError, MemoryError))
+
+
 @pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
 def test_defect7_reference_too_far_for_the_region_is_refused(far):
     # Before: an empty region (the unit squares' sums vanish in the rounding at 1e17 and

@@ -44,7 +44,7 @@ import shapely.affinity
 
 from ._checks import finite_number
 from ._checks import point as point_arg
-from .errors import InvalidShapeError
+from .errors import InvalidShapeError, PolycontactError
 from .shape import Shape, as_shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid, tolerance_for
 
@@ -59,6 +59,17 @@ HOLE_WIDTH_FACTOR = 16.0
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
+
+
+#: Most vertices of convex sums a no-fit polygon builds (about 350 bytes each with the
+#: outline's work arrays: 3.5 GB). Beyond, it is refused with an error, not killed by
+#: the system for want of memory (two large concave bodies make a sum per pair of
+#: their convex pieces).
+MAX_SUM_VERTICES = 10_000_000
+
+
+class NfpTooLargeError(PolycontactError, MemoryError):
+    """The no-fit polygon of these shapes would need more memory than allowed."""
 
 
 #: How many regions GEOS has built since import because the outline parts did not link
@@ -375,6 +386,13 @@ def _entrance(
     should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
     seams and pinholes) are dropped.
     """
+    total = len(bxy) * (len(rst) - 1) + len(rxy) * (len(bst) - 1)
+    if total > MAX_SUM_VERTICES:
+        raise NfpTooLargeError(
+            f"no-fit polygon: the {len(bst) - 1} x {len(rst) - 1} convex sums of the "
+            f"shapes' pieces would hold {total:.3g} vertices, more than "
+            f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
+        )
     kn = _kernels().nfp
     rxy_, rst_, stats, cand, meta = kn.entrance_region(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
