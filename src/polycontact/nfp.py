@@ -201,12 +201,14 @@ def no_fit_polygon(
     Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
     decomposition (ear clipping up to 64 vertices, GEOS's constrained triangulation
     beyond, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
-    vertices in all, each sum in linear time, then every sum edge clipped by the sums
-    whose boxes reach it (found by a scan of the boxes sorted by their smallest x, O(k)
-    per edge at worst; the sum that covered the previous edge is tried first). When A is
+    vertices in all, each sum in linear time, then every sum edge clipped by other
+    sums until covered: first those containing whole cells of a 32 x 32 grid along the
+    edge, then the one that covered the previous edge, then a scan of the boxes sorted
+    by their smallest x (O(k) per edge at worst, for edges of the outline). When A is
     convex or small (k_A = O(1)) and each sum meets few others, that is near
     O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
-    follows that product (figures: ``benchmarks/bench_scaling.py``).
+    follows that product (figures: ``benchmarks/bench_scaling.py``). Past
+    :data:`MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError` is raised.
 
     Examples
     --------
