@@ -108,3 +108,23 @@ def test_command_line_no_traceback(tmp_path):
     assert run.returncode == 2
     assert "Traceback" not in run.stderr and len(run.stderr.splitlines()) == 1
     assert run.stderr.startswith(f"polycontact classify: error: {bad}: ")
+
+
+def test_defect7_separate_bodies_skip_the_feature_search(tmp_path, capsys, monkeypatch):
+    # Before: the features (empty for separate bodies) were always searched: 55 s on two
+    # 200 000-vertex bodies. The CLI now computes only what it prints.
+    from polycontact._kernels import relation as kr
+
+    def no_features(*args):
+        raise AssertionError("features searched for separate bodies")
+
+    monkeypatch.setattr(kr, "features", no_features)
+    a = _write(tmp_path, "a.json", '{"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]}')
+    b = _write(tmp_path, "b.json", '{"vertices": [[3, 0], [4, 0], [4, 1], [3, 1]]}')
+    assert main(["classify", a, b, "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["state"] == "separate" and rep["features"] == []
+    # (the witness is the midpoint of some closest pair)
+    assert rep["distance"] == 2.0 and rep["point"][0] == 2.0 and 0.0 <= rep["point"][1] <= 1.0
+    assert main(["classify", a, b]) == 0
+    assert "features: none" in capsys.readouterr().out

@@ -292,3 +292,15 @@ def _edge(s: pc.Shape, el: Element) -> shapely.LineString:
     loop = s.loops[el.loop]
     i = _stored(s, el)
     return shapely.LineString([loop[i], loop[(i + 1) % len(loop)]])
+
+
+@pytest.mark.parametrize("side", [1e105, 1e154])
+def test_defect7_entrance_block_of_huge_squares_says_why(side):
+    # Before: a bare "ValueError: max() arg is an empty sequence".
+    import warnings
+
+    sq = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], dtype=float) * side
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # Shape's own overflow, if any
+        with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
+            pc.entrance_block(sq, sq)

@@ -5,6 +5,9 @@ slides checked by brute force on integer lattices with the classifier."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +20,17 @@ from nfp_reference import hole_count, reference_region, same_region
 
 import polycontact as pc
 from polycontact import State
+from polycontact import nfp as nfp_module
+
+
+@pytest.fixture(autouse=True, scope="module")
+def no_geos_fallback():
+    """Every region of this module (catalogue, random shapes, ESICUP) is assembled by
+    polycontact's own kernel: the GEOS fallback, which would hide an assembly failure
+    behind a right answer, is never taken."""
+    before = nfp_module.fallback_count()
+    yield
+    assert nfp_module.fallback_count() == before, "the GEOS fallback built some region"
 
 SQ = [(0, 0), (1, 0), (1, 1), (0, 1)]
 H = 1e-7  # "a hair" in the narrow-entry cases
@@ -175,12 +189,10 @@ def test_degenerate_inputs_give_the_same_region():
     assert hole_count(plain) == hole_count(noisy) == 1
 
 
-def test_geos_fallback_gives_the_same_region(monkeypatch):
-    # If the outline parts ever failed to link into rings, GEOS unions the sums.
+def _force_geos_fallback(monkeypatch):
+    """Make the outline assembly report failure, so that GEOS unions the sums."""
     from polycontact._kernels import nfp as kn
 
-    a, b = shape(FRAME), shape(C_CAVITY)
-    want = pc.no_fit_polygon(a, b).region
     real = kn.entrance_region
 
     def unlinked(*args):
@@ -190,7 +202,18 @@ def test_geos_fallback_gives_the_same_region(monkeypatch):
         return rings, starts, stats, cand, meta
 
     monkeypatch.setattr(kn, "entrance_region", unlinked)
+    # (this deliberate fallback is not counted against the module: restored at teardown)
+    monkeypatch.setattr(nfp_module, "_FALLBACKS", nfp_module.fallback_count())
+
+
+def test_geos_fallback_gives_the_same_region(monkeypatch):
+    # If the outline parts ever failed to link into rings, GEOS unions the sums.
+    a, b = shape(FRAME), shape(C_CAVITY)
+    want = pc.no_fit_polygon(a, b).region
+    _force_geos_fallback(monkeypatch)
+    before = nfp_module.fallback_count()
     got = pc.no_fit_polygon(a, b).region
+    assert nfp_module.fallback_count() == before + 1
     assert shapely.symmetric_difference(got, want).area < 1e-12 * want.area
     assert hole_count(got) == hole_count(want)
 
@@ -243,24 +266,59 @@ def test_random_concave_with_holes_against_reference(a, b):
     assert same_region(nfp.region, ref) is None
 
 
+NEAR_COINCIDENT = (
+    "POLYGON ((0.9616839614202389 0.2741604609477383, -0.3084305185662055 "
+    "1.0818944565977688, -2.885051884260717 -0.8224813828432158, 0.5483209218954771 "
+    "-1.9233679228404779, 0.9616839614202389 0.2741604609477383))",
+    "POLYGON ((1.6536898730240086 1, 0.6536898730240085 1.75, -0.3463101269759915 "
+    "1.0000000000000002, 0.6536898730240083 0, 1.6536898730240086 1))",
+)
+
+
 def test_reference_union_of_near_coincident_hulls():
     # B's two vertices 2e-16 apart in x split it into triangles whose sums with A have
     # edges a few ulps apart; GEOS's floating union_all of those hulls lost 0.875 of the
     # area (CI seed of ce6b02e). The oracle now unions on a fine grid; the region is the
     # convex hull of the vertex differences (both shapes are convex).
-    a = shapely.from_wkt(
-        "POLYGON ((0.9616839614202389 0.2741604609477383, -0.3084305185662055 "
-        "1.0818944565977688, -2.885051884260717 -0.8224813828432158, 0.5483209218954771 "
-        "-1.9233679228404779, 0.9616839614202389 0.2741604609477383))")
-    b = shapely.from_wkt(
-        "POLYGON ((1.6536898730240086 1, 0.6536898730240085 1.75, -0.3463101269759915 "
-        "1.0000000000000002, 0.6536898730240083 0, 1.6536898730240086 1))")
+    a, b = (shapely.from_wkt(w) for w in NEAR_COINCIDENT)
     nfp = pc.no_fit_polygon(a, b)
     pa = np.asarray(a.exterior.coords)[:-1]
     pb = np.asarray(b.exterior.coords)[:-1]
     hull = shapely.MultiPoint((pb[:, None] - pa[None] + nfp.reference).reshape(-1, 2))
     assert same_region(nfp.region, hull.convex_hull) is None
     assert same_region(nfp.region, reference_region(a, b, nfp.reference)) is None
+
+
+def test_geos_fallback_unions_near_coincident_hulls_on_a_grid(monkeypatch):
+    # The fallback's floating union_all lost 0.875 of the area 15.7 on this pair (see
+    # test_reference_union_of_near_coincident_hulls); on a snap-rounding grid it is right.
+    a, b = (shapely.from_wkt(w) for w in NEAR_COINCIDENT)
+    _force_geos_fallback(monkeypatch)
+    before = nfp_module.fallback_count()
+    nfp = pc.no_fit_polygon(a, b)
+    assert nfp_module.fallback_count() == before + 1
+    pa = np.asarray(a.exterior.coords)[:-1]
+    pb = np.asarray(b.exterior.coords)[:-1]
+    hull = shapely.MultiPoint((pb[:, None] - pa[None] + nfp.reference).reshape(-1, 2))
+    assert same_region(nfp.region, hull.convex_hull) is None
+
+
+def test_geos_fallback_union_does_not_drop_near_coincident_hulls():
+    # The hulls of the reference's pieces of the pair above (its slabs, A's centroid as
+    # reference) whose floating union_all GEOS cut to 15.74 of 16.62; the fallback's union
+    # is snap-rounded and keeps them whole.
+    from nfp_reference import trapezoids
+
+    a, b = (shapely.from_wkt(w) for w in NEAR_COINCIDENT)
+    a0 = np.array([-0.5611591731704021, -0.46326479604606213])
+    hulls = [shapely.MultiPoint((t[:, None] + (a0 - s)[None]).reshape(-1, 2)).convex_hull
+             for t in trapezoids(b) for s in trapezoids(a)]
+    assert shapely.union_all(hulls).area < 15.75  # GEOS's floating union loses a piece
+    pa = np.asarray(a.exterior.coords)[:-1]
+    pb = np.asarray(b.exterior.coords)[:-1]
+    want = shapely.MultiPoint((pb[:, None] - pa[None] + a0).reshape(-1, 2)).convex_hull
+    got = nfp_module._union_of_sums(hulls, 1e-12 * 4.0)
+    assert same_region(got, want) is None
 
 
 @examples(200)
@@ -345,3 +403,74 @@ def test_inner_fit_against_brute_force(a, container):
             placed = shapely.affinity.translate(ap, x, y)
             inside = placed.difference(c).area < 1e-12
             assert inside == shapely.intersects_xy(ifp, x, y), (x, y)
+
+
+# -- defect 7 of issue 14: no crash at any finite input ----------------------------------
+
+HUGE = [1e105, 1e120, 1e140, 1e154]
+
+
+@pytest.mark.parametrize("side", HUGE)
+def test_defect7_huge_squares_are_refused_not_a_segfault(side):
+    # Before: the centroid overflowed to inf, the sums to NaN, and the sum kernel's
+    # merge never advanced: out-of-bounds writes, a segmentation fault.
+    sq = np.array(SQ, dtype=float) * side
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # Shape's own overflow, if any
+        with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
+            pc.no_fit_polygon(sq, sq)
+        with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
+            pc.inner_fit_polygon(sq, 3 * sq)
+
+
+@pytest.mark.parametrize("side", [1e105, 1e154])
+def test_defect7_huge_squares_time_of_impact_is_refused_not_no_hit(side):
+    # Before: "no hit" where there is one (the same squares as the NFP crash above).
+    sq = np.array(SQ, dtype=float) * side
+    with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
+        pc.time_of_impact(sq, pc.Motion(velocity=(side, 0.0)), sq + [3.0 * side, 0.0],
+                          pc.Motion(), t_max=5.0)
+
+
+def test_defect7_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
+    # Two large concave bodies make a sum per pair of pieces (1000 x 100 000 vertices:
+    # hundreds of millions of vertices); past its budget the NFP raises a clear error.
+    # The budget is lowered here to reach it with small shapes.
+    monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
+    comb = [(0, 0), (4, 0), (4, 3), (3, 1), (2, 3), (1, 1), (0, 3)]
+    with pytest.raises(nfp_module.NfpTooLargeError, match="memory"):
+        pc.no_fit_polygon(comb, comb)
+    assert issubclass(nfp_module.NfpTooLargeError, (pc.PolycontactError, MemoryError))
+
+
+@pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
+def test_defect7_reference_too_far_for_the_region_is_refused(far):
+    # Before: an empty region (the unit squares' sums vanish in the rounding at 1e17 and
+    # beyond), silently wrong.
+    with pytest.raises(ValueError, match="reference"):
+        pc.no_fit_polygon(SQ, SQ, reference=(far, 0.0))
+    with pytest.raises(ValueError, match="reference"):
+        pc.inner_fit_polygon(SQ, np.array(SQ) * 3, reference=(0.0, -far))
+
+
+def test_far_reference_that_float64_resolves_is_answered():
+    # at 1e9 the rounding (1.4e-5) is far below the unit bodies: the region is exact
+    nfp = pc.no_fit_polygon(SQ, SQ, reference=(1e9, 0.0))
+    assert nfp.region.area == pytest.approx(4.0, rel=1e-4)
+
+
+def test_defect7_nfp_kernel_reports_non_finite_sums_instead_of_crashing():
+    # The kernel itself is safe: run apart, so that a crash fails this test only.
+    code = (
+        "import numpy as np\n"
+        "from polycontact._kernels import nfp as kn\n"
+        "sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])\n"
+        "st = np.array([0, 4])\n"
+        "r = np.full((4, 2), np.inf)\n"
+        "print(kn.entrance_region(sq, st, r, st, -1.0, 1e-12, 64.0, 1e-9)[4][1])\n"
+        "print(len(kn.convex_sums(sq, st, r, st)[0]) <= 8)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=900)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["-1.0", "True"]

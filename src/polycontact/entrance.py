@@ -40,7 +40,7 @@ import numpy.typing as npt
 from ._checks import point as point_arg
 from .bodies import BodyLike, as_shape
 from .shape import Shape
-from .tolerances import default_tolerance
+from .tolerances import check_range, default_tolerance, snap_grid
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]
 
@@ -176,7 +176,7 @@ class EntranceBlock:
         # such near-coincident edges ("Ring edge missing"), snap-rounding to the
         # tolerance grid cannot. The vertex components are joined first; the edge
         # components they cover (most of them) are then left out of the union.
-        grid = _grid(self.tolerance)
+        grid = snap_grid(self.tolerance)
         vertex = shapely.union_all(
             [c.geometry for c in self.components if c.family != "A1-B1"], grid_size=grid
         )
@@ -341,6 +341,7 @@ def entrance_block(
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
     a0 = a.centroid.copy() if reference is None else point_arg(reference, "reference")
+    check_range(a0.reshape(1, 2), "reference")
     a0.flags.writeable = False
     eps = default_tolerance(a.packed[0], b.packed[0], a0.reshape(1, 2))
     comps = _vertex_of_b_in_a(a, b, a0) + _vertex_of_a_in_b(a, b, a0)
@@ -402,7 +403,7 @@ def _swept(a: Shape, b: Shape, a0: np.ndarray, eps: float) -> tuple[Component, .
     comps = []
     for (k, i), start, end in zip(_indices(b, "edge"), f0, f1):
         areas, segments = zip(*(_swept_loop(loop + start, end - start, eps) for loop in reflected))
-        area = areas[0] if len(areas) == 1 else shapely.union_all(areas, grid_size=_grid(eps))
+        area = areas[0] if len(areas) == 1 else shapely.union_all(areas, grid_size=snap_grid(eps))
         lines = [g for group in segments for g in group]
         geom = shapely.GeometryCollection([area, *lines]) if lines else area
         comps.append(Component("A1-B1f", (Element("b", "edge", k, i),), geom))
@@ -431,11 +432,12 @@ def _swept_loop(loop: np.ndarray, v: np.ndarray, eps: float) -> tuple[Any, list[
     lines = list(_parallelograms(corners[flat], eps))
     spliced = _splice(loop, v)
     if spliced is None:
-        return shapely.union_all(shapely.polygons(corners[~flat]), grid_size=_grid(eps)), lines
+        return shapely.union_all(shapely.polygons(corners[~flat]), grid_size=snap_grid(eps)), lines
     area = shapely.Polygon(spliced)
-    cut = shapely.intersection(shapely.Polygon(loop), shapely.Polygon(loop + v), grid_size=_grid(eps))
+    cut = shapely.intersection(shapely.Polygon(loop), shapely.Polygon(loop + v),
+                               grid_size=snap_grid(eps))
     if cut.area > 0.0:  # only the 2D part: where P and P + v merely touch, nothing is cut
-        area = shapely.difference(area, _polygonal(cut), grid_size=_grid(eps))
+        area = shapely.difference(area, _polygonal(cut), grid_size=snap_grid(eps))
     return area, lines
 
 
@@ -512,18 +514,6 @@ def _parallelograms(corners: np.ndarray, eps: float) -> np.ndarray:
         ends = np.stack([c[rows, np.argmin(t, axis=1)], c[rows, np.argmax(t, axis=1)]], axis=1)
         out[flat] = shapely.linestrings(ends)
     return out
-
-
-def _grid(eps: float) -> float:
-    """Snap-rounding grid for GEOS overlays: the power of two just below ``eps / 256``.
-
-    Snapping moves a vertex by less than a grid step, so the outline stays well within
-    the tolerance (a slight shift across a nearly parallel edge pair can change the
-    relation by much more than the shift); the grid keeps coordinates of scale s below
-    2**53 steps (s / (s·1e-12 / 256) ≈ 2.6e14). A power of two keeps short binary
-    fractions (0.5, 3.25) exact on the grid, so simple inputs give exact unions.
-    """
-    return float(2.0 ** np.floor(np.log2(eps / 256.0)))
 
 
 def _flat(corners: np.ndarray, eps: float) -> np.ndarray:

@@ -47,10 +47,11 @@ import shapely.affinity
 from ._checks import finite_number
 from ._checks import point as point_arg
 from .bodies import BodyLike, as_shape
+from .errors import InvalidShapeError, PolycontactError
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid, tolerance_for
 
-__all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon"]
+__all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
 
 #: Holes of the union narrower than ``HOLE_WIDTH_FACTOR * tolerance`` (twice the area
 #: over the perimeter) are rounding artefacts where closed sums meet exactly (an exact
@@ -61,6 +62,41 @@ HOLE_WIDTH_FACTOR = 16.0
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
+
+
+#: Most vertices of convex sums a no-fit polygon builds (about 350 bytes each with the
+#: outline's work arrays: 3.5 GB). Beyond, it is refused with an error, not killed by
+#: the system for want of memory (two large concave bodies make a sum per pair of
+#: their convex pieces).
+MAX_SUM_VERTICES = 10_000_000
+
+
+class NfpTooLargeError(PolycontactError, MemoryError):
+    """The no-fit polygon of these shapes would need more memory than allowed."""
+
+
+#: How many regions GEOS has built since import because the outline parts did not link
+#: into rings (see :func:`fallback_count`).
+_FALLBACKS = 0
+
+
+def fallback_count() -> int:
+    """How many no-fit (or inner-fit) regions were built by the GEOS fallback.
+
+    The outline of the union of sums is assembled by polycontact's own kernel; if its
+    parts ever fail to link into rings (they always should), GEOS unions the sums
+    instead. That path is correct but hides a defect of the assembly, so it is counted:
+    the test suite asserts that the count stays zero over its corpora.
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> before = fallback_count()
+    >>> _ = pc.no_fit_polygon([(0, 0), (1, 0), (1, 1)], [(0, 0), (2, 0), (0, 2)])
+    >>> fallback_count() - before
+    0
+    """
+    return _FALLBACKS
 
 
 @functools.cache
@@ -206,6 +242,20 @@ def no_fit_polygon(
     -------
     NoFitPolygon
 
+    Notes
+    -----
+    Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
+    decomposition (ear clipping up to 64 vertices, GEOS's constrained triangulation
+    beyond, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
+    vertices in all, each sum in linear time, then every sum edge clipped by other
+    sums until covered: first those containing whole cells of a 32 x 32 grid along the
+    edge, then the one that covered the previous edge, then a scan of the boxes sorted
+    by their smallest x (O(k) per edge at worst, for edges of the outline). When A is
+    convex or small (k_A = O(1)) and each sum meets few others, that is near
+    O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
+    follows that product (figures: ``benchmarks/bench_scaling.py``). Past
+    :data:`MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError` is raised.
+
     Examples
     --------
     >>> import polycontact as pc
@@ -216,7 +266,7 @@ def no_fit_polygon(
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
-    a0 = _reference(a, reference)
+    a0 = _reference(a, reference, b)
     bxy, bst = _convex_pieces(b)
     axy, ast = _convex_pieces(a)
     r = a0 - axy
@@ -263,7 +313,7 @@ def inner_fit_polygon(
     """
     a = as_shape(a, "a")
     c = as_shape(container, "container")
-    a0 = _reference(a, reference)
+    a0 = _reference(a, reference, c)
     axy, ast = _convex_pieces(a)
     r = a0 - axy
     span = float(np.max(np.ptp(a.exterior, axis=0)))
@@ -296,16 +346,37 @@ def inner_fit_polygon(
 # -- helpers -----------------------------------------------------------------------------
 
 
-def _reference(a: Shape, reference: Any) -> np.ndarray:
+def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
+    """A's reference point, refused when the region around it cannot be represented.
+
+    The region's coordinates reach about ``|a0| + |A| + |B|``; if the default tolerance
+    there (:func:`polycontact.tolerances.tolerance_for`) is as large as the smaller body,
+    float64 cannot tell the region's features apart (a unit square with its reference
+    at 1e100 had an empty region): the reference is refused, never answered wrongly.
+    """
     if reference is None or (isinstance(reference, str) and reference == "centroid"):
         return np.array(a.centroid, dtype=np.float64)
     if isinstance(reference, str):
         if reference == "origin":
-            return np.zeros(2)
+            a0 = np.zeros(2)
+        else:
+            raise ValueError(
+                f"reference: expected 'centroid', 'origin' or a point (x, y), "
+                f"got {reference!r}"
+            )
+    else:
+        a0 = point_arg(reference, "reference")
+        check_range(a0.reshape(1, 2), "reference")
+    xa, xb = a.packed[0], b.packed[0]
+    reach = float(np.abs(a0).max() + np.abs(xa).max() + np.abs(xb).max())
+    size = min(float(np.ptp(xa, axis=0).max()), float(np.ptp(xb, axis=0).max()))
+    if tolerance_for(0.0, reach) >= size:
         raise ValueError(
-            f"reference: expected 'centroid', 'origin' or a point (x, y), got {reference!r}"
+            f"reference ({a0[0]:g}, {a0[1]:g}): the region's coordinates reach {reach:g}, "
+            f"where float64's rounding tolerance {tolerance_for(0.0, reach):g} is not "
+            f"below the bodies' size {size:g}; choose a reference nearer the bodies"
         )
-    return point_arg(reference, "reference")
+    return a0
 
 
 def _tolerance(tolerance: float | None) -> float:
@@ -317,7 +388,12 @@ def _tolerance(tolerance: float | None) -> float:
 
 def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     """Convex CCW pieces of a shape, packed; cached by coordinates."""
-    xy, starts = shape.packed
+    return _pieces_packed(*shape.packed)
+
+
+def _pieces_packed(xy: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Convex CCW pieces of packed loops (the first the outer one, CCW; then the holes,
+    CW), packed; cached by coordinates."""
     key = (xy.tobytes(), starts.tobytes())
     hit = _PIECES_CACHE.get(key)
     if hit is not None:
@@ -329,8 +405,9 @@ def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
         pieces = (pxy, pst)
     if not ok:
         # (shapely.Polygon is slow with an empty hole list)
-        geom = (shapely.Polygon(shape.exterior, shape.holes) if shape.holes
-                else shapely.polygons(shapely.linearrings(shape.exterior)))
+        loops = [xy[starts[k] : starts[k + 1]] for k in range(len(starts) - 1)]
+        geom = (shapely.Polygon(loops[0], loops[1:]) if len(loops) > 1
+                else shapely.polygons(shapely.linearrings(loops[0])))
         pieces = _pieces_of_geometry(geom)
     if len(_PIECES_CACHE) >= _PIECES_CACHE_SIZE:
         _PIECES_CACHE.pop(next(iter(_PIECES_CACHE)))
@@ -359,21 +436,43 @@ def _entrance(
     should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
     seams and pinholes) are dropped.
     """
+    total = len(bxy) * (len(rst) - 1) + len(rxy) * (len(bst) - 1)
+    if total > MAX_SUM_VERTICES:
+        raise NfpTooLargeError(
+            f"no-fit polygon: the {len(bst) - 1} x {len(rst) - 1} convex sums of the "
+            f"shapes' pieces would hold {total:.3g} vertices, more than "
+            f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
+        )
     kn = _kernels().nfp
     rxy_, rst_, stats, cand, meta = kn.entrance_region(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
         ANGLE_TOLERANCE
     )
     eps = float(meta[0])
+    if meta[1] < 0.0:
+        raise InvalidShapeError(
+            "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
+            "(coordinates or reference point too large)"
+        )
     if meta[1]:
         region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
     else:
+        global _FALLBACKS
+        _FALLBACKS += 1
         sums, starts = kn.convex_sums(bxy, bst, rxy, rst)
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
-        polys = shapely.polygons(shapely.linearrings(sums, indices=ids))
-        region = _drop_slivers(shapely.union_all(polys), eps)
+        region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     n_pts = int(meta[2])
     return region, cand[:n_pts, :2], cand[n_pts:], eps
+
+
+def _union_of_sums(polys: Any, eps: float) -> Any:
+    """GEOS union of convex sums (the fallback of :func:`_entrance`), slivers dropped.
+
+    On a snap-rounding grid (:func:`polycontact.tolerances.snap_grid`): GEOS's floating
+    union of polygons whose edges lie a few ulps apart can drop whole pieces.
+    """
+    return _drop_slivers(shapely.union_all(polys, grid_size=snap_grid(eps)), eps)
 
 
 def _polygon_from_rings(

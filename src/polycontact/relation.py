@@ -233,9 +233,9 @@ class Relation:
 
     @cached_property
     def _penetration(self) -> tuple[float, float, float]:
-        from ._kernels import relation as kr
+        from ._kernels import depth as kd
 
-        return cast("tuple[float, float, float]", kr.penetration(*self._packed, self.tolerance))
+        return cast("tuple[float, float, float]", kd.penetration(*self._packed, self.tolerance))
 
     @cached_property
     def distance(self) -> float:
@@ -262,6 +262,8 @@ class Relation:
     @cached_property
     def features(self) -> tuple[Feature, ...]:
         """Every feature of the meeting (see the class docstring)."""
+        if self.state is State.SEPARATE:
+            return ()  # nothing within the tolerance: no search (O(m + n) and more)
         a, b = self.shapes
         a_on, b_on, a_in, b_in, cross = self._raw_features
         out: list[Feature] = []
@@ -280,11 +282,11 @@ class Relation:
     @cached_property
     def point(self) -> np.ndarray | None:
         """Witness point (see the class docstring)."""
-        a_on, b_on, a_in, b_in, cross = self._raw_features
-        xa, _, xb, _ = self._packed
         if self.state is State.SEPARATE:
             _, px, py, qx, qy = self._closest
             return np.array([0.5 * (px + qx), 0.5 * (py + qy)])
+        a_on, b_on, a_in, b_in, cross = self._raw_features
+        xa, _, xb, _ = self._packed
         if self.state is State.PENETRATING:
             if cross:
                 return np.array(cross[0][2:])
@@ -504,9 +506,16 @@ class RelationBatch:
     @cached_property
     def distances(self) -> np.ndarray:
         """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
+        from ._kernels import depth as kd
+        from ._kernels import relation as kr
         from ._kernels import relation_many as km
 
-        return cast("np.ndarray", km.many_distances(*self._pack(), self.states, self.tolerances))
+        pack = self._pack()
+        out = km.many_distances(*pack, self.states, self.tolerances)
+        # the depths need convex pieces (Python-side decomposition cache): one by one
+        for p in np.flatnonzero(self.states == kr.PENETRATING):
+            out[p] = -kd.penetration(*km.oriented_pair(*pack, p), self.tolerances[p])[0]
+        return cast("np.ndarray", out)
 
 
 def _split(count: int, fn: Any) -> list[Any]:

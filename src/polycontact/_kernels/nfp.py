@@ -71,9 +71,10 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
                 c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
                     bxy[pn, 1] - bxy[pi, 1]
                 ) * (rxy[qn, 0] - rxy[qj, 0])
-                if c >= 0.0:
+                # (a NaN turn, from non-finite input, advances both: the loop always ends)
+                if not c < 0.0:
                     i += 1
-                if c <= 0.0:
+                if not c > 0.0:
                     j += 1
             k += 1
             starts[k] = w
@@ -279,6 +280,43 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
     return reach >= first + 2.0 * np.pi - ang_tol
 
 
+#: Sums remembered per grid cell as containing the whole cell (tried first on an edge).
+_PER_CELL = 4
+
+
+@njit(cache=True, nogil=True)
+def _cell_cover(xy, starts, bb, fr, x0, y0, h, g):
+    """For a g x g grid of cells of side h from (x0, y0): up to ``_PER_CELL`` sums that
+    contain each cell (its four corners inside the closed convex sum), -1 elsewhere."""
+    inside = np.zeros((g + 1, g + 1), np.bool_)
+    cover = np.full((g, g, _PER_CELL), -1, np.int64)
+    cnt = np.zeros((g, g), np.int64)
+    for q in range(starts.shape[0] - 1):
+        i0 = max(0, int(np.ceil((bb[q, 0] - x0) / h)))
+        i1 = min(g, int(np.floor((bb[q, 2] - x0) / h)))
+        j0 = max(0, int(np.ceil((bb[q, 1] - y0) / h)))
+        j1 = min(g, int(np.floor((bb[q, 3] - y0) / h)))
+        if i1 <= i0 or j1 <= j0:
+            continue
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                px = x0 + i * h
+                py = y0 + j * h
+                ok = True
+                for e in range(starts[q], starts[q + 1]):
+                    if fr[e, 3] != 0.0 and fr[e, 0] * py - fr[e, 1] * px - fr[e, 2] < 0.0:
+                        ok = False
+                        break
+                inside[i, j] = ok
+        for i in range(i0, i1):
+            for j in range(j0, j1):
+                if (cnt[i, j] < _PER_CELL and inside[i, j] and inside[i + 1, j]
+                        and inside[i, j + 1] and inside[i + 1, j + 1]):
+                    cover[i, j, cnt[i, j]] = q
+                    cnt[i, j] += 1
+    return cover
+
+
 @njit(cache=True, nogil=True)
 def edge_cover(xy, starts, bb, fr, eps):
     """Uncovered parts of the sums' edges.
@@ -302,6 +340,18 @@ def edge_cover(xy, starts, bb, fr, eps):
     nl = 0
     hint = -1
     by_x = np.argsort(bb[:, 0])
+    xs = bb[by_x, 0]
+    wmax = 0.0
+    for q in range(k):
+        wmax = max(wmax, bb[q, 2] - bb[q, 0])
+    # Sums containing whole cells of a grid over all sums: an edge inside the union is
+    # usually covered by those of the cells it crosses, without the scan over the boxes.
+    g = 32
+    gx0 = bb[:, 0].min()
+    gy0 = bb[:, 1].min()
+    h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / g
+    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
+    tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
@@ -321,13 +371,47 @@ def edge_cover(xy, starts, bb, fr, eps):
             hi1[0] = 1.0
             lo0[0] = 0.0
             hi0[0] = 1.0
-            # The sum that swallowed the previous edge whole is tried first: an edge
-            # inside the union is then usually done after one test.
-            for qi in range(-1, k):
-                q = hint if qi < 0 else by_x[qi]
-                if qi >= 0 and bb[q, 0] > x1:
+            # The cells' covering sums along the edge first (up to 2 g samples).
+            nt = 0
+            steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
+            for st in range(steps + 1):
+                t = st / steps
+                ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
+                cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
+                if ci < 0 or cj < 0 or ci >= g or cj >= g:
+                    continue
+                for u in range(_PER_CELL):
+                    q = cover[ci, cj, u]
+                    if q < 0 or q == p:
+                        continue
+                    seen = False
+                    for v in range(nt):
+                        if tried[v] == q:
+                            seen = True
+                            break
+                    if seen or nt == tried.shape[0]:
+                        continue
+                    tried[nt] = q
+                    nt += 1
+                    a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1],
+                                           q < p, eps)
+                    if a1 < b1 and n1 > 0:
+                        n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+                    if a0 < b0 and n0 > 0:
+                        n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+                    if n1 == 0 and n0 == 0:
+                        break
+                if n1 == 0 and n0 == 0:
+                    break
+            # The sum that swallowed the previous edge whole is tried next: an edge
+            # inside the union is then usually done after one test. The others by their
+            # smallest x, from the first that can reach x0 (none is wider than wmax).
+            first = np.searchsorted(xs, x0 - wmax) if n1 > 0 or n0 > 0 else k + 1
+            for qi in range(first - 1, k):
+                q = hint if qi < first else by_x[qi]
+                if qi >= first and bb[q, 0] > x1:
                     break  # sums sorted by their smallest x: none further can meet the edge
-                if q < 0 or (qi >= 0 and q == hint):
+                if q < 0 or (qi >= first and q == hint):
                     continue
                 if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
                     continue
@@ -616,9 +700,14 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     (R, 2); candidate exact fits then candidate slides as segments (C, 4), an exact
     fit as a zero-length segment; ``meta`` =
     ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
-    did not link into rings (the caller then unions the sums another way).
+    did not link into rings (the caller then unions the sums another way), -1 when the
+    sums are not finite (input beyond float64: the caller refuses it).
     """
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
+    if not np.isfinite(sums).all():
+        # error code, not a crash: the caller refuses the input
+        meta = np.array([1.0, -1.0, 0.0])
+        return sums[:0], np.zeros(1, np.int64), np.empty((0, 2)), np.empty((0, 4)), meta
     if eps <= 0.0:
         eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])

@@ -2,8 +2,8 @@
 
 The state kernels are serial: for small pairs (about a microsecond each) a ``prange``
 version measured 2-3 times slower on a 2-core machine; the caller splits the pairs over
-threads instead (the kernels release the GIL). The signed distances (penetration depths
-cost far more per pair) use ``prange``.
+threads instead (the kernels release the GIL). The signed distances use ``prange``;
+penetration depths are left to the caller (:mod:`polycontact._kernels.depth`).
 
 A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
 after body), ``ls`` int64 and ``bs`` int64 (P+1,): the loop starts of body p are
@@ -27,7 +27,6 @@ from .relation import (
     _state_in,
     closest_pair,
     pair_tolerance,
-    penetration,
 )
 from .tolerance import extent_magnitude, tolerance_for
 
@@ -299,7 +298,10 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
 
 @njit(cache=True, nogil=True, parallel=True)
 def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
-    """Signed distances of P classified pairs: the boundary gap, 0, or minus the depth."""
+    """Signed distances of P classified pairs: the boundary gap, or 0; NaN for the
+    penetrating pairs, whose depth the caller computes (it needs convex pieces, see
+    :func:`polycontact._kernels.depth.penetration`; :func:`oriented_pair` gives the
+    pair's bodies)."""
     p_count = bsa.shape[0] - 1
     out = np.empty(p_count)
     for p in prange(p_count):
@@ -308,9 +310,13 @@ def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
         elif states[p] == CONTACT:
             out[p] = 0.0
         else:
-            ya, sa = _body(xa, lsa, bsa, p)
-            yb, sb = _body(xb, lsb, bsb, p)
-            out[p] = -penetration(
-                _oriented(ya, sa, fa[p]), sa, _oriented(yb, sb, fb[p]), sb, eps[p]
-            )[0]
+            out[p] = np.nan
     return out
+
+
+@njit(cache=True, nogil=True)
+def oriented_pair(xa, lsa, bsa, fa, xb, lsb, bsb, fb, p):
+    """Pair p's bodies packed with the interior on the left: ``(xa, sa, xb, sb)``."""
+    ya, sa = _body(xa, lsa, bsa, p)
+    yb, sb = _body(xb, lsb, bsb, p)
+    return _oriented(ya, sa, fa[p]), sa, _oriented(yb, sb, fb[p]), sb

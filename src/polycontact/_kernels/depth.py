@@ -1,0 +1,382 @@
+"""Kernel: penetration depth from the convex Minkowski sums near the origin.
+
+A translation ``d`` of A makes the interiors of A and B overlap exactly when ``d`` lies
+in the union ``O`` of the open convex sums ``int(B_i ⊕ (−A_j))`` over convex pieces
+``B_i`` of B and ``A_j`` of A (see :mod:`polycontact._kernels.nfp`). The penetration
+depth is the distance from the origin to the complement of ``O``: to the outline of the
+union (the boundary of the entrance block, translated so A's reference is the origin),
+or to an exact fit or slide inside it (sum boundaries covered by no open sum).
+
+Only the part of the union inside the disk of radius ``bound`` (a known escape, e.g. out
+of B's bounding box) can hold the answer: only the pairs of pieces whose sum's box meets
+that disk's box are summed, and the sums' edges are visited in increasing distance from
+the origin, each clipped by the open sums (the one that covered the previous edge first)
+until the first uncovered part; the search stops when the next edge is farther than the
+best escape found. Uncovered parts are confirmed with the state kernel.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..errors import PolycontactError
+from .nfp import _PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract
+from .relation import PENETRATING, _state
+
+
+@njit(cache=True, nogil=True)
+def _segment_foot(ax, ay, bx, by):
+    """Point of segment ab nearest to the origin, and its distance."""
+    dx = bx - ax
+    dy = by - ay
+    den = dx * dx + dy * dy
+    t = 0.0
+    if den > 0.0:
+        t = min(1.0, max(0.0, -(ax * dx + ay * dy) / den))
+    px = ax + t * dx
+    py = ay + t * dy
+    return px, py, np.hypot(px, py)
+
+
+@njit(cache=True, nogil=True)
+def _in_disk(ax, ay, bx, by, r):
+    """Parameter interval [lo, hi] of segment ab (t in [0, 1]) within distance r of the
+    origin (empty when lo >= hi)."""
+    dx = bx - ax
+    dy = by - ay
+    a = dx * dx + dy * dy
+    if a == 0.0:
+        return 0.0, 1.0 if np.hypot(ax, ay) < r else 0.0
+    t0 = -(ax * dx + ay * dy) / a
+    fx = ax + t0 * dx
+    fy = ay + t0 * dy
+    w = r * r - (fx * fx + fy * fy)
+    if w <= 0.0:
+        return 1.0, 0.0
+    half = np.sqrt(w / a)
+    return max(0.0, t0 - half), min(1.0, t0 + half)
+
+
+@njit(cache=True, nogil=True)
+def _select_pairs(bb_b, bb_r, bound, bstarts, rstarts, max_vertices):
+    """Pairs (i, j) of pieces whose sum's bounding box meets [-bound, bound]^2; the one
+    row (-1, -1) when their sums would hold more than ``max_vertices`` vertices.
+
+    Pieces of B sorted by their smallest x; for each piece j of R, the pieces i with
+    ``x0_i <= bound - x0_j`` and ``x0_i >= -bound - x1_j - w`` (w: widest piece of B) are
+    scanned by binary search, then tested on both axes.
+    """
+    nb = bb_b.shape[0]
+    nr = bb_r.shape[0]
+    order = np.argsort(bb_b[:, 0])
+    xs = bb_b[order, 0]
+    w = 0.0
+    for i in range(nb):
+        w = max(w, bb_b[i, 2] - bb_b[i, 0])
+    cap = 16 + nb + nr
+    out = np.empty((cap, 2), np.int64)
+    n = 0
+    total = 0
+    for j in range(nr):
+        lo = -bound - bb_r[j, 2]
+        hi = bound - bb_r[j, 0]
+        ylo = -bound - bb_r[j, 3]
+        yhi = bound - bb_r[j, 1]
+        k = np.searchsorted(xs, lo - w)
+        while k < nb and xs[k] <= hi:
+            i = order[k]
+            k += 1
+            if bb_b[i, 2] < lo or bb_b[i, 1] > yhi or bb_b[i, 3] < ylo:
+                continue
+            if n == out.shape[0]:
+                grown = np.empty((2 * n, 2), np.int64)
+                grown[:n] = out[:n]
+                out = grown
+            out[n, 0] = i
+            out[n, 1] = j
+            n += 1
+            total += bstarts[i + 1] - bstarts[i] + rstarts[j + 1] - rstarts[j]
+            if total > max_vertices:
+                return np.full((1, 2), -1, np.int64)
+    return out[:n]
+
+
+@njit(cache=True, nogil=True)
+def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
+    """Convex sums of the given pairs of convex CCW pieces, in O(p + q) each (packed)."""
+    total = 0
+    for k in range(pairs.shape[0]):
+        i = pairs[k, 0]
+        j = pairs[k, 1]
+        total += bstarts[i + 1] - bstarts[i] + rstarts[j + 1] - rstarts[j]
+    out = np.empty((total, 2))
+    starts = np.empty(pairs.shape[0] + 1, np.int64)
+    starts[0] = 0
+    w = 0
+    for k in range(pairs.shape[0]):
+        ps = bstarts[pairs[k, 0]]
+        pe = bstarts[pairs[k, 0] + 1]
+        qs = rstarts[pairs[k, 1]]
+        qe = rstarts[pairs[k, 1] + 1]
+        n = pe - ps
+        m = qe - qs
+        i0 = _lowest(bxy, ps, pe)
+        j0 = _lowest(rxy, qs, qe)
+        i = 0
+        j = 0
+        while i < n or j < m:
+            pi = ps + (i0 - ps + i) % n
+            qj = qs + (j0 - qs + j) % m
+            out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
+            out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
+            w += 1
+            if i == n:
+                j += 1
+                continue
+            if j == m:
+                i += 1
+                continue
+            pn = ps + (i0 - ps + i + 1) % n
+            qn = qs + (j0 - qs + j + 1) % m
+            c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
+                bxy[pn, 1] - bxy[pi, 1]
+            ) * (rxy[qn, 0] - rxy[qj, 0])
+            # (a NaN turn, from non-finite input, advances both: the loop always ends)
+            if not c < 0.0:
+                i += 1
+            if not c > 0.0:
+                j += 1
+        starts[k + 1] = w
+    return out[:w].copy(), starts
+
+
+@njit(cache=True, nogil=True)
+def _escapes(xa, sa, xb, sb, dx, dy, eps):
+    """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict)."""
+    moved = xa.copy()
+    moved[:, 0] += dx
+    moved[:, 1] += dy
+    return _state(moved, sa, 1.0, xb, sb, 1.0, eps) != PENETRATING
+
+
+@njit(cache=True, nogil=True)
+def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
+                      max_vertices):
+    """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
+
+    ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
+    bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
+    ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap.
+    Returns ``(bound, bdx, bdy)`` when nothing nearer ends it, NaNs when the sums would
+    hold more than ``max_vertices`` vertices (none is built).
+
+    Cost: with P pairs of pieces whose sums' boxes meet the disk of radius ``bound`` and
+    K edges of those sums nearer than the depth, O((p + q) log(p + q) + P + K log K)
+    plus the clipping of each of those K edges by the sums until one covers it (one,
+    usually: the sum that covered the previous edge is tried first) and one state check,
+    O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
+    """
+    best = bound
+    pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound,
+                          bstarts, rstarts, max_vertices)
+    if pairs.shape[0] == 1 and pairs[0, 0] < 0:
+        return np.nan, np.nan, np.nan
+    if pairs.shape[0] == 0:
+        return best, bdx, bdy
+    xy, starts = _pair_sums(bxy, bstarts, rxy, rstarts, pairs)
+    k = starts.shape[0] - 1
+    bb = _bboxes(xy, starts)
+    fr = _frames(xy, starts)
+    n_edges = xy.shape[0]
+    dist = np.empty(n_edges)
+    owner = np.empty(n_edges, np.int64)
+    for p in range(k):
+        s = starts[p]
+        e = starts[p + 1]
+        for i in range(s, e):
+            j = i + 1 if i + 1 < e else s
+            owner[i] = p
+            if fr[i, 3] == 0.0:
+                dist[i] = np.inf
+            else:
+                dist[i] = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])[2]
+    by_dist = np.argsort(dist)
+    by_x = np.argsort(bb[:, 0])
+    xs = bb[by_x, 0]
+    wmax = 0.0
+    for p in range(k):
+        wmax = max(wmax, bb[p, 2] - bb[p, 0])
+    cap = 2 * k + 4
+    lo1 = np.empty(cap)
+    hi1 = np.empty(cap)
+    lo0 = np.empty(cap)
+    hi0 = np.empty(cap)
+    # Sums containing whole cells of a grid over the disk: an edge inside the union is
+    # usually covered by those of the cells it crosses, without scanning every sum.
+    g = 32
+    h = 2.0 * bound / g
+    gx0 = -bound
+    gy0 = -bound
+    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
+    tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
+    hint = -1
+    for oi in range(n_edges):
+        i = by_dist[oi]
+        if dist[i] >= best:
+            break
+        p = owner[i]
+        s = starts[p]
+        e = starts[p + 1]
+        j = i + 1 if i + 1 < e else s
+        ax, ay = xy[i, 0], xy[i, 1]
+        bx, by = xy[j, 0], xy[j, 1]
+        x0 = min(ax, bx) - eps
+        x1 = max(ax, bx) + eps
+        y0 = min(ay, by) - eps
+        y1 = max(ay, by) + eps
+        # only the part of the edge inside the disk of the best escape can hold a nearer one
+        tlo, thi = _in_disk(ax, ay, bx, by, best)
+        if tlo >= thi:
+            continue
+        n1 = 1
+        n0 = 1
+        lo1[0] = tlo
+        hi1[0] = thi
+        lo0[0] = tlo
+        hi0[0] = thi
+        # the cells' covering sums along the edge first
+        nt = 0
+        steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
+        for st in range(steps + 1):
+            t = st / steps
+            ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
+            cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
+            if ci < 0 or cj < 0 or ci >= g or cj >= g:
+                continue
+            for u in range(_PER_CELL):
+                q = cover[ci, cj, u]
+                if q < 0 or q == p:
+                    continue
+                seen = False
+                for v in range(nt):
+                    if tried[v] == q:
+                        seen = True
+                        break
+                if seen or nt == tried.shape[0]:
+                    continue
+                tried[nt] = q
+                nt += 1
+                a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1],
+                                       q < p, eps)
+                if a1 < b1 and n1 > 0:
+                    n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+                if a0 < b0 and n0 > 0:
+                    n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+                if n1 == 0 and n0 == 0:
+                    break
+            if n1 == 0 and n0 == 0:
+                break
+        if n1 == 0 and n0 == 0:
+            continue
+        first = np.searchsorted(xs, x0 - wmax)
+        for qi in range(first - 1, k):
+            q = hint if qi < first else by_x[qi]
+            if qi >= first and xs[qi] > x1:
+                break
+            if q < 0 or (qi >= first and q == hint):
+                continue
+            if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
+                continue
+            a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
+            if a1 < b1 and n1 > 0:
+                n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+            if a0 < b0 and n0 > 0:
+                n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+            if n1 == 0 and n0 == 0:
+                hint = q
+                break
+        dx = bx - ax
+        dy = by - ay
+        # Uncovered parts: the outline of the union (n0) or parts covered only within
+        # eps (n1: seams, exact fits, slides). Each is confirmed by the classifier at its
+        # point nearest the origin, then at its ends and middle.
+        for r in range(n0 + n1):
+            lo = lo0[r] if r < n0 else lo1[r - n0]
+            hi = hi0[r] if r < n0 else hi1[r - n0]
+            px0 = ax + lo * dx
+            py0 = ay + lo * dy
+            px1 = ax + hi * dx
+            py1 = ay + hi * dy
+            fx, fy, fd = _segment_foot(px0, py0, px1, py1)
+            if fd >= best:
+                continue
+            for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
+                           (0.5 * (px0 + px1), 0.5 * (py0 + py1))):
+                cd = np.hypot(cx, cy)
+                if cd < best and _escapes(xa, sa, xb, sb, cx, cy, eps):
+                    best = cd
+                    bdx = cx
+                    bdy = cy
+                    break
+    return best, bdx, bdy
+
+
+def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
+                eps: float) -> tuple[float, float, float]:
+    """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
+
+    Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
+    the left of every edge). The first escape is out of B's bounding box; then
+    :func:`depth_from_pieces` looks for a nearer one on the union of the convex sums of
+    the pieces of B and −A (decomposed in O(n log n), cached by coordinates).
+
+    Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
+    pieces whose sums reach the disk of the first escape and their K edges, plus the
+    clipping of each edge nearer than the depth (usually by one sum; by up to P when it
+    is uncovered) and one state check, O((m + n) log(m + n)), per uncovered part nearer
+    than the best escape so far. When one body is small or convex, P = O(m + n) and the
+    whole is near O((m + n) log(m + n)). Two large concave bodies whose pieces are long
+    (stars) make P grow with the product of their piece counts even for a shallow
+    overlap, up to about m n / 4 for deeply interlocked ones: O(P + K P) at worst
+    (figures: ``benchmarks/bench_scaling.py``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> [float(v) for v in penetration(sq, st, sq + np.array([0.75, 0.5]), st, 1e-12)]
+    [0.25, -0.25, 0.0]
+    """
+    from ..nfp import _pieces_packed
+
+    ax0, ay0 = xa.min(axis=0)
+    ax1, ay1 = xa.max(axis=0)
+    bx0, by0 = xb.min(axis=0)
+    bx1, by1 = xb.max(axis=0)
+    bound, bdx, bdy = float(bx1 - ax0), float(bx1 - ax0), 0.0
+    for m, mx, my in ((ax1 - bx0, -1.0, 0.0), (by1 - ay0, 0.0, 1.0), (ay1 - by0, 0.0, -1.0)):
+        if m < bound:
+            bound, bdx, bdy = float(m), mx * float(m), my * float(m)
+    bxy, bst = _pieces_packed(xb, sb)
+    axy, ast = _pieces_packed(xa, sa)
+    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, bound, bdx, bdy, eps,
+                            MAX_SUM_VERTICES)
+    if np.isnan(got[0]):
+        raise DepthTooLargeError(
+            f"penetration depth: the convex sums of the pieces near the overlap would hold "
+            f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({len(xa)} and "
+            f"{len(xb)} vertices) are too large and interlocked for this depth"
+        )
+    return got
+
+
+#: Most vertices of convex sums the depth builds (about 80 bytes each with their frames
+#: and sort keys: 2.4 GB). Beyond, the depth is refused with an error, not killed by
+#: the system for want of memory.
+MAX_SUM_VERTICES = 30_000_000
+
+
+class DepthTooLargeError(PolycontactError, MemoryError):
+    """The penetration depth of these bodies would need more memory than allowed."""
