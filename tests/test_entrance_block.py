@@ -304,3 +304,26 @@ def test_defect7_entrance_block_of_huge_squares_says_why(side):
         warnings.simplefilter("ignore", RuntimeWarning)  # Shape's own overflow, if any
         with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
             pc.entrance_block(sq, sq)
+
+
+def test_union_of_components_a_hole_snaps_onto_its_shell():
+    # GEOS's snap-rounded union refused these components ("side location conflict":
+    # snapping made one invalid), so .area raised for two valid bodies (CI seed).
+    from nfp_reference import reference_region, same_region
+
+    a = pc.Shape(
+        [[0.3958310055569007, 3.9279007059405204], [-0.0015716512765144755, 4.402340680364698],
+         [-0.402291098272617, 3.993491128002938], [0.0237765475853263, 3.598359403260844]],
+        [[[0.03924935039413392, 3.9148615774538986], [-0.027557328357078945, 3.9565765988148796],
+          [-0.05056356214843421, 4.03673657826828], [0.01348515707822336, 4.171345166735382],
+          [0.0625, 4.0]]])
+    b = pc.Shape(
+        [[0.3958310055569007, 4.92790070594052], [-0.0019531200329500277, 5.499996185307585],
+         [-0.499996185307585, 4.99804687996705], [0.0237765475853263, 4.598359403260844]],
+        [[[0.03924935039413392, 4.914861577453899], [-0.04592498523364826, 4.966633545129737],
+          [-0.10112712429686842, 5.073473156536559], [0.03862712429686843, 5.118882064536894],
+          [0.125, 5.0]]])
+    for method in ("swept", "pairs"):
+        eb = pc.entrance_block(a, b, method=method)
+        want = reference_region(a.to_shapely(), b.to_shapely(), eb.reference)
+        assert same_region(eb.to_shapely(), want, rel=1e-6) is None

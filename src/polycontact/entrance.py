@@ -177,8 +177,8 @@ class EntranceBlock:
         # tolerance grid cannot. The vertex components are joined first; the edge
         # components they cover (most of them) are then left out of the union.
         grid = snap_grid(self.tolerance)
-        vertex = shapely.union_all(
-            [c.geometry for c in self.components if c.family != "A1-B1"], grid_size=grid
+        vertex = _union_on_grid(
+            [c.geometry for c in self.components if c.family != "A1-B1"], grid
         )
         shapely.prepare(vertex)
         edge = np.array(
@@ -187,7 +187,7 @@ class EntranceBlock:
             dtype=object,
         )
         rest = edge[~shapely.covers(vertex, edge)] if len(edge) else edge
-        union = _polygonal(shapely.union_all([vertex, *rest], grid_size=grid))
+        union = _polygonal(_union_on_grid([vertex, *rest], grid))
         return _without_specks(union, self.tolerance)
 
     @property
@@ -403,7 +403,7 @@ def _swept(a: Shape, b: Shape, a0: np.ndarray, eps: float) -> tuple[Component, .
     comps = []
     for (k, i), start, end in zip(_indices(b, "edge"), f0, f1):
         areas, segments = zip(*(_swept_loop(loop + start, end - start, eps) for loop in reflected))
-        area = areas[0] if len(areas) == 1 else shapely.union_all(areas, grid_size=snap_grid(eps))
+        area = areas[0] if len(areas) == 1 else _union_on_grid(areas, snap_grid(eps))
         lines = [g for group in segments for g in group]
         geom = shapely.GeometryCollection([area, *lines]) if lines else area
         comps.append(Component("A1-B1f", (Element("b", "edge", k, i),), geom))
@@ -432,7 +432,7 @@ def _swept_loop(loop: np.ndarray, v: np.ndarray, eps: float) -> tuple[Any, list[
     lines = list(_parallelograms(corners[flat], eps))
     spliced = _splice(loop, v)
     if spliced is None:
-        return shapely.union_all(shapely.polygons(corners[~flat]), grid_size=snap_grid(eps)), lines
+        return _union_on_grid(shapely.polygons(corners[~flat]), snap_grid(eps)), lines
     area = shapely.Polygon(spliced)
     cut = shapely.intersection(shapely.Polygon(loop), shapely.Polygon(loop + v),
                                grid_size=snap_grid(eps))
@@ -562,3 +562,19 @@ def _outline(geom: Any) -> Any:
     if geom.geom_type in ("LineString", "MultiLineString"):
         return geom
     return shapely.union_all([_outline(g) for g in shapely.get_parts(geom)])
+
+
+def _union_on_grid(geoms: Any, grid: float) -> Any:
+    """Union of ``geoms`` snap-rounded to ``grid``. GEOS snaps the inputs first, which
+    can make a valid input invalid (a hole's vertex within a grid step of its shell)
+    and then refuse it ("side location conflict"; regression test
+    test_entrance_block::test_union_of_components_a_hole_snaps_onto_its_shell); the
+    inputs are then first made valid on that grid (``set_precision``), a change smaller
+    than the grid step, which is below the tolerance."""
+    import shapely
+
+    try:
+        return shapely.union_all(geoms, grid_size=grid)
+    except shapely.errors.GEOSException:
+        snapped = shapely.set_precision(np.asarray(geoms, dtype=object), grid)
+        return shapely.union_all(snapped, grid_size=grid)
