@@ -495,18 +495,7 @@ def time_of_impact(
     b = as_shape(b, "b")
     ma = check_motion(motion_a, "motion_a")
     mb = check_motion(motion_b, "motion_b")
-    t_max = check_t_max(t_max)
-    tol = finite_number(time_tolerance, "time_tolerance", positive=True)
-    if method not in _METHODS:
-        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
-    if type(samples) is not int and (
-            isinstance(samples, bool) or not isinstance(samples, (int, np.integer))) \
-            or samples < 2:
-        raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
-    if type(max_iterations) is not int and (
-            isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))) \
-            or max_iterations < 1:
-        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
+    t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
 
     # coordinates (checked once per shape, with its body frame) and motions whose
     # products would overflow float64 are refused
@@ -554,6 +543,25 @@ def _query(method: str, args: tuple[Any, ...], fixed: bool) -> tuple[Any, ...]:
             run = _ENTRY[method] = entry_point(run, args)
     out: tuple[Any, ...] = run(*args)
     return out
+
+
+def check_options(t_max: float, method: str, time_tolerance: float, samples: int,
+                  max_iterations: int) -> tuple[float, float]:
+    """The options of :func:`time_of_impact` checked (an error naming each bad one):
+    ``(t_max, time_tolerance)`` as floats."""
+    t_max = check_t_max(t_max)
+    tol = finite_number(time_tolerance, "time_tolerance", positive=True)
+    if method not in _METHODS:
+        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
+    if type(samples) is not int and (
+            isinstance(samples, bool) or not isinstance(samples, (int, np.integer))) \
+            or samples < 2:
+        raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
+    if type(max_iterations) is not int and (
+            isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))) \
+            or max_iterations < 1:
+        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
+    return t_max, tol
 
 
 def body_frame(shape: Shape, tables: bool = True,

@@ -23,11 +23,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._checks import finite_number
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .errors import InvalidShapeError
-from .impact import (_METHODS, _STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
-                     ImpactStatus, _extent, _result, body_frame)
+from .impact import (_STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
+                     ImpactStatus, _extent, _result, body_frame, check_options)
 from .motion import Motion
 from .bodies import as_shape
 from .shape import Shape
@@ -142,15 +141,7 @@ def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion
 
 def _options(t_max: float, method: str, time_tolerance: float, samples: int,
              max_iterations: int, threads: int | None) -> tuple[float, float, int, int, int]:
-    t_max = check_t_max(t_max)
-    tol = finite_number(time_tolerance, "time_tolerance", positive=True)
-    if method not in _METHODS:
-        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
-        raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
-            or max_iterations < 1:
-        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
+    t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
     if threads is None:
         threads = os.cpu_count() or 1
     elif isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
