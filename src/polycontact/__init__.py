@@ -18,7 +18,8 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from .errors import InvalidSceneError, InvalidShapeError, PolycontactError
+from .errors import (DepthTooLargeError, InvalidSceneError, InvalidShapeError, NfpTooLargeError,
+                     PolycontactError)
 from .shape import Shape
 
 __version__ = "0.1.0"
@@ -73,6 +74,8 @@ _LAZY = {
 __all__ = [
     "PolycontactError",
     "InvalidShapeError",
+    "NfpTooLargeError",
+    "DepthTooLargeError",
     "InvalidSceneError",
     "Shape",
     *_LAZY,

@@ -6,7 +6,8 @@ Errors about bad input are also :class:`ValueError`, so ``except ValueError`` wo
 
 from __future__ import annotations
 
-__all__ = ["PolycontactError", "InvalidShapeError", "InvalidSceneError"]
+__all__ = ["PolycontactError", "InvalidShapeError", "InvalidSceneError", "NfpTooLargeError",
+           "DepthTooLargeError"]
 
 
 class PolycontactError(Exception):
@@ -19,3 +20,13 @@ class InvalidShapeError(PolycontactError, ValueError):
 
 class InvalidSceneError(PolycontactError, ValueError):
     """A scene (bodies, motions, t_max) is malformed; the message names the key."""
+
+
+class NfpTooLargeError(PolycontactError, MemoryError):
+    """The no-fit polygon of these shapes would need more memory than allowed
+    (``polycontact.nfp.MAX_SUM_VERTICES`` vertices of convex sums)."""
+
+
+class DepthTooLargeError(PolycontactError, MemoryError):
+    """The penetration depth of these bodies would need more memory than allowed
+    (``polycontact._kernels.depth.MAX_SUM_VERTICES`` vertices of convex sums)."""

@@ -47,7 +47,7 @@ import shapely.affinity
 from ._checks import finite_number
 from ._checks import point as point_arg
 from .bodies import BodyLike, as_shape
-from .errors import InvalidShapeError, PolycontactError
+from .errors import InvalidShapeError, NfpTooLargeError
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid, tolerance_for
 
@@ -69,10 +69,6 @@ ANGLE_TOLERANCE = 1e-9
 #: the system for want of memory (two large concave bodies make a sum per pair of
 #: their convex pieces).
 MAX_SUM_VERTICES = 10_000_000
-
-
-class NfpTooLargeError(PolycontactError, MemoryError):
-    """The no-fit polygon of these shapes would need more memory than allowed."""
 
 
 #: How many regions GEOS has built since import because the outline parts did not link
@@ -242,6 +238,14 @@ def no_fit_polygon(
     -------
     NoFitPolygon
 
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> a = pc.Shape([(0, 0), (2, 0), (2, 1), (0, 1)])
+    >>> nfp = pc.no_fit_polygon(a, a, reference="origin")
+    >>> nfp.region.bounds, nfp.region.area
+    ((-2.0, -1.0, 2.0, 1.0), 8.0)
+
     Notes
     -----
     Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
@@ -255,14 +259,6 @@ def no_fit_polygon(
     O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
     follows that product (figures: ``benchmarks/bench_scaling.py``). Past
     :data:`MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError` is raised.
-
-    Examples
-    --------
-    >>> import polycontact as pc
-    >>> a = pc.Shape([(0, 0), (2, 0), (2, 1), (0, 1)])
-    >>> nfp = pc.no_fit_polygon(a, a, reference="origin")
-    >>> nfp.region.bounds, nfp.region.area
-    ((-2.0, -1.0, 2.0, 1.0), 8.0)
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")

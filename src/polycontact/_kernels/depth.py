@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..errors import PolycontactError
+from ..errors import DepthTooLargeError
 from .nfp import _PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract
 from .relation import PENETRATING, _state
 
@@ -378,5 +378,3 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
 MAX_SUM_VERTICES = 30_000_000
 
 
-class DepthTooLargeError(PolycontactError, MemoryError):
-    """The penetration depth of these bodies would need more memory than allowed."""
