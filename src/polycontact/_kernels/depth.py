@@ -21,7 +21,8 @@ import numpy as np
 from numba import njit
 
 from ..errors import DepthTooLargeError
-from .nfp import _PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract
+from .nfp import (_PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract,
+                  clip_by_cells)
 from .relation import PENETRATING, _state
 
 
@@ -246,37 +247,8 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
         lo0[0] = tlo
         hi0[0] = thi
         # the cells' covering sums along the edge first
-        nt = 0
-        steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
-        for st in range(steps + 1):
-            t = st / steps
-            ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
-            cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
-            if ci < 0 or cj < 0 or ci >= g or cj >= g:
-                continue
-            for u in range(_PER_CELL):
-                q = cover[ci, cj, u]
-                if q < 0 or q == p:
-                    continue
-                seen = False
-                for v in range(nt):
-                    if tried[v] == q:
-                        seen = True
-                        break
-                if seen or nt == tried.shape[0]:
-                    continue
-                tried[nt] = q
-                nt += 1
-                a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1],
-                                       q < p, eps)
-                if a1 < b1 and n1 > 0:
-                    n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-                if a0 < b0 and n0 > 0:
-                    n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
-                if n1 == 0 and n0 == 0:
-                    break
-            if n1 == 0 and n0 == 0:
-                break
+        n1, n0 = clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr,
+                               starts, eps, lo1, hi1, n1, lo0, hi0, n0)
         if n1 == 0 and n0 == 0:
             continue
         first = np.searchsorted(xs, x0 - wmax)

@@ -372,37 +372,8 @@ def edge_cover(xy, starts, bb, fr, eps):
             lo0[0] = 0.0
             hi0[0] = 1.0
             # The cells' covering sums along the edge first (up to 2 g samples).
-            nt = 0
-            steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
-            for st in range(steps + 1):
-                t = st / steps
-                ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
-                cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
-                if ci < 0 or cj < 0 or ci >= g or cj >= g:
-                    continue
-                for u in range(_PER_CELL):
-                    q = cover[ci, cj, u]
-                    if q < 0 or q == p:
-                        continue
-                    seen = False
-                    for v in range(nt):
-                        if tried[v] == q:
-                            seen = True
-                            break
-                    if seen or nt == tried.shape[0]:
-                        continue
-                    tried[nt] = q
-                    nt += 1
-                    a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1],
-                                           q < p, eps)
-                    if a1 < b1 and n1 > 0:
-                        n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-                    if a0 < b0 and n0 > 0:
-                        n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
-                    if n1 == 0 and n0 == 0:
-                        break
-                if n1 == 0 and n0 == 0:
-                    break
+            n1, n0 = clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr,
+                                   starts, eps, lo1, hi1, n1, lo0, hi0, n0)
             # The sum that swallowed the previous edge whole is tried next: an edge
             # inside the union is then usually done after one test. The others by their
             # smallest x, from the first that can reach x0 (none is wider than wmax).
@@ -890,3 +861,42 @@ def merge_collinear(segs, tol):
                 changed = True
                 ln = np.hypot(s[r, 2] - s[r, 0], s[r, 3] - s[r, 1])
     return s[keep].copy()
+
+
+@njit(cache=True, nogil=True)
+def clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr, starts, eps,
+                  lo1, hi1, n1, lo0, hi0, n0):
+    """Clip edge (a, b) of sum p by the sums that cover whole cells along it (up to 2 g
+    samples of the g x g grid of side h from (gx0, gy0), :func:`_cell_cover`), each sum
+    once (``tried``: the ones clipped so far), until nothing is left of either part
+    (``lo1, hi1, n1``: the parts outside the closed sums; ``lo0, hi0, n0``: outside the
+    open ones). Returns ``(n1, n0)``."""
+    nt = 0
+    steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
+    for st in range(steps + 1):
+        t = st / steps
+        ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
+        cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
+        if ci < 0 or cj < 0 or ci >= g or cj >= g:
+            continue
+        for u in range(_PER_CELL):
+            q = cover[ci, cj, u]
+            if q < 0 or q == p:
+                continue
+            seen = False
+            for v in range(nt):
+                if tried[v] == q:
+                    seen = True
+                    break
+            if seen or nt == tried.shape[0]:
+                continue
+            tried[nt] = q
+            nt += 1
+            a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
+            if a1 < b1 and n1 > 0:
+                n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+            if a0 < b0 and n0 > 0:
+                n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+            if n1 == 0 and n0 == 0:
+                return n1, n0
+    return n1, n0
