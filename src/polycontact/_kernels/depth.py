@@ -22,7 +22,7 @@ from numba import njit
 
 from ..errors import DepthTooLargeError
 from .nfp import (_PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract,
-                  clip_by_cells)
+                  clip_by_cells, sum_into)
 from .relation import PENETRATING, _state
 
 
@@ -118,36 +118,8 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     for k in range(pairs.shape[0]):
         ps = bstarts[pairs[k, 0]]
         pe = bstarts[pairs[k, 0] + 1]
-        qs = rstarts[pairs[k, 1]]
-        qe = rstarts[pairs[k, 1] + 1]
-        n = pe - ps
-        m = qe - qs
-        i0 = _lowest(bxy, ps, pe)
-        j0 = _lowest(rxy, qs, qe)
-        i = 0
-        j = 0
-        while i < n or j < m:
-            pi = ps + (i0 - ps + i) % n
-            qj = qs + (j0 - qs + j) % m
-            out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
-            out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
-            w += 1
-            if i == n:
-                j += 1
-                continue
-            if j == m:
-                i += 1
-                continue
-            pn = ps + (i0 - ps + i + 1) % n
-            qn = qs + (j0 - qs + j + 1) % m
-            c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
-                bxy[pn, 1] - bxy[pi, 1]
-            ) * (rxy[qn, 0] - rxy[qj, 0])
-            # (a NaN turn, from non-finite input, advances both: the loop always ends)
-            if not c < 0.0:
-                i += 1
-            if not c > 0.0:
-                j += 1
+        w = sum_into(bxy, ps, pe, _lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
+                     rstarts[pairs[k, 1] + 1], out, w)
         starts[k + 1] = w
     return out[:w].copy(), starts
 

@@ -45,37 +45,9 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
     for bi in range(nb):
         ps = bstarts[bi]
         pe = bstarts[bi + 1]
-        n = pe - ps
         i0 = _lowest(bxy, ps, pe)
         for rj in range(nr):
-            qs = rstarts[rj]
-            qe = rstarts[rj + 1]
-            m = qe - qs
-            j0 = _lowest(rxy, qs, qe)
-            i = 0
-            j = 0
-            while i < n or j < m:
-                pi = ps + (i0 - ps + i) % n
-                qj = qs + (j0 - qs + j) % m
-                out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
-                out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
-                w += 1
-                if i == n:
-                    j += 1
-                    continue
-                if j == m:
-                    i += 1
-                    continue
-                pn = ps + (i0 - ps + i + 1) % n
-                qn = qs + (j0 - qs + j + 1) % m
-                c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
-                    bxy[pn, 1] - bxy[pi, 1]
-                ) * (rxy[qn, 0] - rxy[qj, 0])
-                # (a NaN turn, from non-finite input, advances both: the loop always ends)
-                if not c < 0.0:
-                    i += 1
-                if not c > 0.0:
-                    j += 1
+            w = sum_into(bxy, ps, pe, i0, rxy, rstarts[rj], rstarts[rj + 1], out, w)
             k += 1
             starts[k] = w
     return out[:w].copy(), starts
@@ -900,3 +872,39 @@ def clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr, starts, e
             if n1 == 0 and n0 == 0:
                 return n1, n0
     return n1, n0
+
+
+@njit(cache=True, nogil=True)
+def sum_into(bxy, ps, pe, i0, rxy, qs, qe, out, w):
+    """Write the Minkowski sum of the convex CCW pieces ``bxy[ps:pe]`` (lowest vertex
+    ``i0``) and ``rxy[qs:qe]`` into ``out`` from row ``w``, counter-clockwise from the
+    sum of their lowest vertices, by merging their edges by angle (O(p + q)); returns
+    the next free row."""
+    n = pe - ps
+    m = qe - qs
+    j0 = _lowest(rxy, qs, qe)
+    i = 0
+    j = 0
+    while i < n or j < m:
+        pi = ps + (i0 - ps + i) % n
+        qj = qs + (j0 - qs + j) % m
+        out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
+        out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
+        w += 1
+        if i == n:
+            j += 1
+            continue
+        if j == m:
+            i += 1
+            continue
+        pn = ps + (i0 - ps + i + 1) % n
+        qn = qs + (j0 - qs + j + 1) % m
+        c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
+            bxy[pn, 1] - bxy[pi, 1]
+        ) * (rxy[qn, 0] - rxy[qj, 0])
+        # (a NaN turn, from non-finite input, advances both: the loop always ends)
+        if not c < 0.0:
+            i += 1
+        if not c > 0.0:
+            j += 1
+    return w
