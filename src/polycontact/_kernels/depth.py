@@ -21,8 +21,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import DepthTooLargeError
-from .nfp import (_PER_CELL, _bboxes, _cell_cover, _clip, _compact, _frames, _lowest, _subtract,
-                  clip_by_cells, sum_into)
+from .nfp import _GRID, _bboxes, _frames, _lowest, clip_edge, sum_index, sum_into
 from .relation import PENETRATING, _state
 
 
@@ -175,24 +174,10 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
             else:
                 dist[i] = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])[2]
     by_dist = np.argsort(dist)
-    by_x = np.argsort(bb[:, 0])
-    xs = bb[by_x, 0]
-    wmax = 0.0
-    for p in range(k):
-        wmax = max(wmax, bb[p, 2] - bb[p, 0])
-    cap = 2 * k + 4
-    lo1 = np.empty(cap)
-    hi1 = np.empty(cap)
-    lo0 = np.empty(cap)
-    hi0 = np.empty(cap)
-    # Sums containing whole cells of a grid over the disk: an edge inside the union is
-    # usually covered by those of the cells it crosses, without scanning every sum.
-    g = 32
-    h = 2.0 * bound / g
-    gx0 = -bound
-    gy0 = -bound
-    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
-    tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
+    # the grid over the disk of the first escape
+    h = 2.0 * bound / _GRID
+    index = sum_index(xy, starts, bb, fr, -bound, -bound, h)
+    lo1, hi1, lo0, hi0 = index[-4:]
     hint = -1
     for oi in range(n_edges):
         i = by_dist[oi]
@@ -204,42 +189,14 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
         j = i + 1 if i + 1 < e else s
         ax, ay = xy[i, 0], xy[i, 1]
         bx, by = xy[j, 0], xy[j, 1]
-        x0 = min(ax, bx) - eps
-        x1 = max(ax, bx) + eps
-        y0 = min(ay, by) - eps
-        y1 = max(ay, by) + eps
         # only the part of the edge inside the disk of the best escape can hold a nearer one
         tlo, thi = _in_disk(ax, ay, bx, by, best)
         if tlo >= thi:
             continue
-        n1 = 1
-        n0 = 1
-        lo1[0] = tlo
-        hi1[0] = thi
-        lo0[0] = tlo
-        hi0[0] = thi
-        # the cells' covering sums along the edge first
-        n1, n0 = clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr,
-                               starts, eps, lo1, hi1, n1, lo0, hi0, n0)
+        n1, n0, hint = clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, tlo, thi, eps,
+                                 hint)
         if n1 == 0 and n0 == 0:
             continue
-        first = np.searchsorted(xs, x0 - wmax)
-        for qi in range(first - 1, k):
-            q = hint if qi < first else by_x[qi]
-            if qi >= first and xs[qi] > x1:
-                break
-            if q < 0 or (qi >= first and q == hint):
-                continue
-            if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
-                continue
-            a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
-            if a1 < b1 and n1 > 0:
-                n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-            if a0 < b0 and n0 > 0:
-                n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
-            if n1 == 0 and n0 == 0:
-                hint = q
-                break
         dx = bx - ax
         dy = by - ay
         # Uncovered parts: the outline of the union (n0) or parts covered only within

@@ -300,30 +300,18 @@ def edge_cover(xy, starts, bb, fr, eps):
     those lying within a longer outline part.
     """
     k = starts.shape[0] - 1
-    cap = 2 * k + 4
-    lo1 = np.empty(cap)
-    hi1 = np.empty(cap)
-    lo0 = np.empty(cap)
-    hi0 = np.empty(cap)
     n_edges = xy.shape[0]
     outline = np.empty((4 * n_edges, 4))
     loose = np.empty((4 * n_edges, 4))
     no = 0
     nl = 0
     hint = -1
-    by_x = np.argsort(bb[:, 0])
-    xs = bb[by_x, 0]
-    wmax = 0.0
-    for q in range(k):
-        wmax = max(wmax, bb[q, 2] - bb[q, 0])
-    # Sums containing whole cells of a grid over all sums: an edge inside the union is
-    # usually covered by those of the cells it crosses, without the scan over the boxes.
-    g = 32
+    # the grid over all sums
     gx0 = bb[:, 0].min()
     gy0 = bb[:, 1].min()
-    h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / g
-    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
-    tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
+    h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / _GRID
+    index = sum_index(xy, starts, bb, fr, gx0, gy0, h)
+    lo1, hi1, lo0, hi0 = index[-4:]
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
@@ -333,39 +321,8 @@ def edge_cover(xy, starts, bb, fr, eps):
             bx, by = xy[j, 0], xy[j, 1]
             if ax == bx and ay == by:
                 continue
-            x0 = min(ax, bx) - eps
-            x1 = max(ax, bx) + eps
-            y0 = min(ay, by) - eps
-            y1 = max(ay, by) + eps
-            n1 = 1
-            n0 = 1
-            lo1[0] = 0.0
-            hi1[0] = 1.0
-            lo0[0] = 0.0
-            hi0[0] = 1.0
-            # The cells' covering sums along the edge first (up to 2 g samples).
-            n1, n0 = clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr,
-                                   starts, eps, lo1, hi1, n1, lo0, hi0, n0)
-            # The sum that swallowed the previous edge whole is tried next: an edge
-            # inside the union is then usually done after one test. The others by their
-            # smallest x, from the first that can reach x0 (none is wider than wmax).
-            first = np.searchsorted(xs, x0 - wmax) if n1 > 0 or n0 > 0 else k + 1
-            for qi in range(first - 1, k):
-                q = hint if qi < first else by_x[qi]
-                if qi >= first and bb[q, 0] > x1:
-                    break  # sums sorted by their smallest x: none further can meet the edge
-                if q < 0 or (qi >= first and q == hint):
-                    continue
-                if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
-                    continue
-                a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
-                if a1 < b1 and n1 > 0:
-                    n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-                if a0 < b0 and n0 > 0:
-                    n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
-                if n1 == 0 and n0 == 0:
-                    hint = q
-                    break
+            n1, n0, hint = clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, 0.0, 1.0,
+                                     eps, hint)
             dx = bx - ax
             dy = by - ay
             for r in range(n0):
@@ -835,21 +792,60 @@ def merge_collinear(segs, tol):
     return s[keep].copy()
 
 
+#: Side of the grid (cells per side) whose cells remember the sums containing them whole.
+_GRID = 32
+
+
 @njit(cache=True, nogil=True)
-def clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr, starts, eps,
-                  lo1, hi1, n1, lo0, hi0, n0):
-    """Clip edge (a, b) of sum p by the sums that cover whole cells along it (up to 2 g
-    samples of the g x g grid of side h from (gx0, gy0), :func:`_cell_cover`), each sum
-    once (``tried``: the ones clipped so far), until nothing is left of either part
-    (``lo1, hi1, n1``: the parts outside the closed sums; ``lo0, hi0, n0``: outside the
-    open ones). Returns ``(n1, n0)``."""
+def sum_index(xy, starts, bb, fr, gx0, gy0, h):
+    """What :func:`clip_edge` reads to clip edges by the convex sums ``(xy, starts)``
+    (boxes ``bb``, edge frames ``fr``): the sums sorted by their smallest x (``by_x``,
+    ``xs``) and their widest box (``wmax``); a ``_GRID`` x ``_GRID`` grid of cells of
+    side ``h`` from ``(gx0, gy0)`` with the sums containing each cell whole
+    (:func:`_cell_cover`) and a buffer of the sums tried on an edge; the four interval
+    buffers of the clipped parts."""
+    k = starts.shape[0] - 1
+    by_x = np.argsort(bb[:, 0])
+    xs = bb[by_x, 0]
+    wmax = 0.0
+    for q in range(k):
+        wmax = max(wmax, bb[q, 2] - bb[q, 0])
+    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, _GRID)
+    tried = np.full(_PER_CELL * (_GRID + 2) * 4 + 4, -1, np.int64)
+    cap = 2 * k + 4
+    return (by_x, xs, wmax, cover, gx0, gy0, h, tried,
+            np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
+    """Clip the part [t0, t1] of edge (a, b) of sum p by the other sums
+    (:func:`sum_index`), until nothing is left. Returns ``(n1, n0, hint)``: the parts
+    outside every closed sum shrunk by eps (``lo1[:n1], hi1[:n1]`` of the index) and
+    outside every open sum (``lo0[:n0], hi0[:n0]``), as parameters along the edge, and
+    the sum that covered the edge whole (else ``hint`` unchanged).
+
+    The sums covering whole cells along the edge are tried first, then ``hint`` (the
+    sum that covered the previous edge: an edge inside the union is then usually done
+    after one test), then the others by their smallest x, from the first that can reach
+    the edge (none is wider than ``wmax``).
+    """
+    by_x, xs, wmax, cover, gx0, gy0, h, tried, lo1, hi1, lo0, hi0 = index
+    k = starts.shape[0] - 1
+    lo1[0] = t0
+    hi1[0] = t1
+    lo0[0] = t0
+    hi0[0] = t1
+    n1 = 1
+    n0 = 1
+    # the cells' covering sums (up to 2 _GRID samples along the edge), each once
     nt = 0
-    steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
+    steps = min(2 * _GRID, 1 + int(np.hypot(bx - ax, by - ay) / h))
     for st in range(steps + 1):
         t = st / steps
         ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
         cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
-        if ci < 0 or cj < 0 or ci >= g or cj >= g:
+        if ci < 0 or cj < 0 or ci >= _GRID or cj >= _GRID:
             continue
         for u in range(_PER_CELL):
             q = cover[ci, cj, u]
@@ -870,8 +866,28 @@ def clip_by_cells(ax, ay, bx, by, p, cover, g, h, gx0, gy0, tried, fr, starts, e
             if a0 < b0 and n0 > 0:
                 n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
             if n1 == 0 and n0 == 0:
-                return n1, n0
-    return n1, n0
+                return n1, n0, hint
+    x0 = min(ax, bx) - eps
+    x1 = max(ax, bx) + eps
+    y0 = min(ay, by) - eps
+    y1 = max(ay, by) + eps
+    first = np.searchsorted(xs, x0 - wmax)
+    for qi in range(first - 1, k):
+        q = hint if qi < first else by_x[qi]
+        if qi >= first and xs[qi] > x1:
+            break  # sorted by their smallest x: none further can meet the edge
+        if q < 0 or (qi >= first and q == hint):
+            continue
+        if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
+            continue
+        a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
+        if a1 < b1 and n1 > 0:
+            n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+        if a0 < b0 and n0 > 0:
+            n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+        if n1 == 0 and n0 == 0:
+            return n1, n0, q
+    return n1, n0, hint
 
 
 @njit(cache=True, nogil=True)
