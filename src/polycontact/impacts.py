@@ -6,9 +6,11 @@ looking at all N(N − 1)/2 pairs: each body's swept region over ``[0, t_max]`` 
 by space–time boxes (its bounding circle along its centroid's path, one box per time
 slice, :func:`polycontact._kernels.swept.swept_boxes`), a compiled sort-and-sweep lists
 the pairs whose boxes meet, and only those go to the exact search. Both run the pairs on
-threads (the compiled searches release the GIL), and every answer is the one
+threads (the compiled searches release the GIL), and every answer agrees with the one
 :func:`polycontact.time_of_impact` gives for that pair: the same kernel with the same
-arguments, and pairs the boxes leave out are pairs whose bounding circles never meet in
+arguments (the same status and state, times within the time tolerance; usually equal bit
+for bit, but the kernel compiled inside the batch loop may round a last place
+differently, which can take a search down another, equally valid path), and pairs the boxes leave out are pairs whose bounding circles never meet in
 ``[0, t_max]`` (``time_of_impact`` reports nothing for them either).
 """
 
@@ -88,8 +90,8 @@ class ImpactBatch:
         return int(self.status.shape[0])
 
     def impact(self, k: int) -> Impact:
-        """The :class:`~polycontact.Impact` of pair ``k``, equal to what
-        :func:`polycontact.time_of_impact` returns for it."""
+        """The :class:`~polycontact.Impact` of pair ``k``, agreeing with what
+        :func:`polycontact.time_of_impact` returns for it (see the module docstring)."""
         n = len(self)
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
             raise IndexError(f"k: expected a pair index in [0, {n}), got {k!r}")
@@ -286,8 +288,8 @@ def time_of_impact_many(
     ``(shapes_b[k], motions_b[k])``, in parallel.
 
     Pair k's answer is the one ``time_of_impact(shapes_a[k], motions_a[k], shapes_b[k],
-    motions_b[k], t_max=..., ...)`` gives (the same kernel with the same arguments,
-    bit for bit); the pairs are shared among ``threads`` threads, since the compiled
+    motions_b[k], t_max=..., ...)`` gives (the same kernel with the same arguments; times
+    within the time tolerance, see the module docstring); the pairs are shared among ``threads`` threads, since the compiled
     search releases the GIL. A shape that appears in many pairs (the same object) has
     its tables built once.
 
@@ -476,8 +478,8 @@ def first_impacts(
     A pair meets when its bodies touch or penetrate at some time of the window (an
     :class:`~polycontact.Impact` with a ``state``), or when its search ran out of
     iterations (no verdict: reported, never dropped). Each entry is
-    ``(i, j, impact)`` with ``i < j`` in the caller's numbering and ``impact`` equal to
-    ``time_of_impact(shapes[i], motions[i], shapes[j], motions[j], t_max=t_max, ...)``;
+    ``(i, j, impact)`` with ``i < j`` in the caller's numbering and ``impact`` agreeing
+    with ``time_of_impact(shapes[i], motions[i], shapes[j], motions[j], t_max=t_max, ...)``;
     entries are sorted by :func:`event_time`, then by ``(i, j)``. Pairs that collide
     have ``impact.collides``; the others only touch (or penetrate from the start, or
     have no verdict: ``impact.status``).
