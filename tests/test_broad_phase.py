@@ -140,3 +140,27 @@ def test_intervals_right_far_away_at_long_travel(offset, travel, speed, lateral,
         for end in (s, e):
             if 0.0 < end < t_max:
                 assert abs(dist(end) - R2) <= slack, (end, dist(end))
+
+
+@examples(200)
+@given(st.floats(-1e6, 1e6), st.sampled_from([1e-9, 1.0, 1e9]),
+       st.lists(st.sampled_from([0.0, 1.0, 1e20, 1e40, 1e60, 1e99, 2e100]), min_size=4,
+                max_size=4),
+       st.sampled_from([0.0, 1e-3, 1.0, 1e30, 1e50, 1e200]))
+def test_fast_reach_check_agrees_with_the_one_that_names_the_bound(offset, size, norms, t_max):
+    # time_of_impact tests within_reach with the base cached in the body frame and calls
+    # check_reach (which raises, naming the bound) only when it fails: the two must agree
+    from polycontact.broad_phase import base_reach, check_reach, within_reach
+
+    shape = Shape((np.array([(0, 0), (1, 0), (1, 1), (0, 1)]) + offset) * size)
+    v, acc, w, alpha = norms
+    motion = Motion(velocity=(v, 0.0), acceleration=(0.0, acc), angular_velocity=w,
+                    angular_acceleration=alpha)
+    fast = within_reach(base_reach(shape), shape.bounding_radius, motion._norms, t_max)
+    try:
+        check_reach(shape, motion, t_max, "motion_a")
+        named = True
+    except ValueError as error:
+        assert str(error).startswith("motion_a: the body's ")
+        named = False
+    assert fast == named

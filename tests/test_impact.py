@@ -9,6 +9,7 @@ the library's kernels.
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact import ImpactStatus, Motion, Shape, State, time_of_impact
+from polycontact.broad_phase import intervals_array
 
 TOL = 1e-4
 
@@ -405,8 +407,16 @@ def test_impact_result_sets_every_field():
             for _ in range(2):
                 hit = time_of_impact(sq, Motion(velocity=(1, 0)), b, mb, t_max=t_max,
                                      method=method)
-                assert fields <= set(vars(hit)), fields - set(vars(hit))
-                assert hit == pc.Impact(**{f: getattr(hit, f) for f in fields})
+                lazy = {"broad_phase", "time_tolerance"}  # filled in on first access
+                assert fields - lazy <= set(vars(hit)), fields - lazy - set(vars(hit))
+                # (pickled before the lazy fields are read; a local class cannot be)
+                copy = hit if b is sub else pickle.loads(pickle.dumps(hit))
+                built = pc.Impact(**{f: getattr(hit, f) for f in fields})
+                assert fields <= set(vars(hit)) and hit == built == copy
+                assert hit.broad_phase == tuple(map(tuple, intervals_array(
+                    sq, Motion(velocity=(1, 0)), b, mb, t_max).tolist()))
+                t = hit.time if hit.time is not None else hit.searched_to
+                assert hit.time_tolerance == max(1e-4, 4 * 2.0**-52 * abs(t))
             if b is sub:
                 ref = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), mb,
                                      t_max=t_max, method=method)

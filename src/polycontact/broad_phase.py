@@ -58,16 +58,8 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
     ...
     ValueError: motion_a: the body's coordinates reach 1e+110 within t_max = 1e+50, beyond ±1e+100: products of coordinates would overflow float64
     """
-    cx, cy = shape.centroid.tolist()
-    radius = shape.bounding_radius
-    v, acc, w, alpha = motion._norms  # |v|, |a|, |ω|, |α|, kept with the motion
-    w_max = w + alpha * t_max
-    reach = max(abs(cx), abs(cy)) + v * t_max + 0.5 * acc * t_max * t_max + radius
-    speed = v + acc * t_max + w_max * radius
-    accel = acc + (alpha + w_max * w_max) * radius
-    if reach <= COORDINATE_LIMIT and speed <= COORDINATE_LIMIT and accel <= COORDINATE_LIMIT \
-            and w_max <= COORDINATE_LIMIT:
-        return
+    reach, speed, accel, w_max = reach_terms(base_reach(shape), shape.bounding_radius,
+                                             motion._norms, t_max)
     for value, name in ((reach, "coordinates reach"), (speed, "points' speeds reach"),
                         (accel, "points' accelerations reach"), (w_max, "angular speed reaches")):
         if not value <= COORDINATE_LIMIT:
@@ -75,6 +67,42 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
                 f"{what}: the body's {name} {value:g} within t_max = {t_max:g}, beyond "
                 f"±{COORDINATE_LIMIT:g}: products of coordinates would overflow float64"
             )
+
+
+def base_reach(shape: Shape) -> float:
+    """``max(abs(cx), abs(cy)) + radius``: how far from the origin the body reaches at
+    rest, the first term of :func:`reach_terms`."""
+    cx, cy = shape.centroid.tolist()
+    return float(max(abs(cx), abs(cy)) + shape.bounding_radius)
+
+
+def within_reach(base: float, radius: float, norms: tuple[float, float, float, float],
+                 t_max: float) -> bool:
+    """Whether a body of reach ``base`` at rest (``max(abs(cx), abs(cy)) + radius``) and
+    bounding radius ``radius``, moving with ``norms`` = (abs(v), abs(a), abs(ω), abs(α))
+    (``Motion._norms``), keeps its coordinates, point speeds, point accelerations and
+    angular speed within :data:`~polycontact.tolerances.COORDINATE_LIMIT` over
+    [0, ``t_max``] (False for inf or nan). The fast test of :func:`check_reach`, which
+    says which bound is exceeded; callers with the base cached (:func:`base_reach`) call this first.
+
+    >>> within_reach(2.0, 1.0, (1.0, 0.0, 0.0, 0.0), 10.0)
+    True
+    >>> within_reach(2.0, 1.0, (1e60, 0.0, 0.0, 0.0), 1e50)
+    False
+    """
+    reach, speed, accel, w_max = reach_terms(base, radius, norms, t_max)
+    return (reach <= COORDINATE_LIMIT and speed <= COORDINATE_LIMIT
+            and accel <= COORDINATE_LIMIT and w_max <= COORDINATE_LIMIT)
+
+
+def reach_terms(base: float, radius: float, norms: tuple[float, float, float, float],
+                t_max: float) -> tuple[float, float, float, float]:
+    """Bounds over [0, ``t_max``] of the body's absolute coordinates, point speeds and
+    point accelerations, and its largest angular speed (see :func:`within_reach`)."""
+    v, acc, w, alpha = norms
+    w_max = w + alpha * t_max
+    return (base + v * t_max + 0.5 * acc * t_max * t_max, v + acc * t_max + w_max * radius,
+            acc + (alpha + w_max * w_max) * radius, w_max)
 
 
 def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) -> np.ndarray:

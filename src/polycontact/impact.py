@@ -20,13 +20,14 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._checks import finite_number
 from ._dispatch import entry_point
-from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
+from .broad_phase import (BROAD_PHASE_INFLATION, base_reach, check_motion, check_reach,
+                          check_t_max, within_reach)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
 from .bodies import BodyLike, as_shape
@@ -134,6 +135,23 @@ class Impact:
     searched_to: float = field(repr=False)
     time_tolerance: float = field(repr=False)
     _bodies: tuple[Any, ...] = field(repr=False, compare=False, default=())
+
+    if not TYPE_CHECKING:  # (mypy keeps checking attribute names)
+
+        def __getattr__(self, name: str) -> Any:
+            # ``broad_phase`` and ``time_tolerance`` of a result built by
+            # time_of_impact are filled in on first access, from what the kernel
+            # returned (``_lazy``): converting them cost more than the rest of the
+            # result. Only called for attributes not found the normal way.
+            lazy = self.__dict__.get("_lazy") if name in _LAZY else None
+            if lazy is None:
+                raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+            intervals, tol, t = lazy
+            d = self.__dict__
+            d["broad_phase"] = tuple(map(tuple, intervals.tolist()))
+            # (the kernel's formula, run in Python: the same float operations)
+            d["time_tolerance"] = float(_effective_time_tolerance()(tol, t))
+            return d[name]
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
@@ -266,7 +284,7 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     speed = ki.speed_bound(ma.array, la, mb.array, lb, t_lo, t_hi)
     if speed <= 0.0 or t_hi - t_lo <= lam / speed:
         return t_lo, t_hi
-    (ra, ea), (rb, eb) = body_frame(a), body_frame(b)
+    (ra, ea, _), (rb, eb, _) = body_frame(a), body_frame(b)
     code, hi, lo, *_ = ki._prepared_exact_search(
         ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
         lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, _ULPS, lam, MAX_ITERATIONS)
@@ -491,56 +509,60 @@ def time_of_impact(
     the number of iterations is bounded by ``max_iterations`` (status
     OUT_OF_ITERATIONS, never a hang).
     """
-    a = as_shape(a, "a")
-    b = as_shape(b, "b")
-    ma = check_motion(motion_a, "motion_a")
-    mb = check_motion(motion_b, "motion_b")
+    a = a if type(a) is Shape else as_shape(a, "a")
+    b = b if type(b) is Shape else as_shape(b, "b")
+    ma = motion_a if type(motion_a) is Motion else check_motion(motion_a, "motion_a")
+    mb = motion_b if type(motion_b) is Motion else check_motion(motion_b, "motion_b")
     t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
 
     # coordinates (checked once per shape, with its body frame) and motions whose
     # products would overflow float64 are refused
     exact = method == "exact"
-    ra, ea = body_frame(a, tables=exact, what="a")
-    rb, eb = body_frame(b, tables=exact, what="b")
-    check_reach(a, ma, t_max, "motion_a")
-    check_reach(b, mb, t_max, "motion_b")
+    ra, ea, base_a = body_frame(a, tables=exact, what="a")
+    rb, eb, base_b = body_frame(b, tables=exact, what="b")
+    la, lb = a._radius, b._radius
+    if not (within_reach(base_a, la, ma._norms, t_max)
+            and within_reach(base_b, lb, mb._norms, t_max)):
+        check_reach(a, ma, t_max, "motion_a")  # raises, naming the motion
+        check_reach(b, mb, t_max, "motion_b")
     # the size term of the distance tolerance; the kernels add the float spacing of the
     # coordinates at each time they examine (never a bound over all of [0, t_max])
     eps_rel = RELATIVE_TOLERANCE * max(a._extent, b._extent)
-    la, lb = a.bounding_radius, b.bounding_radius
-    sa, ca, sb, cb = a.packed[1], a.centroid, b.packed[1], b.centroid
     args: tuple[Any, ...]
     if exact:
-        args = (ra, sa, ca, ma.array, la, ea, rb, sb, cb, mb.array, lb, eb, t_max,
-                BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb),
-                int(max_iterations))
+        args = (ra, a._starts, a._centroid, ma._array, la, ea, rb, b._starts, b._centroid,
+                mb._array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS,
+                CONTACT_RESOLUTION * (la + lb), int(max_iterations))
     else:
-        args = (ra, sa, ca, ma.array, la, rb, sb, cb, mb.array, lb, t_max,
-                BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples))
-    out = _query(method, args, type(a) is Shape and type(b) is Shape
-                 and type(ma) is Motion and type(mb) is Motion)
+        args = (ra, a._starts, a._centroid, ma._array, la, rb, b._starts, b._centroid,
+                mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples))
+    # the compiled code called directly when every argument has the type it always has
+    # (Shapes and Motions: see :mod:`polycontact._dispatch`), else through the dispatcher
+    fixed = type(a) is type(b) is Shape and type(ma) is type(mb) is Motion
+    run = _ENTRY.get(method) if fixed else None
+    out = run(*args) if run is not None else _query(method, args, fixed)
+    # (the kernel returns Python floats and ints: Numba boxes float64 and int64 so)
     intervals, code, t_hi, t_lo, t_contact, iters, reached = out
-    return _result(a, ma, b, mb, method, _STATUS[int(code)], float(t_hi), float(t_lo),
-                   float(t_contact), int(iters), float(reached), intervals, t_max, eps_rel, tol)
+    return _result(a, ma, b, mb, method, code, t_hi, t_lo, t_contact, iters, reached,
+                   intervals, t_max, eps_rel, tol)
 
 
-#: The compiled entry points of the query kernels by method (see :func:`_query`).
+#: The compiled entry points of the query kernels by method, once :func:`_query` has
+#: found them (for Shapes and Motions).
 _ENTRY: dict[str, Any] = {}
 
 
 def _query(method: str, args: tuple[Any, ...], fixed: bool) -> tuple[Any, ...]:
     """Run the query kernel of ``method`` on ``args``. ``fixed``: the bodies are Shapes
     and the motions Motions, so every argument has the type it always has (read-only
-    shape and motion arrays, the body-frame tables, Python floats and ints) and the
-    compiled code is called without the dispatcher's type resolution (see
-    :mod:`polycontact._dispatch`); otherwise through the dispatcher."""
-    run = _ENTRY.get(method) if fixed else None
-    if run is None:
-        from ._kernels import impact as ki
+    shape and motion arrays, the body-frame tables, Python floats and ints): the
+    compiled code is found (see :mod:`polycontact._dispatch`) and kept in
+    :data:`_ENTRY` for the next calls; otherwise the call goes through the dispatcher."""
+    from ._kernels import impact as ki
 
-        run = ki.exact_query if method == "exact" else ki.sampled_query
-        if fixed:
-            run = _ENTRY[method] = entry_point(run, args)
+    run = ki.exact_query if method == "exact" else ki.sampled_query
+    if fixed:
+        run = _ENTRY[method] = entry_point(run, args)
     out: tuple[Any, ...] = run(*args)
     return out
 
@@ -549,6 +571,11 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
                   max_iterations: int) -> tuple[float, float]:
     """The options of :func:`time_of_impact` checked (an error naming each bad one):
     ``(t_max, time_tolerance)`` as floats."""
+    if (type(t_max) is float and type(time_tolerance) is float
+            and type(samples) is int and type(max_iterations) is int
+            and 0.0 <= t_max < _INF and 0.0 < time_tolerance < _INF
+            and samples >= 2 and max_iterations >= 1 and method in _METHODS):
+        return t_max, time_tolerance  # the common case, checked in one expression
     t_max = check_t_max(t_max)
     tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
@@ -564,72 +591,77 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
     return t_max, tol
 
 
+_INF = float("inf")
+
+
 def body_frame(shape: Shape, tables: bool = True,
-               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None]:
-    """``(r, tables)``: the shape's vertices relative to its centroid and, when asked
-    for, their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
-    sampled method does not need it). Built on first use and kept with the shape (it
-    is immutable), so that repeated queries on one shape build them once. On first
-    use the coordinates are also checked (:func:`polycontact.tolerances.check_range`,
-    the error naming ``what``) and the shape's extent kept (see :func:`_extent`)."""
+               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None, float]:
+    """``(r, tables, base)``: the shape's vertices relative to its centroid, when asked
+    for their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
+    sampled method does not need it), and how far the body reaches from the origin at
+    rest (:func:`polycontact.broad_phase.base_reach`, for the reach check). Built on
+    first use and kept with the shape (it is immutable), so that repeated queries on
+    one shape build them once. On first use the coordinates are also checked
+    (:func:`polycontact.tolerances.check_range`, the error naming ``what``)."""
     frame = shape._frame
     if frame is not None and (frame[1] is not None or not tables):
-        return frame[0], frame[1]
-    r, tab, extent = frame if frame is not None else (None, None, 0.0)
+        return frame
+    r, tab, base = frame if frame is not None else (None, None, 0.0)
     if r is None:
         xy = shape.packed[0]
         check_range(xy, what)
-        extent = float(np.max(xy.max(axis=0) - xy.min(axis=0)))
+        base = base_reach(shape)
         r = xy - shape.centroid
         r.flags.writeable = False
     if tables and tab is None:
         from ._kernels.advance import edge_table
 
         tab = edge_table(r, shape.packed[1])
-    shape._frame = (r, tab, extent)
-    return r, tab
+    shape._frame = frame = (r, tab, base)
+    return frame
 
 
-def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, status: ImpactStatus,
+def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, code: int,
             t_hi: float, t_lo: float, t_contact: float, iters: int, reached: float,
             intervals: np.ndarray, t_max: float, eps_rel: float, tol: float) -> Impact:
-    if not _TIME_TOLERANCE:
-        from ._kernels.impact import effective_time_tolerance
-
-        # the Python function behind the kernel (the kernel itself without the JIT)
-        _TIME_TOLERANCE.append(getattr(effective_time_tolerance, "py_func",
-                                       effective_time_tolerance))
+    """The :class:`Impact` of a query kernel's answer (``code``: its status code)."""
     first_contact = t_contact if t_contact >= 0.0 else None
-    state = None
-    time = bracket = None
-    if status is ImpactStatus.HIT:
+    state = time = bracket = None
+    if code == _HIT:
         # the kernel found the interiors overlapping at t_hi
-        time, bracket, state = t_hi, (t_lo, t_hi), State.PENETRATING
-    elif status is ImpactStatus.PENETRATING_AT_START:
-        first_contact, state = 0.0, State.PENETRATING
+        time, bracket, state = t_hi, (t_lo, t_hi), _PENETRATING
+    elif code == _AT_START:
+        first_contact, state = 0.0, _PENETRATING
     elif first_contact is not None:
-        state = State.CONTACT
-    if status is ImpactStatus.NO_HIT:
+        state = _CONTACT
+    if code == _NO_HIT:
         reached = t_max
-    # Built field by field, as the frozen dataclass's __init__ would (at a fraction of
-    # its cost per query); the tests check that every field is set.
+    # Built as the frozen dataclass's __init__ would, at a fraction of its cost per
+    # query; ``broad_phase`` and ``time_tolerance`` on first access (see
+    # ``Impact.__getattr__``). The tests check that every field is there.
     out = _new(Impact)
-    d = out.__dict__
-    d["collides"] = status is ImpactStatus.HIT
-    d["time"] = time
-    d["first_contact"] = first_contact
-    d["state"] = state
-    d["status"] = status
-    d["method"] = method
-    d["broad_phase"] = tuple(map(tuple, intervals.tolist()))
-    d["time_bracket"] = bracket
-    d["iterations"] = iters
-    d["searched_to"] = reached
-    # (the kernel's formula, run in Python: the same float operations)
-    d["time_tolerance"] = float(_TIME_TOLERANCE[0](tol, time if time is not None else reached))
-    d["_bodies"] = (a, ma, b, mb, eps_rel)
+    _set_dict(out, "__dict__", {
+        "collides": code == _HIT, "time": time, "first_contact": first_contact,
+        "state": state, "status": _STATUS[code], "method": method, "time_bracket": bracket,
+        "iterations": iters, "searched_to": reached, "_bodies": (a, ma, b, mb, eps_rel),
+        "_lazy": (intervals, tol, time if time is not None else reached)})
     return out
 
 
 _new = object.__new__
-_TIME_TOLERANCE: list[Any] = []  # [the kernel's effective_time_tolerance, as Python]
+_set_dict = object.__setattr__
+
+
+def _effective_time_tolerance() -> Any:
+    """The kernels' ``effective_time_tolerance`` as a Python function (the one behind
+    the compiled kernel, or the kernel itself without the JIT)."""
+    from ._kernels.impact import effective_time_tolerance
+
+    return getattr(effective_time_tolerance, "py_func", effective_time_tolerance)
+
+
+_LAZY = frozenset(("broad_phase", "time_tolerance"))
+# the kernels' status codes (keys of _STATUS) and the states they imply, as plain names
+# (an Enum member lookup costs more than the comparisons)
+_NO_HIT, _HIT, _AT_START = 0, 1, 2
+_PENETRATING, _CONTACT = State.PENETRATING, State.CONTACT

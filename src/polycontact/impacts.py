@@ -27,7 +27,7 @@ import numpy as np
 
 from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
 from .errors import InvalidShapeError
-from .impact import (_STATUS, _ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
+from .impact import (_ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
                      ImpactStatus, _extent, _result, body_frame, check_options)
 from .motion import Motion
 from .bodies import as_shape
@@ -156,7 +156,7 @@ def _pack(shapes: list[Shape], exact: bool) -> tuple[Any, ...]:
     """The shapes' body-frame tables one after another (see ``impacts_chunk``)."""
     frames: list[Any] = [body_frame(s, tables=exact) for s in shapes]
     n = len(shapes)
-    nv = np.array([len(r) for r, _ in frames], dtype=np.int64)
+    nv = np.array([len(f[0]) for f in frames], dtype=np.int64)
     v_off = np.zeros(n + 1, np.int64)
     np.cumsum(nv, out=v_off[1:])
     s_off = np.zeros(n + 1, np.int64)
@@ -228,9 +228,10 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
     def make(p: int) -> Impact:
         a, ma = shape_of(p, 0), motion_of(p, 0)
         b, mb = shape_of(p, 1), motion_of(p, 1)
-        return _result(a, ma, b, mb, method, _STATUS[int(code[p])], float(t_hi[p]),
+        # (the intervals copied: the result keeps them, not the whole batch's array)
+        return _result(a, ma, b, mb, method, int(code[p]), float(t_hi[p]),
                        float(t_lo[p]), float(contact[p]), int(iters[p]), float(reached[p]),
-                       iv[p, :n_iv[p]], t_max, float(eps_rel[p]), tol)
+                       iv[p, :n_iv[p]].copy(), t_max, float(eps_rel[p]), tol)
 
     return make
 
