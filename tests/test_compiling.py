@@ -92,3 +92,33 @@ def test_version():
 def test_warmup_refuses_an_unknown_family():
     with pytest.raises(ValueError, match="families: expected names from"):
         compiling.warmup(["classfication"])
+
+
+def test_a_kernel_changed_in_another_module_gets_a_fresh_cache(tmp_path):
+    # Numba checks only the file of the function it cached, but exact_query (in
+    # impact.py) has overlap_intervals (in broad_phase.py) compiled into it: after a
+    # change to broad_phase.py alone Numba loaded the old code. The cache's directory is
+    # named after all the kernels' sources, so such a change lands in a fresh one.
+    import shutil
+
+    copy = tmp_path / "_kernels"
+    shutil.copytree(PACKAGE / "_kernels", copy, ignore=shutil.ignore_patterns("__pycache__"))
+    before = compiling.kernel_sources_fingerprint(copy)
+    assert before == compiling.kernel_sources_fingerprint()
+    target = copy / "broad_phase.py"
+    target.write_text(target.read_text() + "\n# a change\n")
+    assert compiling.kernel_sources_fingerprint(copy) != before
+    # and the kernels' cache lives in the directory of the current sources
+    code = (
+        "from polycontact._kernels.advance import traversal_stack\n"
+        "from polycontact import compiling\n"
+        "traversal_stack()\n"
+        "print(traversal_stack._cache._cache_path)\n"
+        "print(compiling.kernel_sources_fingerprint())\n"
+    )
+    for env in ({"NUMBA_CACHE_DIR": str(tmp_path / "numba")}, {"XDG_CACHE_HOME": str(tmp_path)}):
+        out = _run([sys.executable, "-c", code], env)
+        assert out.returncode == 0, out.stderr
+        path, fingerprint = out.stdout.split()
+        assert Path(path).name.endswith("-" + fingerprint), path
+        assert any(Path(path).glob("advance.traversal_stack*.nbi"))

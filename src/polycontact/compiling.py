@@ -9,7 +9,9 @@ after it loads the compiled code in well under a second.
 puts its own kernels' cache in the per-user cache directory instead
 (``platformdirs.user_cache_dir("polycontact")``, e.g. ``~/.cache/polycontact/numba`` on
 Linux). Setting ``NUMBA_CACHE_DIR`` overrides this for every Numba library, as Numba
-documents; other libraries' caches are never moved by polycontact.
+documents; other libraries' caches are never moved by polycontact. Either way the
+kernels go in a subdirectory named after a hash of all the kernels' sources
+(:func:`kernel_sources_fingerprint`), since Numba tracks only each function's own file.
 
 **First run.** :func:`warmup` compiles (or loads) every kernel family and reports each
 stage to a callback; the command line says "compiling kernels, first run only, about a
@@ -27,13 +29,14 @@ True
 
 from __future__ import annotations
 
+import hashlib
 import os
 import time
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["FAMILIES", "cache_directory", "is_warm", "warmup"]
+__all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint", "warmup"]
 
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
@@ -61,17 +64,38 @@ def cache_directory() -> Path:
     return Path(platformdirs.user_cache_dir("polycontact")) / "numba"
 
 
+def kernel_sources_fingerprint(directory: Path | None = None) -> str:
+    """A hash of the sources of every kernel module (``directory``: the ``_kernels``
+    package by default), part of the cache's path.
+
+    Numba's cache checks only the file of the function it compiled, but a kernel's
+    compiled code includes the kernels it calls from other modules: after one of
+    those changes (an upgrade that keeps a file's size and time, a branch switched in
+    a source checkout) Numba would load the old code. Any change to any kernel source
+    changes this hash, hence the cache directory: the kernels are compiled afresh.
+
+    >>> len(kernel_sources_fingerprint())
+    16
+    """
+    digest = hashlib.sha256()
+    for path in sorted((directory or _PACKAGE / "_kernels").glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
 def install_cache_locator() -> None:
-    """Make Numba cache polycontact's kernels in :func:`cache_directory`.
+    """Make Numba cache polycontact's kernels in :func:`cache_directory`, in a
+    subdirectory named after the kernels' sources (:func:`kernel_sources_fingerprint`).
 
     Called by ``polycontact._kernels`` before any kernel is defined. A locator class is
     put first in Numba's list; it claims only functions whose source lies in this
-    package, and only when ``NUMBA_CACHE_DIR`` is not set (Numba's own locator then
-    applies). If this Numba has no such list, its default applies: the cache stays
-    beside the sources, which is slower to clean up but never wrong.
+    package. If this Numba has no such list, its default applies: the cache stays
+    beside the sources and is checked file by file only (see
+    :func:`kernel_sources_fingerprint`).
     """
     try:
-        from numba.core import caching, config
+        from numba.core import caching
     except ImportError:  # pragma: no cover - numba is a dependency
         return
     classes = getattr(getattr(caching, "CacheImpl", None), "_locator_classes", None)
@@ -80,6 +104,7 @@ def install_cache_locator() -> None:
         return
     if any(getattr(c, "_polycontact", False) for c in classes):
         return
+    fingerprint = kernel_sources_fingerprint()
 
     class _Locator(base):  # type: ignore[misc, valid-type]
         _polycontact = True
@@ -88,11 +113,11 @@ def install_cache_locator() -> None:
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
             sub = self.get_suitable_cache_subpath(py_file)
-            self._cache_path = str(cache_directory() / sub)
+            self._cache_path = str(cache_directory() / f"{sub}-{fingerprint}")
 
         @classmethod
         def from_function(cls, py_func: Any, py_file: str) -> Any:
-            if getattr(config, "CACHE_DIR", "") or not Path(py_file).resolve().is_relative_to(_PACKAGE):
+            if not Path(py_file).resolve().is_relative_to(_PACKAGE):
                 return None
             locator = cls(py_func, py_file)
             try:
