@@ -55,6 +55,21 @@ def test_nonpositive_intervals_match_numpy_roots(d0, dv, acc, r):
             assert any(a - 1e-9 <= m <= b + 1e-9 for a, b in out)
 
 
+@given(st.tuples(small, small), st.tuples(small, small), st.tuples(small, small),
+       st.floats(0.1, 5))
+def test_interval_ends_are_sign_changes_to_adjacent_floats(d0, dv, acc, r):
+    # the root finder (false position and halving) must still end, at every end
+    # strictly inside [0, 3], on an exact zero of |D(t)| - r or on a sign change of it
+    # between adjacent floats
+    ca, ma, cb, mb = _motion_pair(d0, dv, acc)
+    p = kb.relative_motion(ca, ma, cb, mb)
+    f = lambda t: kb.derivative(p, r, 0, t) <= 0.0  # noqa: E731
+    for x in kb.nonpositive_intervals(p, r, 0.0, 3.0).ravel():
+        if 0.0 < x < 3.0:
+            below, above = np.nextafter(x, -np.inf), np.nextafter(x, np.inf)
+            assert kb.derivative(p, r, 0, x) == 0.0 or f(below) != f(x) or f(x) != f(above)
+
+
 @given(st.tuples(small, small), st.tuples(small, small), st.tuples(small, small))
 def test_distance_is_monotone_between_breakpoints(d0, dv, acc):
     ca, ma, cb, mb = _motion_pair(d0, dv, acc)
