@@ -58,10 +58,12 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
     ...
     ValueError: motion_a: the body's coordinates reach 1e+110 within t_max = 1e+50, beyond ±1e+100: products of coordinates would overflow float64
     """
-    reach, speed, accel, w_max = reach_terms(base_reach(shape), shape.bounding_radius,
-                                             motion._norms, t_max)
-    for value, name in ((reach, "coordinates reach"), (speed, "points' speeds reach"),
-                        (accel, "points' accelerations reach"), (w_max, "angular speed reaches")):
+    excess = reach_excess(base_reach(shape), shape.bounding_radius, motion._norms, t_max)
+    if excess is None:
+        return
+    names = ("coordinates reach", "points' speeds reach", "points' accelerations reach",
+             "angular speed reaches")
+    for value, name in zip(excess, names):
         if not value <= COORDINATE_LIMIT:
             raise ValueError(
                 f"{what}: the body's {name} {value:g} within t_max = {t_max:g}, beyond "
@@ -71,38 +73,34 @@ def check_reach(shape: Shape, motion: Motion, t_max: float, what: str) -> None:
 
 def base_reach(shape: Shape) -> float:
     """``max(abs(cx), abs(cy)) + radius``: how far from the origin the body reaches at
-    rest, the first term of :func:`reach_terms`."""
+    rest (the first term of :func:`reach_excess`)."""
     cx, cy = shape.centroid.tolist()
     return float(max(abs(cx), abs(cy)) + shape.bounding_radius)
 
 
-def within_reach(base: float, radius: float, norms: tuple[float, float, float, float],
-                 t_max: float) -> bool:
-    """Whether a body of reach ``base`` at rest (``max(abs(cx), abs(cy)) + radius``) and
-    bounding radius ``radius``, moving with ``norms`` = (abs(v), abs(a), abs(ω), abs(α))
+def reach_excess(base: float, radius: float, norms: tuple[float, float, float, float],
+                 t_max: float) -> tuple[float, float, float, float] | None:
+    """None when a body of reach ``base`` at rest (:func:`base_reach`) and bounding
+    radius ``radius``, moving with ``norms`` = (abs(v), abs(a), abs(ω), abs(α))
     (``Motion._norms``), keeps its coordinates, point speeds, point accelerations and
     angular speed within :data:`~polycontact.tolerances.COORDINATE_LIMIT` over
-    [0, ``t_max``] (False for inf or nan). The fast test of :func:`check_reach`, which
-    says which bound is exceeded; callers with the base cached (:func:`base_reach`) call this first.
+    [0, ``t_max``]; else those four bounds (one of them beyond the limit, or nan). The
+    test of :func:`check_reach`, for callers that keep the base (time_of_impact).
 
-    >>> within_reach(2.0, 1.0, (1.0, 0.0, 0.0, 0.0), 10.0)
+    >>> reach_excess(2.0, 1.0, (1.0, 0.0, 0.0, 0.0), 10.0) is None
     True
-    >>> within_reach(2.0, 1.0, (1e60, 0.0, 0.0, 0.0), 1e50)
-    False
+    >>> reach_excess(2.0, 1.0, (1e60, 0.0, 0.0, 0.0), 1e50)[0]
+    1e+110
     """
-    reach, speed, accel, w_max = reach_terms(base, radius, norms, t_max)
-    return (reach <= COORDINATE_LIMIT and speed <= COORDINATE_LIMIT
-            and accel <= COORDINATE_LIMIT and w_max <= COORDINATE_LIMIT)
-
-
-def reach_terms(base: float, radius: float, norms: tuple[float, float, float, float],
-                t_max: float) -> tuple[float, float, float, float]:
-    """Bounds over [0, ``t_max``] of the body's absolute coordinates, point speeds and
-    point accelerations, and its largest angular speed (see :func:`within_reach`)."""
     v, acc, w, alpha = norms
     w_max = w + alpha * t_max
-    return (base + v * t_max + 0.5 * acc * t_max * t_max, v + acc * t_max + w_max * radius,
-            acc + (alpha + w_max * w_max) * radius, w_max)
+    reach = base + v * t_max + 0.5 * acc * t_max * t_max
+    speed = v + acc * t_max + w_max * radius
+    accel = acc + (alpha + w_max * w_max) * radius
+    if (reach <= COORDINATE_LIMIT and speed <= COORDINATE_LIMIT and accel <= COORDINATE_LIMIT
+            and w_max <= COORDINATE_LIMIT):
+        return None
+    return reach, speed, accel, w_max
 
 
 def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) -> np.ndarray:

@@ -27,7 +27,7 @@ import numpy as np
 from ._checks import finite_number
 from ._dispatch import entry_point
 from .broad_phase import (BROAD_PHASE_INFLATION, base_reach, check_motion, check_reach,
-                          check_t_max, within_reach)
+                          check_t_max, reach_excess)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
 from .bodies import BodyLike, as_shape
@@ -521,8 +521,8 @@ def time_of_impact(
     ra, ea, base_a = body_frame(a, tables=exact, what="a")
     rb, eb, base_b = body_frame(b, tables=exact, what="b")
     la, lb = a._radius, b._radius
-    if not (within_reach(base_a, la, ma._norms, t_max)
-            and within_reach(base_b, lb, mb._norms, t_max)):
+    if (reach_excess(base_a, la, ma._norms, t_max) is not None
+            or reach_excess(base_b, lb, mb._norms, t_max) is not None):
         check_reach(a, ma, t_max, "motion_a")  # raises, naming the motion
         check_reach(b, mb, t_max, "motion_b")
     # the size term of the distance tolerance; the kernels add the float spacing of the
