@@ -518,8 +518,12 @@ def time_of_impact(
     # coordinates (checked once per shape, with its body frame) and motions whose
     # products would overflow float64 are refused
     exact = method == "exact"
-    ra, ea, base_a = body_frame(a, tables=exact, what="a")
-    rb, eb, base_b = body_frame(b, tables=exact, what="b")
+    fa, fb = a._frame, b._frame  # (the frames built, as body_frame returns them)
+    if fa is None or exact and fa[1] is None:
+        fa = body_frame(a, tables=exact, what="a")
+    if fb is None or exact and fb[1] is None:
+        fb = body_frame(b, tables=exact, what="b")
+    (ra, ea, base_a), (rb, eb, base_b) = fa, fb
     la, lb = a._radius, b._radius
     if (reach_excess(base_a, la, ma._norms, t_max) is not None
             or reach_excess(base_b, lb, mb._norms, t_max) is not None):
@@ -541,10 +545,7 @@ def time_of_impact(
     fixed = type(a) is type(b) is Shape and type(ma) is type(mb) is Motion
     run = _ENTRY.get(method) if fixed else None
     out = run(*args) if run is not None else _query(method, args, fixed)
-    # (the kernel returns Python floats and ints: Numba boxes float64 and int64 so)
-    intervals, code, t_hi, t_lo, t_contact, iters, reached = out
-    return _result(a, ma, b, mb, method, code, t_hi, t_lo, t_contact, iters, reached,
-                   intervals, t_max, eps_rel, tol)
+    return _result(a, ma, b, mb, method, out, t_max, eps_rel, tol)
 
 
 #: The compiled entry points of the query kernels by method, once :func:`_query` has
@@ -621,10 +622,12 @@ def body_frame(shape: Shape, tables: bool = True,
     return frame
 
 
-def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, code: int,
-            t_hi: float, t_lo: float, t_contact: float, iters: int, reached: float,
-            intervals: np.ndarray, t_max: float, eps_rel: float, tol: float) -> Impact:
-    """The :class:`Impact` of a query kernel's answer (``code``: its status code)."""
+def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, out: tuple[Any, ...],
+            t_max: float, eps_rel: float, tol: float) -> Impact:
+    """The :class:`Impact` of a query kernel's answer ``out`` = (intervals, status code,
+    t_hi, t_lo, first contact, iterations, t_reached): Python floats and ints (Numba
+    boxes float64 and int64 so) and the intervals' array."""
+    intervals, code, t_hi, t_lo, t_contact, iters, reached = out
     first_contact = t_contact if t_contact >= 0.0 else None
     state = time = bracket = None
     if code == _HIT:
@@ -639,13 +642,13 @@ def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, code: int,
     # Built as the frozen dataclass's __init__ would, at a fraction of its cost per
     # query; ``broad_phase`` and ``time_tolerance`` on first access (see
     # ``Impact.__getattr__``). The tests check that every field is there.
-    out = _new(Impact)
-    _set_dict(out, "__dict__", {
+    impact = _new(Impact)
+    _set_dict(impact, "__dict__", {
         "collides": code == _HIT, "time": time, "first_contact": first_contact,
         "state": state, "status": _STATUS[code], "method": method, "time_bracket": bracket,
         "iterations": iters, "searched_to": reached, "_bodies": (a, ma, b, mb, eps_rel),
         "_lazy": (intervals, tol, time if time is not None else reached)})
-    return out
+    return impact
 
 
 _new = object.__new__

@@ -229,9 +229,10 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
         a, ma = shape_of(p, 0), motion_of(p, 0)
         b, mb = shape_of(p, 1), motion_of(p, 1)
         # (the intervals copied: the result keeps them, not the whole batch's array)
-        return _result(a, ma, b, mb, method, int(code[p]), float(t_hi[p]),
-                       float(t_lo[p]), float(contact[p]), int(iters[p]), float(reached[p]),
-                       iv[p, :n_iv[p]].copy(), t_max, float(eps_rel[p]), tol)
+        return _result(a, ma, b, mb, method,
+                       (iv[p, :n_iv[p]].copy(), int(code[p]), float(t_hi[p]), float(t_lo[p]),
+                        float(contact[p]), int(iters[p]), float(reached[p])),
+                       t_max, float(eps_rel[p]), tol)
 
     return make
 
