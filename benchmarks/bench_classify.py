@@ -14,7 +14,9 @@ What is timed (medians of several repeats, peers measured in the same run):
   ``shapely.relate`` (a simulation's loop), taking turns every 50 pairs, with the
   target ratio;
 - signed distances of the 100 000 pairs (``classify_many(...).distances``) against the
-  states alone, and for the separate pairs against ``shapely.distance`` (targets printed);
+  states alone (also with every pair made distinct: the pairs repeat 3000, and each
+  distinct pair's depth is computed once), and for the separate pairs against
+  ``shapely.distance`` (targets printed);
 - growth from 8 to 1024 vertices;
 - ``python -X importtime -c "import polycontact"``.
 

@@ -13,6 +13,9 @@ that disk's box are summed, and the sums' edges are visited in increasing distan
 the origin, each clipped by the open sums (the one that covered the previous edge first)
 until the first uncovered part; the search stops when the next edge is farther than the
 best escape found. Uncovered parts are confirmed with the state kernel.
+
+Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
+body is decomposed once and each distinct pair computed once, in parallel.
 """
 
 from __future__ import annotations
