@@ -14,7 +14,9 @@ What is timed (medians of several repeats, peers measured in the same run):
   ``shapely.relate`` (a simulation's loop), taking turns every 50 pairs, with the
   target ratio;
 - signed distances of the 100 000 pairs (``classify_many(...).distances``) against the
-  states alone, and for the separate pairs against ``shapely.distance`` (targets printed);
+  states alone (also with every pair made distinct: the pairs repeat 3000, and each
+  distinct pair's depth is computed once), and for the separate pairs against
+  ``shapely.distance`` (targets printed);
 - growth from 8 to 1024 vertices;
 - ``python -X importtime -c "import polycontact"``.
 
@@ -201,6 +203,65 @@ def import_time() -> float:
     return statistics.median(runs)
 
 
+def distance_rows(arr_a: np.ndarray, arr_b: np.ndarray, repeats: int) -> None:
+    """The signed-distance rows: ``classify_many(...).distances`` of the pairs against
+    the states alone, the same with every pair distinct, and the separate pairs
+    against ``shapely.distance`` (prebuilt)."""
+    print("\nsigned distances of the same 100 000 pairs (seconds, median (min-max) of "
+          f"{repeats} runs, each from a fresh classify_many)")
+    states_t, dist_t = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        batch = pc.classify_many(arr_a, arr_b)
+        t1 = time.perf_counter()
+        batch.distances  # noqa: B018 - computed on first access
+        states_t.append(t1 - t0)
+        dist_t.append(time.perf_counter() - t1)
+    print(f"  states                                  {spread(states_t)}")
+    print(f"  distances (on first access)             {spread(dist_t)}")
+    print(f"  distances / states (per run):          {ratio_text(dist_t, states_t, 3.0, True)}")
+    # The 100 000 pairs repeat 3000 pairs: the depth is computed once per distinct pair
+    # (and the pieces once per distinct body). The same pairs made all distinct (A and B
+    # shifted alike by p 2^-20 along x) show the cost of one depth per pair.
+    shift = np.zeros((len(arr_a), 1, 2))
+    shift[:, 0, 0] = np.arange(len(arr_a)) * 2.0**-20
+    uni_a, uni_b = arr_a + shift, arr_b + shift
+    uni_states, uni_dist = [], []
+    for _ in range(max(3, repeats // 2)):
+        t0 = time.perf_counter()
+        b_uni = pc.classify_many(uni_a, uni_b)
+        t1 = time.perf_counter()
+        b_uni.distances  # noqa: B018
+        uni_states.append(t1 - t0)
+        uni_dist.append(time.perf_counter() - t1)
+    print(f"  all pairs distinct ({np.bincount(b_uni.states, minlength=3).tolist()} "
+          f"separate/contact/penetrating): states {spread(uni_states)}, distances "
+          f"{spread(uni_dist)}")
+    print(f"    distances / states (per run):        "
+          f"{ratio_text(uni_dist, uni_states, 3.0, True)}")
+    sep = batch.states == 0
+    sep_a, sep_b = np.ascontiguousarray(arr_a[sep]), np.ascontiguousarray(arr_b[sep])
+    poly_sa, poly_sb = shapely.polygons(sep_a), shapely.polygons(sep_b)
+    ours_sep, ours_sep_total, geos_sep = [], [], []
+    for _ in range(repeats):  # interleaved, fresh batch each time
+        t0 = time.perf_counter()
+        b_sep = pc.classify_many(sep_a, sep_b)
+        t1 = time.perf_counter()
+        b_sep.distances  # noqa: B018
+        t2 = time.perf_counter()
+        shapely.distance(poly_sa, poly_sb)
+        t3 = time.perf_counter()
+        ours_sep.append(t2 - t1)
+        ours_sep_total.append(t2 - t0)
+        geos_sep.append(t3 - t2)
+    print(f"  the {int(sep.sum())} separate pairs: distances {spread(ours_sep)}, with their "
+          f"states {spread(ours_sep_total)}, shapely.distance (prebuilt) {spread(geos_sep)}")
+    print(f"    shapely.distance / distances:          {ratio_text(geos_sep, ours_sep, 5.0)}")
+    print(f"    shapely.distance / (states+distances): {ratio_text(geos_sep, ours_sep_total, 5.0)}")
+    np.testing.assert_allclose(b_sep.distances, shapely.distance(poly_sa, poly_sb),
+                               rtol=1e-9, atol=1e-12)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer pairs and repeats")
@@ -254,41 +315,7 @@ def main() -> None:
     print(f"  shapely.intersects (prebuilt)          {t_int:8.3f}   ratio {t_int / t_many:6.1f}x")
     print(f"  shapely.polygons x2 + relate           {t_build + t_rel:8.3f}   "
           f"ratio {(t_build + t_rel) / t_many:6.1f}x")
-    print("\nsigned distances of the same 100 000 pairs (seconds, median (min-max) of "
-          f"{repeats} runs, each from a fresh classify_many)")
-    states_t, dist_t = [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        batch = pc.classify_many(arr_a, arr_b)
-        t1 = time.perf_counter()
-        batch.distances  # noqa: B018 - computed on first access
-        states_t.append(t1 - t0)
-        dist_t.append(time.perf_counter() - t1)
-    totals = [s + d for s, d in zip(states_t, dist_t)]
-    print(f"  states                                  {spread(states_t)}")
-    print(f"  distances (on first access)             {spread(dist_t)}")
-    print(f"  distances / states (per run):          {ratio_text(dist_t, states_t, 3.0, True)}")
-    sep = batch.states == 0
-    sep_a, sep_b = np.ascontiguousarray(arr_a[sep]), np.ascontiguousarray(arr_b[sep])
-    poly_sa, poly_sb = shapely.polygons(sep_a), shapely.polygons(sep_b)
-    ours_sep, ours_sep_total, geos_sep = [], [], []
-    for _ in range(repeats):  # interleaved, fresh batch each time
-        t0 = time.perf_counter()
-        b_sep = pc.classify_many(sep_a, sep_b)
-        t1 = time.perf_counter()
-        b_sep.distances  # noqa: B018
-        t2 = time.perf_counter()
-        shapely.distance(poly_sa, poly_sb)
-        t3 = time.perf_counter()
-        ours_sep.append(t2 - t1)
-        ours_sep_total.append(t2 - t0)
-        geos_sep.append(t3 - t2)
-    print(f"  the {int(sep.sum())} separate pairs: distances {spread(ours_sep)}, with their "
-          f"states {spread(ours_sep_total)}, shapely.distance (prebuilt) {spread(geos_sep)}")
-    print(f"    shapely.distance / distances:          {ratio_text(geos_sep, ours_sep, 5.0)}")
-    print(f"    shapely.distance / (states+distances): {ratio_text(geos_sep, ours_sep_total, 5.0)}")
-    np.testing.assert_allclose(b_sep.distances, shapely.distance(poly_sa, poly_sb),
-                               rtol=1e-9, atol=1e-12)
+    distance_rows(arr_a, arr_b, repeats)
     many = pc.classify_many(arr_a, arr_b).states[:3000]
     rel = shapely.relate(poly_a[:3000], poly_b[:3000])
     inter = shapely.intersects(poly_a[:3000], poly_b[:3000])

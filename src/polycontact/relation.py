@@ -512,9 +512,9 @@ class RelationBatch:
 
         pack = self._pack()
         out = km.many_distances(*pack, self.states, self.tolerances)
-        # the depths need convex pieces (Python-side decomposition cache): one by one
-        for p in np.flatnonzero(self.states == kr.PENETRATING):
-            out[p] = -kd.penetration(*km.oriented_pair(*pack, p), self.tolerances[p])[0]
+        pen = np.flatnonzero(self.states == kr.PENETRATING)
+        if pen.size:
+            out[pen] = -kd.penetrations(*pack, pen, self.tolerances[pen])[:, 0]
         return cast("np.ndarray", out)
 
 

@@ -13,16 +13,21 @@ that disk's box are summed, and the sums' edges are visited in increasing distan
 the origin, each clipped by the open sums (the one that covered the previous edge first)
 until the first uncovered part; the search stops when the next edge is farther than the
 best escape found. Uncovered parts are confirmed with the state kernel.
+
+Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
+body is decomposed once and each distinct pair computed once, in parallel.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..errors import DepthTooLargeError
-from .nfp import _GRID, _bboxes, _frames, _lowest, clip_edge, sum_index, sum_into
+from .nfp import _GRID, _PER_CELL, _bboxes, _frames, _lowest, clip_edge, sum_index, sum_into
+from .decompose import ring_pieces
 from .relation import PENETRATING, _state
+from .relation_many import _body, _oriented
 
 
 @njit(cache=True, nogil=True)
@@ -123,6 +128,32 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     return out[:w].copy(), starts
 
 
+#: Up to this many convex sums, :func:`depth_from_pieces` clips the edges without the grid
+#: of :func:`polycontact._kernels.nfp.sum_index` (building it costs more than it saves
+#: there: 83 against 26 us per penetrating pair of 12-gons, about 9 sums).
+_GRID_FROM = 128
+
+
+@njit(cache=True, nogil=True)
+def _scan_index(xy, starts, bb):
+    """The index of :func:`polycontact._kernels.nfp.sum_index` without its grid: one cell
+    of infinite side that no sum is said to cover, so that
+    :func:`polycontact._kernels.nfp.clip_edge` goes straight to the hint and the scan of
+    the sums by their smallest x (the same clips; what is skipped is the set-up of the
+    cells, about O(32² k) for k sums)."""
+    k = starts.shape[0] - 1
+    by_x = np.argsort(bb[:, 0])
+    xs = bb[by_x, 0]
+    wmax = 0.0
+    for q in range(k):
+        wmax = max(wmax, bb[q, 2] - bb[q, 0])
+    cover = np.full((1, 1, _PER_CELL), -1, np.int64)
+    tried = np.empty(_PER_CELL * 2, np.int64)
+    cap = 2 * k + 4
+    return (by_x, xs, wmax, cover, 0.0, 0.0, np.inf, tried,
+            np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
+
+
 @njit(cache=True, nogil=True)
 def _escapes(xa, sa, xb, sb, dx, dy, eps):
     """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict)."""
@@ -134,14 +165,16 @@ def _escapes(xa, sa, xb, sb, dx, dy, eps):
 
 @njit(cache=True, nogil=True)
 def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                      max_vertices):
+                      max_vertices, grid_from=_GRID_FROM):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
     bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
     ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap.
     Returns ``(bound, bdx, bdy)`` when nothing nearer ends it, NaNs when the sums would
-    hold more than ``max_vertices`` vertices (none is built).
+    hold more than ``max_vertices`` vertices (none is built). The edges are clipped with
+    the grid of :func:`polycontact._kernels.nfp.sum_index` when there are more than
+    ``grid_from`` sums, else by the scan alone (:func:`_scan_index`).
 
     Cost: with P pairs of pieces whose sums' boxes meet the disk of radius ``bound`` and
     K edges of those sums nearer than the depth, O((p + q) log(p + q) + P + K log K)
@@ -174,9 +207,10 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
             else:
                 dist[i] = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])[2]
     by_dist = np.argsort(dist)
-    # the grid over the disk of the first escape
-    h = 2.0 * bound / _GRID
-    index = sum_index(xy, starts, bb, fr, -bound, -bound, h)
+    if k > grid_from:  # the grid over the disk of the first escape
+        index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID)
+    else:
+        index = _scan_index(xy, starts, bb)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = -1
     for oi in range(n_edges):
@@ -228,9 +262,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
 
     Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). The first escape is out of B's bounding box; then
-    :func:`depth_from_pieces` looks for a nearer one on the union of the convex sums of
-    the pieces of B and −A (decomposed in O(n log n), cached by coordinates).
+    the left of every edge). The first escape is out of B's bounding box
+    (:func:`box_escape`); then :func:`depth_from_pieces` looks for a nearer one on the
+    union of the convex sums of the pieces of B and −A (decomposed in O(n log n), cached
+    by coordinates).
 
     Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
     pieces whose sums reach the disk of the first escape and their K edges, plus the
@@ -252,25 +287,57 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """
     from ..nfp import _pieces_packed
 
-    ax0, ay0 = xa.min(axis=0)
-    ax1, ay1 = xa.max(axis=0)
-    bx0, by0 = xb.min(axis=0)
-    bx1, by1 = xb.max(axis=0)
-    bound, bdx, bdy = float(bx1 - ax0), float(bx1 - ax0), 0.0
-    for m, mx, my in ((ax1 - bx0, -1.0, 0.0), (by1 - ay0, 0.0, 1.0), (ay1 - by0, 0.0, -1.0)):
-        if m < bound:
-            bound, bdx, bdy = float(m), mx * float(m), my * float(m)
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, bound, bdx, bdy, eps,
+    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *box_escape(xa, xb), eps,
                             MAX_SUM_VERTICES)
     if np.isnan(got[0]):
-        raise DepthTooLargeError(
-            f"penetration depth: the convex sums of the pieces near the overlap would hold "
-            f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({len(xa)} and "
-            f"{len(xb)} vertices) are too large and interlocked for this depth"
-        )
+        raise _too_large(len(xa), len(xb))
     return got
+
+
+def _too_large(m: int, n: int) -> DepthTooLargeError:
+    return DepthTooLargeError(
+        f"penetration depth: the convex sums of the pieces near the overlap would hold "
+        f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({m} and "
+        f"{n} vertices) are too large and interlocked for this depth"
+    )
+
+
+@njit(cache=True, nogil=True)
+def box_escape(xa, xb):
+    """The shortest of the four axis translations of A (vertices ``xa``) that take it
+    out of the bounding box of B (vertices ``xb``): ``(length, dx, dy)``; the first of
+    +x, −x, +y, −y on a tie."""
+    ax0 = ax1 = xa[0, 0]
+    ay0 = ay1 = xa[0, 1]
+    for i in range(1, xa.shape[0]):
+        ax0 = min(ax0, xa[i, 0])
+        ax1 = max(ax1, xa[i, 0])
+        ay0 = min(ay0, xa[i, 1])
+        ay1 = max(ay1, xa[i, 1])
+    bx0 = bx1 = xb[0, 0]
+    by0 = by1 = xb[0, 1]
+    for i in range(1, xb.shape[0]):
+        bx0 = min(bx0, xb[i, 0])
+        bx1 = max(bx1, xb[i, 0])
+        by0 = min(by0, xb[i, 1])
+        by1 = max(by1, xb[i, 1])
+    bound = bx1 - ax0
+    bdx = bound
+    bdy = 0.0
+    if ax1 - bx0 < bound:
+        bound = ax1 - bx0
+        bdx = -bound
+    if by1 - ay0 < bound:
+        bound = by1 - ay0
+        bdx = 0.0
+        bdy = bound
+    if ay1 - by0 < bound:
+        bound = ay1 - by0
+        bdx = 0.0
+        bdy = -bound
+    return bound, bdx, bdy
 
 
 #: Most vertices of convex sums the depth builds (about 80 bytes each with their frames
@@ -279,3 +346,211 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
 MAX_SUM_VERTICES = 30_000_000
 
 
+
+
+# -- many pairs (classify_many's distances) ------------------------------------------------
+
+
+@njit(cache=True, nogil=True)
+def _same_body(x, ls, bs, f, p, q):
+    """Whether bodies p and q of a packed batch are equal (loops, orientation, vertices)."""
+    if f[p] != f[q] or bs[p + 1] - bs[p] != bs[q + 1] - bs[q]:
+        return False
+    p0 = ls[bs[p]]
+    q0 = ls[bs[q]]
+    for k in range(bs[p + 1] - bs[p]):
+        if ls[bs[p] + k] - p0 != ls[bs[q] + k] - q0:
+            return False
+    for i in range(ls[bs[p + 1] - 1] - p0):
+        if x[p0 + i, 0] != x[q0 + i, 0] or x[p0 + i, 1] != x[q0 + i, 1]:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def distinct_bodies(x, ls, bs, f, ids):
+    """The distinct bodies among bodies ``ids`` of a packed batch: ``(first, slot)``,
+    ``first`` the ids of the distinct ones (each at its first occurrence, in order) and
+    ``slot[k]`` the position in ``first`` of the body equal to ``ids[k]``.
+
+    Bodies are grouped by a weighted sum of their coordinates (equal bodies have equal
+    sums), then compared in full within a group: O(n log n) for n bodies, plus the
+    comparisons, one per body unless different bodies share a sum.
+    """
+    n = ids.shape[0]
+    key = np.empty(n)
+    for k in range(n):
+        p = ids[k]
+        r0 = ls[bs[p]]
+        h = f[p] + (ls[bs[p + 1] - 1] - r0) + 0.5 * (bs[p + 1] - bs[p])
+        for i in range(ls[bs[p + 1] - 1] - r0):
+            w = 1.0 + 0.6180339887498949 * i - np.floor(0.6180339887498949 * i)
+            h += w * x[r0 + i, 0] + (w + 0.25) * x[r0 + i, 1]
+        key[k] = h
+    order = np.argsort(key, kind="mergesort")  # equal keys stay in order: first is first
+    rep = np.empty(n, np.int64)  # the first k' of ids equal to ids[k]
+    reps = np.empty(n, np.int64)  # the distinct ones of the current group
+    g = 0
+    while g < n:
+        e = g + 1
+        while e < n and key[order[e]] == key[order[g]]:
+            e += 1
+        m = 0
+        for u in range(g, e):
+            k = order[u]
+            rep[k] = k
+            for v in range(m):
+                if _same_body(x, ls, bs, f, ids[reps[v]], ids[k]):
+                    rep[k] = reps[v]
+                    break
+            if rep[k] == k:
+                reps[m] = k
+                m += 1
+        g = e
+    slot = np.empty(n, np.int64)
+    first = np.empty(n, np.int64)
+    m = 0
+    for k in range(n):
+        if rep[k] == k:
+            slot[k] = m
+            first[m] = ids[k]
+            m += 1
+        else:
+            slot[k] = slot[rep[k]]
+    return first[:m].copy(), slot
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
+    """Convex CCW pieces of bodies ``ids`` of a packed batch (oriented: interior on the
+    left), by :func:`polycontact._kernels.decompose.ring_pieces`, negated (the pieces
+    of −A) if ``negate``: ``(xy, starts, first, count, ok)``. Body k's pieces are
+    ``starts[first[k]:first[k] + count[k] + 1]`` (rows of ``xy``); ``ok[k]`` is False
+    for a body that ring_pieces does not decompose (holes, or a long concave ring):
+    the caller decomposes those (its rows are reserved for none)."""
+    n = ids.shape[0]
+    row = np.zeros(n + 1, np.int64)
+    first = np.zeros(n + 1, np.int64)
+    for k in range(n):
+        p = ids[k]
+        v = ls[bs[p + 1] - 1] - ls[bs[p]]
+        single = bs[p + 1] - bs[p] == 2
+        # convex: the ring itself; else at most 3 (v - 2) vertices of merged triangles
+        row[k + 1] = row[k] + (0 if not single else 3 * v if v <= max_ear else v)
+        first[k + 1] = first[k] + (v + 1 if single else 0)
+    xy = np.empty((row[n], 2))
+    starts = np.empty(first[n], np.int64)
+    count = np.zeros(n, np.int64)
+    ok = np.zeros(n, np.bool_)
+    for k in prange(n):
+        p = ids[k]
+        if bs[p + 1] - bs[p] != 2:
+            continue
+        ring = x[ls[bs[p]] : ls[bs[p] + 1]]
+        if f[p] < 0.0:
+            ring = ring[::-1].copy()
+        done, pxy, pst = ring_pieces(ring, rel, ulps, max_ear)
+        if not done:
+            continue
+        ok[k] = True
+        count[k] = pst.shape[0] - 1
+        sign = -1.0 if negate else 1.0
+        for i in range(pxy.shape[0]):
+            xy[row[k] + i, 0] = sign * pxy[i, 0]
+            xy[row[k] + i, 1] = sign * pxy[i, 1]
+        for i in range(pst.shape[0]):
+            starts[first[k] + i] = row[k] + pst[i]
+    return xy, starts, first[:n].copy(), count, ok
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy, rst,
+                    rfirst, rcount, slot_b, bxy, bst, bfirst, bcount, max_vertices):
+    """Penetration depths ``(P, 3)`` (depth, dx, dy; NaNs as in
+    :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, in
+    parallel: pair k's A has the pieces of −A number ``slot_a[k]`` of
+    ``(rxy, rst, rfirst, rcount)`` (see :func:`pieces_of_bodies`), its B those number
+    ``slot_b[k]`` of ``(bxy, bst, bfirst, bcount)``; ``eps`` per pair."""
+    n = pairs.shape[0]
+    out = np.empty((n, 3))
+    for k in prange(n):
+        p = pairs[k]
+        ya, sa = _body(xa, lsa, bsa, p)
+        yb, sb = _body(xb, lsb, bsb, p)
+        ya = _oriented(ya, sa, fa[p])
+        yb = _oriented(yb, sb, fb[p])
+        ra = rfirst[slot_a[k]]
+        rb = bfirst[slot_b[k]]
+        bound, bdx, bdy = box_escape(ya, yb)
+        out[k, 0], out[k, 1], out[k, 2] = depth_from_pieces(
+            ya, sa, yb, sb, bxy, bst[rb : rb + bcount[slot_b[k]] + 1], rxy,
+            rst[ra : ra + rcount[slot_a[k]] + 1], bound, bdx, bdy, eps[k], max_vertices)
+    return out
+
+
+def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
+                  ids: np.ndarray, negate: bool) -> tuple[np.ndarray, ...]:
+    """:func:`pieces_of_bodies`, with the bodies it leaves decomposed by
+    :func:`polycontact.nfp._pieces_packed` (GEOS) and appended."""
+    from ..nfp import _EAR_CLIPPING_MAX, _pieces_packed
+    from ..tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
+
+    xy, st, first, count, ok = pieces_of_bodies(x, ls, bs, f, ids, negate,
+                                                RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                                                _EAR_CLIPPING_MAX)
+    if ok.all():
+        return xy, st, first, count
+    more_xy, more_st = [xy], [st]
+    rows, at = len(xy), len(st)
+    for k in np.flatnonzero(~ok):
+        y, s = _body(x, ls, bs, ids[k])
+        if f[ids[k]] < 0.0:  # a raw clockwise ring
+            y = y[::-1].copy()
+        pxy, pst = _pieces_packed(y, s)
+        more_xy.append(-pxy if negate else pxy)
+        more_st.append(pst + rows)
+        first[k], count[k] = at, len(pst) - 1
+        rows += len(pxy)
+        at += len(pst)
+    return np.concatenate(more_xy), np.concatenate(more_st), first, count
+
+
+def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
+                 xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
+                 pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
+    """Penetration depths of the pairs ``pairs`` of two packed batches (the form of
+    :mod:`polycontact._kernels.relation_many`), in parallel: ``(P, 3)`` rows ``(depth,
+    dx, dy)``, each equal to :func:`penetration` of the pair; ``eps`` per pair.
+
+    Each distinct body (bodies repeat in a batch) is decomposed once, in parallel, and
+    each distinct pair (the same two bodies and tolerance) computed once.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> ls, bs, f = np.array([0, 4]), np.array([0, 2]), np.ones(1)
+    >>> penetrations(sq, ls, bs, f, sq + 0.5, ls, bs, f, np.array([0]), np.array([1e-12]))
+    array([[ 0.5, -0.5,  0. ]])
+    """
+    pairs = np.asarray(pairs, dtype=np.int64)
+    eps = np.ascontiguousarray(eps, dtype=np.float64)
+    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
+    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
+    # equal pairs (the same A, B and tolerance) have the same depth: one computation
+    order = np.lexsort((eps.view(np.int64), slot_b, slot_a))
+    key = np.c_[slot_a[order], slot_b[order], eps[order].view(np.int64)]
+    new = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
+    one = order[new]  # the first of each group of equal pairs
+    group = np.empty(len(pairs), np.int64)
+    group[order] = np.cumsum(new) - 1
+    ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
+    rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
+    out = depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one],
+                          slot_a[one], *ra, slot_b[one], *rb, MAX_SUM_VERTICES)
+    bad = np.flatnonzero(np.isnan(out[:, 0]))
+    if bad.size:
+        p = pairs[one[bad[0]]]
+        raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
+                         int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]))
+    return out[group]

@@ -3,7 +3,7 @@
 The state kernels are serial: for small pairs (about a microsecond each) a ``prange``
 version measured 2-3 times slower on a 2-core machine; the caller splits the pairs over
 threads instead (the kernels release the GIL). The signed distances use ``prange``;
-penetration depths are left to the caller (:mod:`polycontact._kernels.depth`).
+penetration depths are left to the caller (:func:`polycontact._kernels.depth.penetrations`).
 
 A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
 after body), ``ls`` int64 and ``bs`` int64 (P+1,): the loop starts of body p are
@@ -300,8 +300,7 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
 def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
     """Signed distances of P classified pairs: the boundary gap, or 0; NaN for the
     penetrating pairs, whose depth the caller computes (it needs convex pieces, see
-    :func:`polycontact._kernels.depth.penetration`; :func:`oriented_pair` gives the
-    pair's bodies)."""
+    :func:`polycontact._kernels.depth.penetrations`)."""
     p_count = bsa.shape[0] - 1
     out = np.empty(p_count)
     for p in prange(p_count):
@@ -312,11 +311,3 @@ def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
         else:
             out[p] = np.nan
     return out
-
-
-@njit(cache=True, nogil=True)
-def oriented_pair(xa, lsa, bsa, fa, xb, lsb, bsb, fb, p):
-    """Pair p's bodies packed with the interior on the left: ``(xa, sa, xb, sb)``."""
-    ya, sa = _body(xa, lsa, bsa, p)
-    yb, sb = _body(xb, lsb, bsb, p)
-    return _oriented(ya, sa, fa[p]), sa, _oriented(yb, sb, fb[p]), sb
