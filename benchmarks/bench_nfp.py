@@ -41,7 +41,9 @@ import polycontact as pc
 from polycontact import nfp as nfp_module
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT.parent / "shared" / "datasets" / "esicup"
+# the data sit in <checkout>/../shared (main checkout) or ../../shared (a worktree)
+DATA = next((p / "shared" / "datasets" / "esicup" for p in ROOT.parents
+             if (p / "shared" / "datasets" / "esicup").is_dir()), ROOT.parent / "shared")
 sys.path.insert(0, str(ROOT / "tests"))
 
 
@@ -188,7 +190,6 @@ def _line(r: dict, check: bool) -> str:
         line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:10d} {r['clip_false_holes']:16d}"
                  f" {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")
     return line
-    return 0
 
 
 if __name__ == "__main__":

@@ -11,8 +11,11 @@ included: the pieces come from a triangulation of the solid region, by ear clipp
 GEOS, merged Hertel–Mehlhorn style), each sum made in O(p + q) by merging edge angles.
 The union's outline is assembled directly: the parts of the sums' edges that lie inside
 no other sum are linked into rings (GEOS unions the sums only if that ever failed).
-Decompositions are cached by coordinates, so a nesting code calling this for many pairs
-of the same pieces decomposes each piece once.
+Two rings without holes are decomposed, summed and outlined in one kernel call (a convex
+ring is its own piece; ear clipping a ring of up to 64 vertices again costs less than
+looking its pieces up from Python); the other decompositions (GEOS's triangulation of
+larger rings and of shapes with holes) are cached by coordinates, so a nesting code
+calling this for many pairs of the same pieces decomposes each piece once.
 
 An area union loses the positions where A fits exactly: a jigsaw piece in its socket
 (an isolated point) or a square sliding in a slot of its own width (a segment). They are
@@ -70,6 +73,12 @@ ANGLE_TOLERANCE = 1e-9
 #: their convex pieces).
 MAX_SUM_VERTICES = 10_000_000
 
+
+#: The empty exact fits and slides of most results, shared: read-only (and empty).
+_NO_FITS = np.empty((0, 2))
+_NO_FITS.flags.writeable = False
+_NO_SLIDES = np.empty((0, 2, 2))
+_NO_SLIDES.flags.writeable = False
 
 #: How many regions GEOS has built since import because the outline parts did not link
 #: into rings (see :func:`fallback_count`).
@@ -249,8 +258,8 @@ def no_fit_polygon(
     Notes
     -----
     Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
-    decomposition (ear clipping up to 64 vertices, GEOS's constrained triangulation
-    beyond, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
+    decomposition (ear clipping up to 64 vertices, redone on each call; GEOS's
+    constrained triangulation beyond and with holes, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
     vertices in all, each sum in linear time, then every sum edge clipped by other
     sums until covered: first those containing whole cells of a 32 x 32 grid along the
     edge, then the one that covered the previous edge, then a scan of the boxes sorted
@@ -263,12 +272,24 @@ def no_fit_polygon(
     a = as_shape(a, "a")
     b = as_shape(b, "b")
     a0 = _reference(a, reference, b)
-    bxy, bst = _convex_pieces(b)
-    axy, ast = _convex_pieces(a)
-    r = a0 - axy
-    region, pts, segs, eps = _entrance(bxy, bst, r, ast, tolerance)
+
+    def pieces() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        bxy, bst = _convex_pieces(b)
+        axy, ast = _convex_pieces(a)
+        return bxy, bst, a0 - axy, ast
+
+    xa, sa = a.packed
+    xb, sb = b.packed
+    out: tuple[Any, ...] = (False,)
+    if len(sa) == 2 and len(sb) == 2:
+        # two rings: decomposed and summed in one kernel call (see _pieces_packed)
+        out = _kernels().nfp.ring_entrance(
+            xb, xa, float(a0[0]), float(a0[1]), _tolerance(tolerance), RELATIVE_TOLERANCE,
+            ROUNDING_ULPS, ANGLE_TOLERANCE, _EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
+    out = out[1:] if out[0] else _entrance_kernel(*pieces(), tolerance)
+    region, pts, segs, eps = _entrance_result(out, pieces)
     fits, slides = _clean_degenerate(
-        pts, segs, (bxy, bst, r, ast), eps, lambda: _touching(a, b, a0, eps)
+        pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
     )
     return NoFitPolygon(region, fits, slides, a0, a, b, eps)
 
@@ -317,7 +338,8 @@ def inner_fit_polygon(
     x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
     outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
     fxy, fst = _pieces_of_geometry(outside)
-    blocked, pts, segs, eps = _entrance(fxy, fst, r, ast, tolerance)
+    blocked, pts, segs, eps = _entrance_result(
+        _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -330,7 +352,8 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, (fxy, fst, r, ast), eps, lambda: fits)
+    fit_pts, slide_segs = _clean_degenerate(
+        pts, segs, lambda: (fxy, fst, r, ast), eps, lambda: fits)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -363,9 +386,9 @@ def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
     else:
         a0 = point_arg(reference, "reference")
         check_range(a0.reshape(1, 2), "reference")
-    xa, xb = a.packed[0], b.packed[0]
-    reach = float(np.abs(a0).max() + np.abs(xa).max() + np.abs(xb).max())
-    size = min(float(np.ptp(xa, axis=0).max()), float(np.ptp(xb, axis=0).max()))
+    # the shapes' largest |coordinate| and extent are cached on them
+    reach = max(abs(float(a0[0])), abs(float(a0[1]))) + a._magnitude + b._magnitude
+    size = min(a._extent, b._extent)
     if tolerance_for(0.0, reach) >= size:
         raise ValueError(
             f"reference ({a0[0]:g}, {a0[1]:g}): the region's coordinates reach {reach:g}, "
@@ -422,16 +445,11 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     return pieces
 
 
-def _entrance(
+def _entrance_kernel(
     bxy: np.ndarray, bst: np.ndarray, rxy: np.ndarray, rst: np.ndarray, tolerance: float | None
-) -> tuple[Any, np.ndarray, np.ndarray, float]:
-    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, eps).
-
-    The outline is assembled from the uncovered parts of the sums' edges (see
-    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
-    should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
-    seams and pinholes) are dropped.
-    """
+) -> tuple[Any, ...]:
+    """The outline kernel's answer for E = B ⊕ R from convex pieces (see
+    :func:`_entrance_result`); too many sums' vertices are refused first."""
     total = len(bxy) * (len(rst) - 1) + len(rxy) * (len(bst) - 1)
     if total > MAX_SUM_VERTICES:
         raise NfpTooLargeError(
@@ -439,11 +457,25 @@ def _entrance(
             f"shapes' pieces would hold {total:.3g} vertices, more than "
             f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
         )
-    kn = _kernels().nfp
-    rxy_, rst_, stats, cand, meta = kn.entrance_region(
+    out: tuple[Any, ...] = _kernels().nfp.entrance_region(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
         ANGLE_TOLERANCE
     )
+    return out
+
+
+def _entrance_result(
+    out: tuple[Any, ...], pieces: Callable[[], tuple[np.ndarray, ...]]
+) -> tuple[Any, np.ndarray, np.ndarray, float]:
+    """(region, candidate fits, candidate slides, eps) from the kernel's answer ``out``
+    (:func:`polycontact._kernels.nfp.entrance_region`) for E = B ⊕ R.
+
+    The outline is assembled from the uncovered parts of the sums' edges (see
+    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
+    should), GEOS unions the sums of the convex pieces ``pieces()`` (B's, then R's)
+    instead. Rings thinner than the tolerance (rounding seams and pinholes) are dropped.
+    """
+    rxy_, rst_, stats, cand, meta = out
     eps = float(meta[0])
     if meta[1] < 0.0:
         raise InvalidShapeError(
@@ -455,7 +487,7 @@ def _entrance(
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = kn.convex_sums(bxy, bst, rxy, rst)
+        sums, starts = _kernels().nfp.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     n_pts = int(meta[2])
@@ -463,7 +495,7 @@ def _entrance(
 
 
 def _union_of_sums(polys: Any, eps: float) -> Any:
-    """GEOS union of convex sums (the fallback of :func:`_entrance`), slivers dropped.
+    """GEOS union of convex sums (the fallback of :func:`_entrance_result`), slivers dropped.
 
     On a snap-rounding grid (:func:`polycontact.tolerances.snap_grid`): GEOS's floating
     union of polygons whose edges lie a few ulps apart can drop whole pieces.
@@ -550,23 +582,24 @@ def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> float:
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: tuple[Any, ...], eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, pieces: Callable[[], tuple[np.ndarray, ...]],
+    eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
-    of sum edges, and are snapped to them (within ``64 eps``). ``pieces`` are the convex
-    pieces the sums are made of; ``make_check()`` gives the verifying predicate.
+    of sum edges, and are snapped to them (within ``64 eps``). ``pieces()`` gives the
+    convex pieces the sums are made of; ``make_check()`` the verifying predicate.
     """
+    if len(pts) == 0 and len(segs) == 0:
+        return _NO_FITS, _NO_SLIDES
     near = HOLE_WIDTH_FACTOR * eps
     snap = 64.0 * eps
-    slides = np.empty((0, 2, 2))
-    if len(pts) == 0 and len(segs) == 0:
-        return np.empty((0, 2)), slides
+    slides = _NO_SLIDES
     check = make_check()
     kn = _kernels().nfp
-    sums, starts = kn.convex_sums(*pieces)
+    sums, starts = kn.convex_sums(*pieces())
     pts = kn.snap(pts, np.zeros_like(pts), sums, starts, snap)
     if len(segs):
         flat = segs.reshape(-1, 2)
@@ -586,6 +619,6 @@ def _clean_degenerate(
         if check(p):
             fits.append(p)
     if not fits:
-        return np.empty((0, 2)), slides
+        return _NO_FITS, slides
     out = np.array(fits)
     return out[np.lexsort((out[:, 1], out[:, 0]))], slides
