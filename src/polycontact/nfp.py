@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import functools
 import struct
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -113,8 +114,10 @@ def _kernels() -> SimpleNamespace:
     return SimpleNamespace(nfp=nfp, decompose=decompose, relate_state=relate_state)
 
 
-#: Little-endian WKB header of a one-ring polygon: byte order, type 3, rings, points.
-_WKB_POLYGON = struct.Struct("<BIII")
+#: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
+#: float64 coordinates): byte order, type 3, rings, points.
+_WKB_POLYGON = struct.Struct("=BIII")
+_WKB_BYTE_ORDER = 1 if sys.byteorder == "little" else 0
 
 #: Rings up to this many vertices are triangulated by ear clipping (quadratic, but
 #: without the cost of a GEOS call); larger ones and shapes with holes by GEOS.
@@ -476,13 +479,13 @@ def _entrance_result(
     instead. Rings thinner than the tolerance (rounding seams and pinholes) are dropped.
     """
     rxy_, rst_, stats, cand, meta = out
-    eps = float(meta[0])
-    if meta[1] < 0.0:
+    eps, status, n_pts = meta.tolist()
+    if status < 0.0:
         raise InvalidShapeError(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
             "(coordinates or reference point too large)"
         )
-    if meta[1]:
+    if status:
         region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
     else:
         global _FALLBACKS
@@ -490,8 +493,9 @@ def _entrance_result(
         sums, starts = _kernels().nfp.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
-    n_pts = int(meta[2])
-    return region, cand[:n_pts, :2], cand[n_pts:], eps
+    if len(cand) == 0:
+        return region, _NO_FITS, cand, eps
+    return region, cand[: int(n_pts), :2], cand[int(n_pts) :], eps
 
 
 def _union_of_sums(polys: Any, eps: float) -> Any:
@@ -509,8 +513,8 @@ def _polygon_from_rings(
     """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
     if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
-        header = _WKB_POLYGON.pack(1, 3, 1, len(xy))
-        return shapely.from_wkb(header + xy.astype("<f8", copy=False).tobytes())
+        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, len(xy))
+        return shapely.from_wkb(header + xy.tobytes())
     shells: list[Any] = []
     holes: list[Any] = []
     for k in range(len(starts) - 1):
