@@ -21,12 +21,14 @@ of the area or the number of holes differs (a false hole).
 
 Times are for building all the NFPs of an instance once (medians over ``--repeat``
 runs; an instance with fewer than 2000 NFPs is built several times per run and the
-time divided). Run: ``python benchmarks/bench_nfp.py [--check] [--repeat 5] [instance ...]``
+time divided), with Python's cyclic garbage collector run before and paused during each
+timed run, as ``timeit`` does (the same for every tool). Run: ``python benchmarks/bench_nfp.py [--check] [--repeat 5] [instance ...]``
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import statistics
 import sys
@@ -41,7 +43,9 @@ import polycontact as pc
 from polycontact import nfp as nfp_module
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT.parent / "shared" / "datasets" / "esicup"
+# the data sit in <checkout>/../shared (main checkout) or ../../shared (a worktree)
+DATA = next((p / "shared" / "datasets" / "esicup" for p in ROOT.parents
+             if (p / "shared" / "datasets" / "esicup").is_dir()), ROOT.parent / "shared")
 sys.path.insert(0, str(ROOT / "tests"))
 
 
@@ -118,10 +122,19 @@ def run(path: Path, repeat: int, check: bool) -> dict:
     for _ in range(repeat):
         for name, fn in (("pc_cold", t_pc_cold), ("pc_warm", t_pc_warm),
                          ("pyclipper", t_clipper), ("pysfcgal", t_sfcgal)):
-            t0 = time.perf_counter()
-            for _ in range(inner):
-                results[name] = fn()
-            times[name].append((time.perf_counter() - t0) / inner)
+            # as timeit does: the previous results freed and the cyclic garbage
+            # collector run before the clock starts, and kept from running while it runs
+            results.pop(name, None)
+            gc.collect()
+            gc.disable()
+            try:
+                t0 = time.perf_counter()
+                for _ in range(inner):
+                    out = fn()
+                times[name].append((time.perf_counter() - t0) / inner)
+            finally:
+                gc.enable()
+            results[name] = out
     row = {"instance": path.stem, "pieces": len(rings), "nfps": len(pairs)}
     row.update({k: statistics.median(v) for k, v in times.items()})
     if check:
@@ -188,7 +201,6 @@ def _line(r: dict, check: bool) -> str:
         line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:10d} {r['clip_false_holes']:16d}"
                  f" {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")
     return line
-    return 0
 
 
 if __name__ == "__main__":

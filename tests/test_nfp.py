@@ -194,6 +194,7 @@ def _force_geos_fallback(monkeypatch):
     from polycontact._kernels import nfp as kn
 
     real = kn.entrance_region
+    real_rings = kn.ring_entrance
 
     def unlinked(*args):
         rings, starts, stats, cand, meta = real(*args)
@@ -201,7 +202,14 @@ def _force_geos_fallback(monkeypatch):
         meta[1] = 0.0
         return rings, starts, stats, cand, meta
 
+    def rings_unlinked(*args):
+        ok, *out = real_rings(*args)
+        out[-1] = out[-1].copy()
+        out[-1][1] = 0.0
+        return ok, *out
+
     monkeypatch.setattr(kn, "entrance_region", unlinked)
+    monkeypatch.setattr(kn, "ring_entrance", rings_unlinked)
     # (this deliberate fallback is not counted against the module: restored at teardown)
     monkeypatch.setattr(nfp_module, "_FALLBACKS", nfp_module.fallback_count())
 
@@ -351,7 +359,9 @@ def test_grid_shapes_against_reference_and_lattice(a, b):
 
 # -- ESICUP pieces ----------------------------------------------------------------------
 
-ESICUP = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "esicup"
+# <checkout>/../shared (the main checkout) or further up (a worktree)
+ESICUP = next((p / "shared" / "datasets" / "esicup" for p in Path(__file__).resolve().parents
+               if (p / "shared" / "datasets" / "esicup").is_dir()), Path("/nonexistent"))
 
 
 def _rotated(ring, degrees):

@@ -11,8 +11,11 @@ included: the pieces come from a triangulation of the solid region, by ear clipp
 GEOS, merged Hertel–Mehlhorn style), each sum made in O(p + q) by merging edge angles.
 The union's outline is assembled directly: the parts of the sums' edges that lie inside
 no other sum are linked into rings (GEOS unions the sums only if that ever failed).
-Decompositions are cached by coordinates, so a nesting code calling this for many pairs
-of the same pieces decomposes each piece once.
+Two rings without holes are decomposed, summed and outlined in one kernel call (a convex
+ring is its own piece; ear clipping a ring of up to 64 vertices again costs less than
+looking its pieces up from Python); the other decompositions (GEOS's triangulation of
+larger rings and of shapes with holes) are cached by coordinates, so a nesting code
+calling this for many pairs of the same pieces decomposes each piece once.
 
 An area union loses the positions where A fits exactly: a jigsaw piece in its socket
 (an isolated point) or a square sliding in a slot of its own width (a segment). They are
@@ -34,6 +37,7 @@ from __future__ import annotations
 
 import functools
 import struct
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -71,6 +75,12 @@ ANGLE_TOLERANCE = 1e-9
 MAX_SUM_VERTICES = 10_000_000
 
 
+#: The empty exact fits and slides of most results, shared: read-only (and empty).
+_NO_FITS = np.empty((0, 2))
+_NO_FITS.flags.writeable = False
+_NO_SLIDES = np.empty((0, 2, 2))
+_NO_SLIDES.flags.writeable = False
+
 #: How many regions GEOS has built since import because the outline parts did not link
 #: into rings (see :func:`fallback_count`).
 _FALLBACKS = 0
@@ -104,8 +114,10 @@ def _kernels() -> SimpleNamespace:
     return SimpleNamespace(nfp=nfp, decompose=decompose, relate_state=relate_state)
 
 
-#: Little-endian WKB header of a one-ring polygon: byte order, type 3, rings, points.
-_WKB_POLYGON = struct.Struct("<BIII")
+#: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
+#: float64 coordinates): byte order, type 3, rings, points.
+_WKB_POLYGON = struct.Struct("=BIII")
+_WKB_BYTE_ORDER = 1 if sys.byteorder == "little" else 0
 
 #: Rings up to this many vertices are triangulated by ear clipping (quadratic, but
 #: without the cost of a GEOS call); larger ones and shapes with holes by GEOS.
@@ -249,8 +261,8 @@ def no_fit_polygon(
     Notes
     -----
     Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
-    decomposition (ear clipping up to 64 vertices, GEOS's constrained triangulation
-    beyond, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
+    decomposition (ear clipping up to 64 vertices, redone on each call; GEOS's
+    constrained triangulation beyond and with holes, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
     vertices in all, each sum in linear time, then every sum edge clipped by other
     sums until covered: first those containing whole cells of a 32 x 32 grid along the
     edge, then the one that covered the previous edge, then a scan of the boxes sorted
@@ -263,12 +275,24 @@ def no_fit_polygon(
     a = as_shape(a, "a")
     b = as_shape(b, "b")
     a0 = _reference(a, reference, b)
-    bxy, bst = _convex_pieces(b)
-    axy, ast = _convex_pieces(a)
-    r = a0 - axy
-    region, pts, segs, eps = _entrance(bxy, bst, r, ast, tolerance)
+
+    def pieces() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        bxy, bst = _convex_pieces(b)
+        axy, ast = _convex_pieces(a)
+        return bxy, bst, a0 - axy, ast
+
+    xa, sa = a.packed
+    xb, sb = b.packed
+    out: tuple[Any, ...] = (False,)
+    if len(sa) == 2 and len(sb) == 2:
+        # two rings: decomposed and summed in one kernel call (see _pieces_packed)
+        out = _kernels().nfp.ring_entrance(
+            xb, xa, float(a0[0]), float(a0[1]), _tolerance(tolerance), RELATIVE_TOLERANCE,
+            ROUNDING_ULPS, ANGLE_TOLERANCE, _EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
+    out = out[1:] if out[0] else _entrance_kernel(*pieces(), tolerance)
+    region, pts, segs, eps = _entrance_result(out, pieces)
     fits, slides = _clean_degenerate(
-        pts, segs, (bxy, bst, r, ast), eps, lambda: _touching(a, b, a0, eps)
+        pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
     )
     return NoFitPolygon(region, fits, slides, a0, a, b, eps)
 
@@ -317,7 +341,8 @@ def inner_fit_polygon(
     x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
     outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
     fxy, fst = _pieces_of_geometry(outside)
-    blocked, pts, segs, eps = _entrance(fxy, fst, r, ast, tolerance)
+    blocked, pts, segs, eps = _entrance_result(
+        _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -330,7 +355,8 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, (fxy, fst, r, ast), eps, lambda: fits)
+    fit_pts, slide_segs = _clean_degenerate(
+        pts, segs, lambda: (fxy, fst, r, ast), eps, lambda: fits)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -363,9 +389,9 @@ def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
     else:
         a0 = point_arg(reference, "reference")
         check_range(a0.reshape(1, 2), "reference")
-    xa, xb = a.packed[0], b.packed[0]
-    reach = float(np.abs(a0).max() + np.abs(xa).max() + np.abs(xb).max())
-    size = min(float(np.ptp(xa, axis=0).max()), float(np.ptp(xb, axis=0).max()))
+    # the shapes' largest |coordinate| and extent are cached on them
+    reach = max(abs(float(a0[0])), abs(float(a0[1]))) + a._magnitude + b._magnitude
+    size = min(a._extent, b._extent)
     if tolerance_for(0.0, reach) >= size:
         raise ValueError(
             f"reference ({a0[0]:g}, {a0[1]:g}): the region's coordinates reach {reach:g}, "
@@ -422,16 +448,11 @@ def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     return pieces
 
 
-def _entrance(
+def _entrance_kernel(
     bxy: np.ndarray, bst: np.ndarray, rxy: np.ndarray, rst: np.ndarray, tolerance: float | None
-) -> tuple[Any, np.ndarray, np.ndarray, float]:
-    """E = B ⊕ R from convex pieces: (region, candidate fits, candidate slides, eps).
-
-    The outline is assembled from the uncovered parts of the sums' edges (see
-    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
-    should), GEOS unions the sums instead. Rings thinner than the tolerance (rounding
-    seams and pinholes) are dropped.
-    """
+) -> tuple[Any, ...]:
+    """The outline kernel's answer for E = B ⊕ R from convex pieces (see
+    :func:`_entrance_result`); too many sums' vertices are refused first."""
     total = len(bxy) * (len(rst) - 1) + len(rxy) * (len(bst) - 1)
     if total > MAX_SUM_VERTICES:
         raise NfpTooLargeError(
@@ -439,31 +460,46 @@ def _entrance(
             f"shapes' pieces would hold {total:.3g} vertices, more than "
             f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
         )
-    kn = _kernels().nfp
-    rxy_, rst_, stats, cand, meta = kn.entrance_region(
+    out: tuple[Any, ...] = _kernels().nfp.entrance_region(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
         ANGLE_TOLERANCE
     )
-    eps = float(meta[0])
-    if meta[1] < 0.0:
+    return out
+
+
+def _entrance_result(
+    out: tuple[Any, ...], pieces: Callable[[], tuple[np.ndarray, ...]]
+) -> tuple[Any, np.ndarray, np.ndarray, float]:
+    """(region, candidate fits, candidate slides, eps) from the kernel's answer ``out``
+    (:func:`polycontact._kernels.nfp.entrance_region`) for E = B ⊕ R.
+
+    The outline is assembled from the uncovered parts of the sums' edges (see
+    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
+    should), GEOS unions the sums of the convex pieces ``pieces()`` (B's, then R's)
+    instead. Rings thinner than the tolerance (rounding seams and pinholes) are dropped.
+    """
+    rxy_, rst_, stats, cand, meta = out
+    eps, status, n_pts = meta.tolist()
+    if status < 0.0:
         raise InvalidShapeError(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
             "(coordinates or reference point too large)"
         )
-    if meta[1]:
+    if status:
         region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = kn.convex_sums(bxy, bst, rxy, rst)
+        sums, starts = _kernels().nfp.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
-    n_pts = int(meta[2])
-    return region, cand[:n_pts, :2], cand[n_pts:], eps
+    if len(cand) == 0:
+        return region, _NO_FITS, cand, eps
+    return region, cand[: int(n_pts), :2], cand[int(n_pts) :], eps
 
 
 def _union_of_sums(polys: Any, eps: float) -> Any:
-    """GEOS union of convex sums (the fallback of :func:`_entrance`), slivers dropped.
+    """GEOS union of convex sums (the fallback of :func:`_entrance_result`), slivers dropped.
 
     On a snap-rounding grid (:func:`polycontact.tolerances.snap_grid`): GEOS's floating
     union of polygons whose edges lie a few ulps apart can drop whole pieces.
@@ -477,8 +513,8 @@ def _polygon_from_rings(
     """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
     if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
-        header = _WKB_POLYGON.pack(1, 3, 1, len(xy))
-        return shapely.from_wkb(header + xy.astype("<f8", copy=False).tobytes())
+        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, len(xy))
+        return shapely.from_wkb(header + xy.tobytes())
     shells: list[Any] = []
     holes: list[Any] = []
     for k in range(len(starts) - 1):
@@ -541,32 +577,36 @@ def _touching(
     return check
 
 
-def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> float:
-    """Distance from p to the nearest of the segments (S, 2, 2)."""
-    a = segs[:, 0]
-    u = segs[:, 1] - a
-    t = np.clip(((p - a) * u).sum(axis=1) / (u * u).sum(axis=1), 0.0, 1.0)
-    return float(np.min(np.hypot(*(a + t[:, None] * u - p).T)))
+def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """Distance from each point p (P, 2) to the nearest of the segments (S, 2, 2): (P,)."""
+    a = segs[None, :, 0]
+    u = segs[None, :, 1] - a
+    d = p[:, None, :] - a
+    t = np.clip((d * u).sum(axis=2) / (u * u).sum(axis=2), 0.0, 1.0)
+    off = d - t[:, :, None] * u
+    dist: np.ndarray = np.hypot(off[:, :, 0], off[:, :, 1]).min(axis=1)
+    return dist
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: tuple[Any, ...], eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, pieces: Callable[[], tuple[np.ndarray, ...]],
+    eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
-    of sum edges, and are snapped to them (within ``64 eps``). ``pieces`` are the convex
-    pieces the sums are made of; ``make_check()`` gives the verifying predicate.
+    of sum edges, and are snapped to them (within ``64 eps``). ``pieces()`` gives the
+    convex pieces the sums are made of; ``make_check()`` the verifying predicate.
     """
+    if len(pts) == 0 and len(segs) == 0:
+        return _NO_FITS, _NO_SLIDES
     near = HOLE_WIDTH_FACTOR * eps
     snap = 64.0 * eps
-    slides = np.empty((0, 2, 2))
-    if len(pts) == 0 and len(segs) == 0:
-        return np.empty((0, 2)), slides
+    slides = _NO_SLIDES
     check = make_check()
     kn = _kernels().nfp
-    sums, starts = kn.convex_sums(*pieces)
+    sums, starts = kn.convex_sums(*pieces())
     pts = kn.snap(pts, np.zeros_like(pts), sums, starts, snap)
     if len(segs):
         flat = segs.reshape(-1, 2)
@@ -578,14 +618,14 @@ def _clean_degenerate(
         if kept:
             slides = np.array(kept)
     fits: list[np.ndarray] = []
-    for p in pts:
-        if any(np.hypot(*(p - q)) <= near for q in fits):
-            continue
-        if len(slides) and _distance_to_segments(p, slides) <= near:
+    on_slide = (_distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
+                else np.zeros(len(pts), dtype=bool))
+    for p, skip in zip(pts, on_slide.tolist()):
+        if skip or any(np.hypot(*(p - q)) <= near for q in fits):
             continue
         if check(p):
             fits.append(p)
     if not fits:
-        return np.empty((0, 2)), slides
+        return _NO_FITS, slides
     out = np.array(fits)
     return out[np.lexsort((out[:, 1], out[:, 0]))], slides

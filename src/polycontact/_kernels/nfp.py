@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .decompose import ring_pieces
 from .tolerance import tolerance_of
 
 
@@ -633,6 +634,33 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
 
 
 @njit(cache=True, nogil=True)
+def ring_entrance(bxy, axy, a0x, a0y, eps, rel_tol, ulps, ang_tol, max_ear, max_sum):
+    """:func:`entrance_region` of two simple CCW rings B and A (no holes), each cut into
+    convex pieces here (:func:`polycontact._kernels.decompose.ring_pieces`, up to
+    ``max_ear`` vertices), A's reflected through ``(a0x, a0y)``: one call where a
+    decomposition cached by the caller would cost more to look up than to redo.
+
+    Returns ``(ok, ring_xy, ring_starts, ring_stats, candidates, meta)``; ``ok`` is
+    False (and the rest empty) when a ring is too large or has no ear left, or the sums
+    would hold more than ``max_sum`` vertices: the caller then decomposes the rings
+    another way (or refuses them) and calls :func:`entrance_region`.
+    """
+    okb, bp, bst = ring_pieces(bxy, rel_tol, ulps, max_ear)
+    oka, ap, ast = ring_pieces(axy, rel_tol, ulps, max_ear)
+    total = bp.shape[0] * (ast.shape[0] - 1) + ap.shape[0] * (bst.shape[0] - 1)
+    if not (okb and oka) or total > max_sum:
+        return (False, bp[:0], np.zeros(1, np.int64), np.empty((0, 2)), np.empty((0, 4)),
+                np.zeros(3))
+    r = np.empty_like(ap)
+    for i in range(ap.shape[0]):
+        r[i, 0] = a0x - ap[i, 0]
+        r[i, 1] = a0y - ap[i, 1]
+    ring_xy, ring_starts, stats, cand, meta = entrance_region(
+        bp, bst, r, ast, eps, rel_tol, ulps, ang_tol)
+    return True, ring_xy, ring_starts, stats, cand, meta
+
+
+@njit(cache=True, nogil=True)
 def _closed(xy, starts):
     """The packed loops with each loop's first point repeated at its end."""
     n = starts.shape[0] - 1
@@ -795,6 +823,10 @@ def merge_collinear(segs, tol):
 #: Side of the grid (cells per side) whose cells remember the sums containing them whole.
 _GRID = 32
 
+#: Fewer sums than this are clipped without the grid: setting up its cells would cost
+#: more than scanning the few sums' boxes for every edge.
+_GRID_MIN_SUMS = 256
+
 
 @njit(cache=True, nogil=True)
 def sum_index(xy, starts, bb, fr, gx0, gy0, h):
@@ -802,16 +834,18 @@ def sum_index(xy, starts, bb, fr, gx0, gy0, h):
     (boxes ``bb``, edge frames ``fr``): the sums sorted by their smallest x (``by_x``,
     ``xs``) and their widest box (``wmax``); a ``_GRID`` x ``_GRID`` grid of cells of
     side ``h`` from ``(gx0, gy0)`` with the sums containing each cell whole
-    (:func:`_cell_cover`) and a buffer of the sums tried on an edge; the four interval
-    buffers of the clipped parts."""
+    (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``_GRID_MIN_SUMS`` sums,
+    and a buffer of the sums tried on an edge; the four interval buffers of the clipped
+    parts."""
     k = starts.shape[0] - 1
     by_x = np.argsort(bb[:, 0])
     xs = bb[by_x, 0]
     wmax = 0.0
     for q in range(k):
         wmax = max(wmax, bb[q, 2] - bb[q, 0])
-    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, _GRID)
-    tried = np.full(_PER_CELL * (_GRID + 2) * 4 + 4, -1, np.int64)
+    g = _GRID if k >= _GRID_MIN_SUMS else 0
+    cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
+    tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
     cap = 2 * k + 4
     return (by_x, xs, wmax, cover, gx0, gy0, h, tried,
             np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
@@ -838,14 +872,15 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
     hi0[0] = t1
     n1 = 1
     n0 = 1
-    # the cells' covering sums (up to 2 _GRID samples along the edge), each once
+    # the cells' covering sums (up to 2 g samples along the edge), each once
+    g = cover.shape[0]
     nt = 0
-    steps = min(2 * _GRID, 1 + int(np.hypot(bx - ax, by - ay) / h))
-    for st in range(steps + 1):
+    steps = min(2 * g, 1 + int(np.hypot(bx - ax, by - ay) / h))
+    for st in range(steps + 1 if g > 0 else 0):
         t = st / steps
         ci = int(np.floor((ax + t * (bx - ax) - gx0) / h))
         cj = int(np.floor((ay + t * (by - ay) - gy0) / h))
-        if ci < 0 or cj < 0 or ci >= _GRID or cj >= _GRID:
+        if ci < 0 or cj < 0 or ci >= g or cj >= g:
             continue
         for u in range(_PER_CELL):
             q = cover[ci, cj, u]

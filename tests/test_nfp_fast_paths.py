@@ -1,0 +1,120 @@
+"""The no-fit polygon's fast paths and their fallbacks give the same answers.
+
+- Two rings without holes go through one kernel call that decomposes them itself
+  (``ring_entrance``); shapes with holes, rings too large for ear clipping and sums past
+  the memory budget take the cached-pieces path (``entrance_region``).
+- The outline clips each sum edge by the other sums: with a grid of cells covered whole
+  by sums from ``_GRID_MIN_SUMS`` sums on, by a scan of the sums' boxes below.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from nfp_reference import reference_region, same_region
+from profiles import examples
+
+import polycontact as pc
+from polycontact import nfp as nfp_module
+from polycontact._kernels import nfp as kn
+from polycontact.tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
+
+@pytest.fixture(autouse=True)
+def no_geos_fallback():
+    """Every region here is assembled by polycontact's own kernel (the GEOS fallback
+    would hide a wrong outline behind a right region)."""
+    before = nfp_module.fallback_count()
+    yield
+    assert nfp_module.fallback_count() == before, "the GEOS fallback built some region"
+
+
+ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, nfp_module.ANGLE_TOLERANCE)
+
+
+def star(n: int, seed: int, centre=(0.0, 0.0), lo=0.6, hi=3.0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t = 2.0 * np.pi * (np.arange(n) + rng.uniform(0.1, 0.9, n)) / n
+    r = rng.uniform(lo, hi, n)
+    return np.column_stack((centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)))
+
+
+@st.composite
+def rings(draw):
+    """A star-shaped ring (concave in general, convex sometimes), 3 to 20 vertices."""
+    n = draw(st.integers(3, 20))
+    seed = draw(st.integers(0, 2**32 - 1))
+    lo = draw(st.sampled_from([0.6, 2.9]))  # 2.9: nearly a circle, often convex
+    return pc.Shape(star(n, seed, (draw(st.floats(-5, 5)), draw(st.floats(-5, 5))), lo))
+
+
+@examples(100)
+@given(rings(), rings(), st.sampled_from([None, "origin", (0.25, -1.5)]))
+def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
+    a0 = nfp_module._reference(a, reference, b)
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(a)
+    want = kn.entrance_region(bxy, bst, a0 - axy, ast, *ARGS)
+    ok, *got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS,
+                                nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
+    assert ok
+    for g, w in zip(got, want):
+        np.testing.assert_array_equal(g, w)
+
+
+def _count_paths(monkeypatch):
+    calls = {"ring": 0, "pieces": 0}
+    real_ring, real_pieces = kn.ring_entrance, kn.entrance_region
+
+    def ring(*args):
+        calls["ring"] += 1
+        return real_ring(*args)
+
+    def pieces(*args):
+        calls["pieces"] += 1
+        return real_pieces(*args)
+
+    monkeypatch.setattr(kn, "ring_entrance", ring)
+    monkeypatch.setattr(kn, "entrance_region", pieces)
+    return calls
+
+
+@pytest.mark.parametrize("case", ["rings", "hole", "large ring", "budget"])
+def test_each_path_is_taken_and_right(monkeypatch, case):
+    a = pc.Shape(star(7, 1))
+    b = pc.Shape(star(9, 2, (1.0, 0.5)))
+    want_path = {"ring": 1, "pieces": 0}
+    if case == "hole":
+        b = pc.Shape(star(9, 2, (1.0, 0.5), 2.0), [star(5, 3, (1.0, 0.5), 0.3, 0.5)[::-1]])
+        want_path = {"ring": 0, "pieces": 1}
+    elif case == "large ring":  # beyond ear clipping: GEOS's pieces
+        b = pc.Shape(star(nfp_module._EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
+        want_path = {"ring": 1, "pieces": 1}
+    elif case == "budget":  # the ring kernel declines, the pieces path refuses
+        monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
+    calls = _count_paths(monkeypatch)
+    if case == "budget":
+        with pytest.raises(nfp_module.NfpTooLargeError):
+            pc.no_fit_polygon(a, b)
+        assert calls == {"ring": 1, "pieces": 0}
+        return
+    nfp = pc.no_fit_polygon(a, b)
+    assert calls == want_path
+    ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
+    assert same_region(nfp.region, ref) is None
+
+
+@pytest.mark.parametrize("n_sums", [24, 300])
+def test_outline_with_and_without_the_grid(n_sums):
+    # A concave A of 3 pieces around B of n_sums / 3 pieces: below _GRID_MIN_SUMS the
+    # edges are clipped by the box scan alone, from it on the grid's covering sums first.
+    a = pc.Shape([(0, 0), (3, 0), (3, 1), (2, 1), (2, 0.4), (1, 0.4), (1, 1), (0, 1)])
+    b = pc.Shape(star(n_sums // 3 * 2 + 2, 5, (0.5, 0.5), 1.5, 3.0))
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(a)
+    k = (len(bst) - 1) * (len(ast) - 1)
+    assert (k >= kn._GRID_MIN_SUMS) == (n_sums >= kn._GRID_MIN_SUMS)
+    nfp = pc.no_fit_polygon(a, b)
+    ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
+    assert same_region(nfp.region, ref) is None
