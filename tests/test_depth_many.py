@@ -93,7 +93,8 @@ def test_batch_depths_of_shapes_with_holes_and_raw_arrays():
 @given(st.integers(0, 10**6), st.integers(4, 40), st.integers(4, 40),
        st.floats(-1.0, 1.0), st.floats(-1.0, 1.0))
 def test_depth_without_the_grid_equals_the_depth_with_it(seed, na, nb, cx, cy):
-    # the scan alone (few sums) and the grid of cells (many) clip alike
+    # the scan alone (few sums, grid_from above them) and the grid of cells (grid_from
+    # 0) clip alike
     a = pc.Shape(_ring(seed, na, (0.0, 0.0)))
     b = pc.Shape(_ring(seed + 1, nb, (cx, cy)))
     rel = pc.classify(a, b)

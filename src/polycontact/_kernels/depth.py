@@ -24,7 +24,8 @@ import numpy as np
 from numba import njit, prange
 
 from ..errors import DepthTooLargeError
-from .nfp import _GRID, _PER_CELL, _bboxes, _frames, _lowest, clip_edge, sum_index, sum_into
+from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
+                  sum_into)
 from .decompose import ring_pieces
 from .relation import PENETRATING, _state
 from .relation_many import _body, _oriented
@@ -128,32 +129,6 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     return out[:w].copy(), starts
 
 
-#: Up to this many convex sums, :func:`depth_from_pieces` clips the edges without the grid
-#: of :func:`polycontact._kernels.nfp.sum_index` (building it costs more than it saves
-#: there: 83 against 26 us per penetrating pair of 12-gons, about 9 sums).
-_GRID_FROM = 128
-
-
-@njit(cache=True, nogil=True)
-def _scan_index(xy, starts, bb):
-    """The index of :func:`polycontact._kernels.nfp.sum_index` without its grid: one cell
-    of infinite side that no sum is said to cover, so that
-    :func:`polycontact._kernels.nfp.clip_edge` goes straight to the hint and the scan of
-    the sums by their smallest x (the same clips; what is skipped is the set-up of the
-    cells, about O(32² k) for k sums)."""
-    k = starts.shape[0] - 1
-    by_x = np.argsort(bb[:, 0])
-    xs = bb[by_x, 0]
-    wmax = 0.0
-    for q in range(k):
-        wmax = max(wmax, bb[q, 2] - bb[q, 0])
-    cover = np.full((1, 1, _PER_CELL), -1, np.int64)
-    tried = np.empty(_PER_CELL * 2, np.int64)
-    cap = 2 * k + 4
-    return (by_x, xs, wmax, cover, 0.0, 0.0, np.inf, tried,
-            np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
-
-
 @njit(cache=True, nogil=True)
 def _escapes(xa, sa, xb, sb, dx, dy, eps):
     """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict)."""
@@ -165,7 +140,7 @@ def _escapes(xa, sa, xb, sb, dx, dy, eps):
 
 @njit(cache=True, nogil=True)
 def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                      max_vertices, grid_from=_GRID_FROM):
+                      max_vertices, grid_from=_GRID_MIN_SUMS):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
@@ -173,8 +148,9 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap.
     Returns ``(bound, bdx, bdy)`` when nothing nearer ends it, NaNs when the sums would
     hold more than ``max_vertices`` vertices (none is built). The edges are clipped with
-    the grid of :func:`polycontact._kernels.nfp.sum_index` when there are more than
-    ``grid_from`` sums, else by the scan alone (:func:`_scan_index`).
+    the grid of :func:`polycontact._kernels.nfp.sum_index` from ``grid_from`` sums on,
+    else by the scan alone (a 12-gon pair makes about 9 sums; the grid's set-up cost 83
+    of its 105 us).
 
     Cost: with P pairs of pieces whose sums' boxes meet the disk of radius ``bound`` and
     K edges of those sums nearer than the depth, O((p + q) log(p + q) + P + K log K)
@@ -207,10 +183,8 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
             else:
                 dist[i] = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])[2]
     by_dist = np.argsort(dist)
-    if k > grid_from:  # the grid over the disk of the first escape
-        index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID)
-    else:
-        index = _scan_index(xy, starts, bb)
+    # (the grid, if any, over the disk of the first escape)
+    index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = -1
     for oi in range(n_edges):

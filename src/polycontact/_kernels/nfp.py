@@ -829,21 +829,21 @@ _GRID_MIN_SUMS = 256
 
 
 @njit(cache=True, nogil=True)
-def sum_index(xy, starts, bb, fr, gx0, gy0, h):
+def sum_index(xy, starts, bb, fr, gx0, gy0, h, grid_from=_GRID_MIN_SUMS):
     """What :func:`clip_edge` reads to clip edges by the convex sums ``(xy, starts)``
     (boxes ``bb``, edge frames ``fr``): the sums sorted by their smallest x (``by_x``,
     ``xs``) and their widest box (``wmax``); a ``_GRID`` x ``_GRID`` grid of cells of
     side ``h`` from ``(gx0, gy0)`` with the sums containing each cell whole
-    (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``_GRID_MIN_SUMS`` sums,
-    and a buffer of the sums tried on an edge; the four interval buffers of the clipped
-    parts."""
+    (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``grid_from`` sums (the
+    same clips, found by the scan alone), and a buffer of the sums tried on an edge;
+    the four interval buffers of the clipped parts."""
     k = starts.shape[0] - 1
     by_x = np.argsort(bb[:, 0])
     xs = bb[by_x, 0]
     wmax = 0.0
     for q in range(k):
         wmax = max(wmax, bb[q, 2] - bb[q, 0])
-    g = _GRID if k >= _GRID_MIN_SUMS else 0
+    g = _GRID if k >= grid_from else 0
     cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
     tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
     cap = 2 * k + 4
