@@ -5,14 +5,15 @@ test it skips (``relation._overlap_state``), near the tolerance boundary.
 full test must say separate for the same pair and tolerance. The pairs are placed along
 the line of their bounding boxes' centres (the line ``_apart`` projects on) at a gap of
 about eps, just above it and just below it, at scales 1e-9..1e9 and offsets up to 1e9,
-so both the early exit and the fall-through are taken.
+so both the early exit and the fall-through are taken. Also: the state kernel with its
+scratch passed in (``relate_state_into``, what ``classify`` calls on Shapes).
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from catalogue import shapes
+from catalogue import pairs, shapes
 from hypothesis import event, given
 from hypothesis import strategies as st
 from profiles import examples
@@ -134,3 +135,35 @@ def test_early_exit_never_fires_for_a_body_in_a_hole():
         eps = default_tolerance(frame.packed[0], xb)
         apart, full = _check(*frame.packed, xb, inner.packed[1], eps)
         assert not apart and full == kr.SEPARATE
+
+
+@examples(100)
+@given(pairs(holes=None))
+def test_state_with_passed_scratch_is_the_allocating_state(pair):
+    """relate_state_into (the scratch passed in, no allocation) gives relate_state's
+    answer; a buffer too small for a pair that needs it gives -1, never a wrong state."""
+    a, b, _ = pair
+    eps = default_tolerance(a.packed[0], b.packed[0])
+    want = kr.relate_state(*a.packed, *b.packed, eps)
+    size = a.n_vertices + b.n_vertices
+    buf = np.full(kr.scratch_floats(size) + 3, np.nan)
+    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want
+    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want  # reused
+    small = kr.relate_state_into(*a.packed, *b.packed, eps, buf[: kr.scratch_floats(size) - 1])
+    assert small in (-1, want) and (small == -1 or want == kr.SEPARATE)
+
+
+def test_scratch_views_do_not_overlap():
+    size = 13
+    buf = np.zeros(kr.scratch_floats(size))
+    box, ids, touch, rays, rord = kr._scratch_views(buf, size)
+    assert box.shape == (size + 1, 4) and ids.shape == (size + 1, 4)
+    assert rays.shape == (2 * size + 2, 6) and rord.shape == (2 * size + 2,)
+    assert touch.shape[0] >= size + 1
+    box[:] = 1.0
+    rays[:] = 2.0
+    ids[:] = 3
+    rord[:] = 4
+    touch[:] = True
+    assert (box == 1.0).all() and (rays == 2.0).all() and (ids == 3).all()
+    assert (rord == 4).all() and touch.all()

@@ -407,13 +407,12 @@ def _state(xa, sa, fa, xb, sb, fb, eps):
     """State of A against B; ``fa``/``fb`` = +1.0 or -1.0 (interior left/right).
 
     :func:`_state_in` with scratch allocated only for the pairs its early exits leave
-    (five allocations cost about 100 ns, as much as a small pair's test).
+    (an allocation costs as much as a small pair's test).
     """
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
-    ba = _bbox(xa, na)
-    bb = _bbox(xb, nb)
-    if _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps):
+    apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
+    if apart:
         return SEPARATE
     box, ids, touch, rays, rord = _scratch(na + nb)
     return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, rord)
@@ -422,14 +421,46 @@ def _state(xa, sa, fa, xb, sb, fb, eps):
 @njit(cache=True, nogil=True)
 def _scratch(size):
     """Scratch buffers for :func:`_state_in` for up to ``size`` vertices in all: edge
-    boxes, edge ids, touch flags, and the rays at one touch point with their order."""
+    boxes, edge ids, touch flags, and the rays at one touch point with their order
+    (views of one allocation)."""
+    return _scratch_views(np.empty(scratch_floats(size)), size)
+
+
+@njit(cache=True, nogil=True)
+def scratch_floats(size):
+    """Length of a float64 buffer that holds the scratch of the state kernel for pairs
+    of up to ``size`` vertices in all (see :func:`relate_state_into`).
+
+    >>> scratch_floats(24)
+    554
+    """
+    r = size + 1
+    return 22 * r + (size + 8) // 8
+
+
+@njit(cache=True, nogil=True)
+def _scratch_views(buf, size):
+    """:func:`_scratch`'s five buffers as views of ``buf`` (of at least
+    ``scratch_floats(size)`` floats): edge boxes (r, 4), edge ids (r, 4) int64, touch
+    flags, rays (2 r, 6), ray order (2 r) int64, with r = size + 1."""
+    r = size + 1
+    ints = buf[16 * r : 22 * r].view(np.int64)
     return (
-        np.empty((size + 1, 4)),
-        np.empty((size + 1, 4), np.int64),
-        np.empty(size + 1, np.bool_),
-        np.empty((2 * size + 2, 6)),
-        np.empty(2 * size + 2, np.int64),
+        buf[: 4 * r].reshape(r, 4),
+        ints[: 4 * r].reshape(r, 4),
+        buf[22 * r : scratch_floats(size)].view(np.bool_),
+        buf[4 * r : 16 * r].reshape(2 * r, 6),
+        ints[4 * r :],
     )
+
+
+@njit(cache=True, nogil=True)
+def _early_exit(xa, na, xb, nb, eps):
+    """``(apart, box of A, box of B)``: apart when the boxes are more than eps apart or
+    :func:`_apart` proves the bodies are."""
+    ba = _bbox(xa, na)
+    bb = _bbox(xb, nb)
+    return _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps), ba, bb
 
 
 @njit(cache=True, nogil=True)
@@ -457,9 +488,8 @@ def _state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch, rays, rord):
     """
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
-    ba = _bbox(xa, na)
-    bb = _bbox(xb, nb)
-    if _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps):
+    apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
+    if apart:
         return SEPARATE
     return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, rord)
 
@@ -607,6 +637,39 @@ def relate_state(xa, sa, xb, sb, eps):
     [0, 1, 2]
     """
     return _state(xa, sa, 1.0, xb, sb, 1.0, eps)
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): the counts of the
+# arrays it is called with and passes on cost ~0.1 us per call, as much as the test of a
+# small separate pair. Nothing in it may allocate: the scratch is passed in.
+@njit(cache=True, nogil=True, _nrt=False)
+def relate_state_into(xa, sa, xb, sb, eps, scratch):
+    """:func:`relate_state` with its scratch passed in, allocating nothing.
+
+    ``scratch`` is a float64 buffer of at least :func:`scratch_floats` (vertices of
+    both bodies) entries, used by one call at a time (one per thread); returns -1 (and
+    computes nothing) when a pair that needs it finds it too small.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> buf = np.empty(scratch_floats(8))
+    >>> [relate_state_into(sq, st, sq + d, st, 1e-12, buf) for d in ([2, 0], [1, 0], [0.5, 0.5])]
+    [0, 1, 2]
+    >>> relate_state_into(sq, st, sq, st, 1e-12, buf[:10])
+    -1
+    """
+    na = sa[sa.shape[0] - 1]
+    nb = sb[sb.shape[0] - 1]
+    apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
+    if apart:
+        return SEPARATE
+    if scratch.shape[0] < scratch_floats(na + nb):
+        return -1
+    box, ids, touch, rays, rord = _scratch_views(scratch, na + nb)
+    return _overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, box, ids, touch, rays, rord)
 
 
 @njit(cache=True, nogil=True)
