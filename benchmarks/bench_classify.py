@@ -32,6 +32,7 @@ the general check.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -262,13 +263,38 @@ def distance_rows(arr_a: np.ndarray, arr_b: np.ndarray, repeats: int) -> None:
                                rtol=1e-9, atol=1e-12)
 
 
+def prebuilt_rows(rng: np.random.Generator, repeats: int, rows) -> None:
+    """classify on prebuilt Shapes against shapely.relate on prebuilt polygons, one row
+    per (vertices, target ratio)."""
+    print("\nclassify on prebuilt Shapes vs shapely.relate on prebuilt polygons (us per "
+          f"pair, median (min-max) of {2 * repeats + 1} passes over the pairs, the two "
+          "taking turns every 50 pairs; ratio = relate / classify per chunk of 50, median "
+          "(10th-90th percentile))")
+    print(f"{'vertices':>8} {'classify(Shape, Shape)':>24} {'shapely.relate':>22}  ratio")
+    for n, target in rows:
+        pairs = make_pairs(rng, n, 600 if n < 1000 else 100)
+        shapes = [(pc.Shape(a), pc.Shape(b)) for a, b in pairs]
+        geoms = [(shapely.Polygon(a), shapely.Polygon(b)) for a, b in pairs]
+        t, chunks = rounds({"ours": ours, "relate": shapely.relate},
+                           {"ours": shapes, "relate": geoms}, 2 * repeats + 1,
+                           50 if n < 1000 else 10)
+        print(f"{n:>8} {spread(t['ours']):>24} {spread(t['relate']):>22}  "
+              f"{ratio_text(chunks['relate'], chunks['ours'], target, quantiles=True)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer pairs and repeats")
+    parser.add_argument("--prebuilt", action="store_true",
+                        help="only the prebuilt-Shape rows (12 and 96 vertices)")
     args = parser.parse_args()
     repeats = 3 if args.quick else 7
     rng = np.random.default_rng(20261122)
     pc.warmup()
+    if args.prebuilt:
+        print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+        prebuilt_rows(rng, repeats, ((12, 5.0), (96, 3.0)))
+        return
 
     print("classify from raw arrays vs Shapely construction + predicate (us per pair)")
     print(f"{'vertices':>8} {'classify':>10} {'intersects':>11} {'relate':>10} "
@@ -282,20 +308,7 @@ def main() -> None:
         print(f"{n:>8} {t_ours:>10.2f} {t_int:>11.2f} {t_rel:>10.2f} "
               f"{t_int / t_ours:>13.1f} {t_rel / t_ours:>9.1f}")
 
-    print("\nclassify on prebuilt Shapes vs shapely.relate on prebuilt polygons (us per "
-          f"pair, median (min-max) of {2 * repeats + 1} passes over the pairs, the two "
-          "taking turns every 50 pairs; ratio = relate / classify per chunk of 50, median "
-          "(10th-90th percentile))")
-    print(f"{'vertices':>8} {'classify(Shape, Shape)':>24} {'shapely.relate':>22}  ratio")
-    for n, target in ((12, 5.0), (96, 3.0), (1024, 1.0)):
-        pairs = make_pairs(rng, n, 600 if n < 1000 else 100)
-        shapes = [(pc.Shape(a), pc.Shape(b)) for a, b in pairs]
-        geoms = [(shapely.Polygon(a), shapely.Polygon(b)) for a, b in pairs]
-        t, chunks = rounds({"ours": ours, "relate": shapely.relate},
-                           {"ours": shapes, "relate": geoms}, 2 * repeats + 1,
-                           50 if n < 1000 else 10)
-        print(f"{n:>8} {spread(t['ours']):>24} {spread(t['relate']):>22}  "
-              f"{ratio_text(chunks['relate'], chunks['ours'], target, quantiles=True)}")
+    prebuilt_rows(rng, repeats, ((12, 5.0), (96, 3.0), (1024, 1.0)))
 
     print("\nclassify_many: 100 000 pairs of 12-gons (seconds)")
     base = make_pairs(rng, 12, 3000)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import enum
 import os
+import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -384,8 +385,22 @@ _RAW: list[Any] = []  # [classify_raw], bound on first use
 _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
-_STATE: list[Any] = []  # [relate_state's entry point for two Shapes], bound on first use
+#: The state kernels for two Shapes, bound on first use: [relate_state_into's entry point,
+#: relate_state's entry point] (see polycontact._dispatch).
+_STATE: list[Any] = []
 _new = object.__new__
+
+#: Vertices (both bodies together) that each thread's scratch buffer for :func:`classify`
+#: holds (~90 kB); larger pairs allocate their own, which costs little beside their test.
+_SCRATCH_VERTICES = 512
+_LOCAL = threading.local()
+
+
+def _thread_scratch() -> np.ndarray:
+    """This thread's scratch buffer for the state kernel, made on its first use."""
+    buf: np.ndarray = np.empty(_kr().scratch_floats(_SCRATCH_VERTICES))
+    _LOCAL.scratch = buf
+    return buf
 
 
 def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
@@ -425,21 +440,33 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
     >>> round(classify(sq, sq + [0.75, 0.5]).distance, 12)
     -0.25
     """
-    if type(a) is Shape and type(b) is Shape and _STATE:
-        # Prebuilt shapes (a simulation's loop), the fastest path: the tolerance is
-        # cached on each shape and the state kernel is called without the dispatcher's
-        # type resolution (the shapes' read-only arrays have fixed types: see
-        # polycontact._dispatch).
+    if isinstance(a, Shape) and isinstance(b, Shape) and _STATE:
+        # Shapes (prebuilt: a simulation's loop), the fastest path: the tolerance is
+        # cached on each shape, the state kernel is called without the dispatcher's type
+        # resolution (the shapes' read-only arrays have fixed types: see
+        # polycontact._dispatch) and with this thread's scratch (nothing allocated).
         if tolerance is None:
             eps = a._tolerance if a._tolerance > b._tolerance else b._tolerance
         else:
             eps = _check_tolerance(tolerance)
+        try:
+            buf = _LOCAL.scratch
+        except AttributeError:
+            buf = _thread_scratch()
+        code = _STATE[0](a._xy, a._starts, b._xy, b._starts, eps, buf)
+        if code < 0:  # more vertices than the buffer holds
+            code = _STATE[1](a._xy, a._starts, b._xy, b._starts, eps)
         obj = _new(Relation)
         d = obj.__dict__
-        d["state"] = _STATES[_STATE[0](a._xy, a._starts, b._xy, b._starts, eps)]
+        d["state"] = _STATES[code]
         d["tolerance"] = eps
         d["_pair"] = (a, b)
         return obj
+    return _classify_other(a, b, tolerance)
+
+
+def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relation:
+    """:func:`classify` of bodies that are not both Shapes (and its first call)."""
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     if (
         type(a) is _ND
@@ -464,17 +491,12 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
             return obj
     sa = as_shape(a, "a")
     sb = as_shape(b, "b")
-    eps = (sa._tolerance if sa._tolerance > sb._tolerance else sb._tolerance) if tol < 0.0 \
-        else tol
     if not _STATE:
-        _STATE.append(entry_point(_kr().relate_state, (sa._xy, sa._starts, sb._xy, sb._starts,
-                                                       eps)))
-    obj = _new(Relation)
-    d = obj.__dict__
-    d["state"] = _STATES[_STATE[0](sa._xy, sa._starts, sb._xy, sb._starts, eps)]
-    d["tolerance"] = eps
-    d["_pair"] = (sa, sb)
-    return obj
+        args = (sa._xy, sa._starts, sb._xy, sb._starts, 1.0)
+        into = entry_point(_kr().relate_state_into, (*args, np.empty(0)))
+        # one slice assignment: threads binding at once leave the same two entries
+        _STATE[:] = [into, entry_point(_kr().relate_state, args)]
+    return classify(sa, sb, tolerance=tolerance)
 
 
 @dataclass(frozen=True, eq=False)

@@ -257,8 +257,18 @@ def _view(xy, ls, lo, nl, b, buf):
 @njit(cache=True, nogil=True)
 def _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, k0, k1, states, used):
     box, ids, touch, rays, rord = _scratch(2 * vmax)
-    ba = np.empty(lmax + 1, np.int64)
-    bb = np.empty(lmax + 1, np.int64)
+    _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, ids, touch,
+                   rays, rord, np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): per pair it makes four
+# views and passes a dozen arrays to the state kernel, and their atomic reference counts
+# cost ~25 ns per pair. Nothing in it may allocate: the buffers are passed in.
+@njit(cache=True, nogil=True, _nrt=False)
+def _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, ids, touch,
+                   rays, rord, ba, bb):
+    """The loop of :func:`_classify_range` with its buffers (``ba``, ``bb``: loop starts
+    of the two bodies)."""
     for k in range(k0, k1):
         i = pi[k]
         j = pj[k]

@@ -1,0 +1,169 @@
+"""The state kernel's early exit for separate pairs (``relation._apart``) against the full
+test it skips (``relation._overlap_state``), near the tolerance boundary.
+
+``_apart`` may answer "separate" only where the full test does: whenever it fires, the
+full test must say separate for the same pair and tolerance. The pairs are placed along
+the line of their bounding boxes' centres (the line ``_apart`` projects on) at a gap of
+about eps, just above it and just below it, at scales 1e-9..1e9 and offsets up to 1e9,
+so both the early exit and the fall-through are taken. Also: the state kernel with its
+scratch passed in (``relate_state_into``, what ``classify`` calls on Shapes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from catalogue import pairs, shapes
+from hypothesis import event, given
+from hypothesis import strategies as st
+from profiles import examples
+
+from polycontact import Shape
+from polycontact._kernels import relation as kr
+from polycontact.tolerances import default_tolerance
+
+#: Gaps as multiples of the pair's tolerance: well inside, at and around the boundary.
+FACTORS = (0.0, 0.5, 1.0 - 1e-6, 1.0, 1.0 + 1e-12, 1.0 + 1e-9, 1.0 + 1e-6, 1.0 + 1e-3,
+           1.0 + 2.0**-40, 1.5, 4.0)
+
+
+def _states(xa, sa, xb, sb, eps):
+    """(``_apart`` fired, ``_state_in``, the full test) for one pair and tolerance."""
+    na, nb = sa[-1], sb[-1]
+    ba, bb = kr._bbox(xa, na), kr._bbox(xb, nb)
+    scratch = kr._scratch(na + nb)
+    fast = kr._state_in(xa, sa, 1.0, xb, sb, 1.0, eps, *scratch)
+    full = kr._overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, *scratch)
+    return bool(kr._apart(xa, na, xb, nb, ba, bb, eps)), fast, full
+
+
+def _place(xa: np.ndarray, xb: np.ndarray, w: np.ndarray, gap: float) -> np.ndarray:
+    """``xb`` moved so that its box centre lies on the line from ``xa``'s box centre along
+    ``w`` (unit) and its vertices project onto ``w`` ``gap`` beyond ``xa``'s."""
+    ca = 0.5 * (xa.min(0) + xa.max(0))
+    cb = 0.5 * (xb.min(0) + xb.max(0))
+    t = gap + (xa - ca).dot(w).max() - (xb - cb).dot(w).min()
+    return xb - cb + ca + t * w
+
+
+def _eps_at(xa, xb, w, factor):
+    """The pair's default tolerance once placed ``factor`` tolerances apart (the
+    tolerance follows the coordinates' magnitude, which follows the placement)."""
+    eps = default_tolerance(xa, xb)
+    for _ in range(3):
+        eps = default_tolerance(xa, _place(xa, xb, w, factor * eps))
+    return eps
+
+
+def _check(xa, sa, xb, sb, eps):
+    apart, fast, full = _states(xa, sa, xb, sb, eps)
+    if apart:
+        assert full == kr.SEPARATE
+    assert fast == full
+    return apart, full
+
+
+@examples(300)
+@given(shapes(grid=False), shapes(grid=False), st.integers(-9, 9),
+       st.sampled_from([(0.0, 0.0), (1e9, 0.0), (-1e9, 1e9), (3e8, -7e8)]),
+       st.floats(0.0, 2.0 * np.pi), st.sampled_from(FACTORS))
+def test_early_exit_agrees_with_the_full_test_near_the_tolerance(a, b, power, offset, angle,
+                                                                  factor):
+    w = np.array([np.cos(angle), np.sin(angle)])
+    # far from the origin a body must span many float spacings to stay a polygon
+    scale = 10.0 ** (power if offset == (0.0, 0.0) else max(power, -4))
+    xa = a.packed[0] * scale + np.array(offset)
+    xb0 = b.packed[0] * scale + np.array(offset)
+    eps = _eps_at(xa, xb0, w, factor)
+    xb = _place(xa, xb0, w, factor * eps)
+    for e in (eps, eps * (1.0 - 1e-9), eps * (1.0 + 1e-9), 0.0, 2.0 * eps):
+        for apart, _ in (_check(xa, a.packed[1], xb, b.packed[1], e),
+                         _check(xb, b.packed[1], xa, a.packed[1], e)):
+            event("early exit" if apart else "full test")
+
+
+def _symmetric(rng: np.random.Generator, n: int) -> np.ndarray:
+    """A centrally symmetric star of 2 n vertices with vertex (1, 0) farthest along x:
+    its box centre is its centre, so two of them placed along the line of their centres
+    have their nearest vertices on that line."""
+    t = np.sort(rng.uniform(0.15, np.pi - 0.15, n - 1))
+    r = rng.uniform(0.3, 0.95, n - 1)
+    half = np.r_[[[1.0, 0.0]], np.c_[r * np.cos(t), r * np.sin(t)]]
+    return np.r_[half, -half]
+
+
+def _turned(xy: np.ndarray, angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return xy @ np.array([[c, s], [-s, c]])
+
+
+@pytest.mark.parametrize(("power", "offset"), [(p, 0.0) for p in (-9, -3, 0, 4, 9)]
+                         + [(p, 1e9) for p in (-3, 0, 4, 9)])
+def test_early_exit_fires_above_the_tolerance_and_falls_through_below(power, offset):
+    """Vertex to vertex along the line of centres: 4 eps apart the early exit answers
+    separate; at 0.5 eps and just below eps it falls through and the full test finds
+    the contact (a threshold that forgot eps, or took a fraction of it, would answer
+    separate there)."""
+    rng = np.random.default_rng(power + 100)
+    scale = 10.0**power
+    for k in range(20):
+        angle = rng.uniform(0.0, 2.0 * np.pi)
+        w = np.array([np.cos(angle), np.sin(angle)])
+        xa = _turned(_symmetric(rng, 5), angle) * scale + offset
+        xb0 = _turned(_symmetric(rng, 4), angle + np.pi) * scale * rng.uniform(0.5, 2.0) \
+            + offset
+        sa, sb = np.array([0, len(xa)]), np.array([0, len(xb0)])
+        # just inside the tolerance: 1e-3 of it is far above the rounding of the
+        # coordinates at offset 0, 1e-1 at offset 1e9 (eps is 64 float spacings there)
+        near = 1.0 - (0.1 if offset else 1e-3)
+        for factor, fires, state in ((4.0, True, kr.SEPARATE), (0.5, False, kr.CONTACT),
+                                     (near, False, kr.CONTACT)):
+            eps = _eps_at(xa, xb0, w, factor)
+            xb = _place(xa, xb0, w, factor * eps)
+            assert Shape(xb).n_vertices == len(xb)  # still a valid polygon
+            apart, full = _check(xa, sa, xb, sb, eps)
+            assert (apart, full) == (fires, state), (k, factor)
+
+
+def test_early_exit_never_fires_for_a_body_in_a_hole():
+    """A body inside a hole of another is apart from it, but no line separates them: the
+    early exit must leave it to the full test."""
+    frame = Shape([(0, 0), (10, 0), (10, 10), (0, 10)], holes=[[(2, 2), (2, 8), (8, 8), (8, 2)]])
+    inner = Shape([(4, 4), (6, 4), (6, 6), (4, 6)])
+    for d in ((0.0, 0.0), (1.9, 0.0), (0.0, -1.9)):
+        xb = inner.packed[0] + np.array(d)
+        eps = default_tolerance(frame.packed[0], xb)
+        apart, full = _check(*frame.packed, xb, inner.packed[1], eps)
+        assert not apart and full == kr.SEPARATE
+
+
+@examples(100)
+@given(pairs(holes=None))
+def test_state_with_passed_scratch_is_the_allocating_state(pair):
+    """relate_state_into (the scratch passed in, no allocation) gives relate_state's
+    answer; a buffer too small for a pair that needs it gives -1, never a wrong state."""
+    a, b, _ = pair
+    eps = default_tolerance(a.packed[0], b.packed[0])
+    want = kr.relate_state(*a.packed, *b.packed, eps)
+    size = a.n_vertices + b.n_vertices
+    buf = np.full(kr.scratch_floats(size) + 3, np.nan)
+    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want
+    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want  # reused
+    small = kr.relate_state_into(*a.packed, *b.packed, eps, buf[: kr.scratch_floats(size) - 1])
+    assert small in (-1, want) and (small == -1 or want == kr.SEPARATE)
+
+
+def test_scratch_views_do_not_overlap():
+    size = 13
+    buf = np.zeros(kr.scratch_floats(size))
+    box, ids, touch, rays, rord = kr._scratch_views(buf, size)
+    assert box.shape == (size + 1, 4) and ids.shape == (size + 1, 4)
+    assert rays.shape == (2 * size + 2, 6) and rord.shape == (2 * size + 2,)
+    assert touch.shape[0] >= size + 1
+    box[:] = 1.0
+    rays[:] = 2.0
+    ids[:] = 3
+    rord[:] = 4
+    touch[:] = True
+    assert (box == 1.0).all() and (rays == 2.0).all() and (ids == 3).all()
+    assert (rord == 4).all() and touch.all()
