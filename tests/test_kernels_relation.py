@@ -131,10 +131,11 @@ def test_features_kernel_against_numpy(pair):
 @given(st.lists(st.floats(-100, 100), min_size=0, max_size=60))
 @example(list(range(32, 0, -1)))                 # reversed: the heap-sort fallback
 @example([1.0] * 20 + [0.0] * 20 + [0.5] * 20)   # bunched keys, bucket pass then fallback
-def test_sort_by_xmin(keys):
+def test_sort_into_orders_rows_by_xmin(keys):
     box = np.zeros((len(keys), 4))
     box[:, 0] = keys
-    order = kr._sort_by_xmin(box, len(keys))
+    order = np.empty(len(keys), np.int64)
+    kr._sort_into(box, len(keys), order, np.empty(len(keys) + 1, np.int64))
     assert sorted(order.tolist()) == list(range(len(keys)))
     assert np.all(np.diff(box[order, 0]) >= 0)
 

@@ -116,14 +116,6 @@ def _edge_table(xy, starts, offset, wx0, wx1, wy0, wy1, box, ids, cnt):
 
 
 @njit(cache=True, nogil=True)
-def _sort_by_xmin(box, cnt):
-    """Order of the first cnt rows of box by xmin (see :func:`_sort_into`)."""
-    order = np.empty(cnt, np.int64)
-    _sort_into(box, cnt, order, np.empty(cnt + 1, np.int64))
-    return order
-
-
-@njit(cache=True, nogil=True)
 def _sort_into(box, cnt, order, start):
     """Write into ``order[:cnt]`` the order of the first cnt rows of box by xmin.
 
