@@ -27,7 +27,7 @@ from ..errors import DepthTooLargeError
 from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
                   sum_into)
 from .decompose import ring_pieces
-from .relation import PENETRATING, _state
+from .relation import PENETRATING, _bbox, _state
 from .relation_many import _body, _oriented
 
 
@@ -283,20 +283,8 @@ def box_escape(xa, xb):
     """The shortest of the four axis translations of A (vertices ``xa``) that take it
     out of the bounding box of B (vertices ``xb``): ``(length, dx, dy)``; the first of
     +x, −x, +y, −y on a tie."""
-    ax0 = ax1 = xa[0, 0]
-    ay0 = ay1 = xa[0, 1]
-    for i in range(1, xa.shape[0]):
-        ax0 = min(ax0, xa[i, 0])
-        ax1 = max(ax1, xa[i, 0])
-        ay0 = min(ay0, xa[i, 1])
-        ay1 = max(ay1, xa[i, 1])
-    bx0 = bx1 = xb[0, 0]
-    by0 = by1 = xb[0, 1]
-    for i in range(1, xb.shape[0]):
-        bx0 = min(bx0, xb[i, 0])
-        bx1 = max(bx1, xb[i, 0])
-        by0 = min(by0, xb[i, 1])
-        by1 = max(by1, xb[i, 1])
+    ax0, ax1, ay0, ay1 = _bbox(xa, xa.shape[0])
+    bx0, bx1, by0, by1 = _bbox(xb, xb.shape[0])
     bound = bx1 - ax0
     bdx = bound
     bdy = 0.0
