@@ -1,4 +1,5 @@
-"""First impacts among many moving bodies: ``first_impacts`` against the all-pairs loop.
+"""First impacts among many moving bodies: ``first_impacts`` against the all-pairs loop
+of ``time_of_impact``.
 
 Run: ``python benchmarks/bench_first_impacts.py [--bodies N] [--repeat R] [--seed S]``.
 
@@ -10,10 +11,10 @@ pass. Printed, in one run:
 
 - ``first_impacts`` (swept bounds + exact search on threads), its candidate pairs and
   the events found;
-- the all-pairs loops of today: ``Scene(...).first_impact()`` (N(N − 1)/2
-  ``time_of_impact`` calls) and, to check every answer, a plain double loop of
-  ``time_of_impact`` whose events must equal those of ``first_impacts`` (same pairs,
-  equal ``Impact`` objects);
+- ``Scene(...).first_impact()``, which before issue 11 was the all-pairs loop
+  (N(N − 1)/2 ``time_of_impact`` calls) and now goes through the same World, and the
+  all-pairs baseline: a plain double loop of ``time_of_impact`` whose events must equal
+  those of ``first_impacts`` (same pairs, equal ``Impact`` objects);
 - medians over R rounds (each: ``first_impacts`` and ``first_impact``, median of 5
   calls, then one run of each loop) and the median of the per-round ratios, with their
   spread (fastest and slowest call of ``first_impacts``, range of the ratios and of the
@@ -137,8 +138,8 @@ def main() -> None:
           f"{len(cand)} candidate pairs; {len(events)} pairs meet, {hits} collide)")
     print(f"first_impact:  {1e3 * t_one:9.1f} ms  -> bodies {first.i}, {first.j} at "
           f"t = {first.impact.time:.6f} ({first.impact.status.value})")
-    print(f"Scene.first_impact (all pairs): {t_scene:7.2f} s  ({1e6 * t_scene / pairs:.1f} us "
-          f"per pair) -> {ba.name}, {bb.name} at t = {imp.time:.6f}")
+    print(f"Scene.first_impact (World): {t_scene:7.2f} s  -> {ba.name}, {bb.name} at "
+          f"t = {imp.time:.6f}")
     same = {(i, j): imp for i, j, imp in slow} == {(e.i, e.j): e.impact for e in events}
     print(f"double loop of time_of_impact:  {t_brute:7.2f} s  -> {len(slow)} pairs meet; "
           f"first_impacts gives the same pairs and Impacts: {same}")

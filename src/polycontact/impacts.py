@@ -25,7 +25,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .broad_phase import BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max
+from .broad_phase import (BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max,
+                          reach_excess)
 from .errors import InvalidShapeError
 from .impact import (_ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
                      ImpactStatus, _extent, _result, body_frame, check_options)
@@ -254,8 +255,7 @@ def _unique(shapes: list[Shape]) -> tuple[list[Shape], np.ndarray]:
 
 def _motion_array(motions: list[Motion]) -> np.ndarray:
     """The rows ``Motion.array`` of every motion, in one NumPy call."""
-    return np.array([(*m.velocity, *m.acceleration, m.angular_velocity, m.angular_acceleration)
-                     for m in motions], dtype=np.float64).reshape(len(motions), 6)
+    return np.array([m._array for m in motions], dtype=np.float64).reshape(len(motions), 6)
 
 
 def _extents(shapes: list[Shape], motions: list[Motion], names: list[tuple[str, str]],
@@ -266,10 +266,10 @@ def _extents(shapes: list[Shape], motions: list[Motion], names: list[tuple[str, 
     (once per shape, with its body frame), then motions that would carry coordinates,
     speeds or accelerations beyond float64's safe range within [0, t_max]. Errors name
     the body's arguments, ``names[k] = (shape's, motion's)``."""
-    for s, (what, _) in zip(shapes, names):
-        body_frame(s, tables=False, what=what)
-    for s, m, (_, what) in zip(shapes, motions, names):
-        check_reach(s, m, t_max, what)
+    bases = [body_frame(s, tables=False, what=what)[2] for s, (what, _) in zip(shapes, names)]
+    for s, m, base, (_, what) in zip(shapes, motions, bases, names):
+        if reach_excess(base, s.bounding_radius, m._norms, t_max) is not None:
+            check_reach(s, m, t_max, what)  # raises, naming the motion
     return np.array([_extent(s) for s in shapes], dtype=np.float64)
 
 
