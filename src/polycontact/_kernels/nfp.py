@@ -852,6 +852,19 @@ def sum_index(xy, starts, bb, fr, gx0, gy0, h, grid_from=_GRID_MIN_SUMS):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0):
+    """Take from the parts of edge (a, b) of sum p what sum q covers: from
+    ``lo1[:n1], hi1[:n1]`` its closed interior shrunk by eps, from ``lo0[:n0],
+    hi0[:n0]`` its open interior (see :func:`_clip`); returns the new ``(n1, n0)``."""
+    a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
+    if a1 < b1 and n1 > 0:
+        n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
+    if a0 < b0 and n0 > 0:
+        n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+    return n1, n0
+
+
+@njit(cache=True, nogil=True, inline="always")
 def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
     """Clip the part [t0, t1] of edge (a, b) of sum p by the other sums
     (:func:`sum_index`), until nothing is left. Returns ``(n1, n0, hint)``: the parts
@@ -895,11 +908,7 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
                 continue
             tried[nt] = q
             nt += 1
-            a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
-            if a1 < b1 and n1 > 0:
-                n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-            if a0 < b0 and n0 > 0:
-                n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+            n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0)
             if n1 == 0 and n0 == 0:
                 return n1, n0, hint
     x0 = min(ax, bx) - eps
@@ -915,11 +924,7 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
             continue
         if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
             continue
-        a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
-        if a1 < b1 and n1 > 0:
-            n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
-        if a0 < b0 and n0 > 0:
-            n0 = _compact(lo0, hi0, _subtract(lo0, hi0, n0, a0, b0))
+        n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0)
         if n1 == 0 and n0 == 0:
             return n1, n0, q
     return n1, n0, hint
