@@ -32,8 +32,9 @@ b = a.moved((1.0, 0.5))
 print(kr.relate_shapes_into(a._kernel, b._kernel, 1e-12, np.empty(kr.scratch_floats(8))))
 views = kr._scratch(8)
 print([v.base.refcount for v in views])  # one reference per view
-print([kr.relate_state(*a.packed, *a.moved(d).packed, 1e-12)
-       for d in ((1.0, 0.5), (0.5, 0.5), (3.0, 0.0)) for _ in range(50)] == [1] * 50 + [2] * 50 + [0] * 50)
+got = [kr.relate_state(*a.packed, *a.moved(d).packed, 1e-12)
+       for d in ((1.0, 0.5), (0.5, 0.5), (3.0, 0.0)) for _ in range(50)]
+print(got == [1] * 50 + [2] * 50 + [0] * 50)
 """
 
 

@@ -642,15 +642,13 @@ def _fmt(v: float) -> str:
 def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """The shape in one read-only float64 array, the layout of
     :data:`polycontact._kernels.relation.PACK_HEAD`: loop count, bounding box ``(xmin,
-    xmax, ymin, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the loop
+    ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the loop
     ``starts`` as int64 bit patterns, then ``xy`` row by row. :func:`polycontact.classify`
-    passes it to the state kernel: one array to unbox per shape instead of two."""
-    head = 5 + len(starts)  # PACK_HEAD + the starts (the kernels are imported lazily)
-    pack = np.empty(head + xy.size)
-    pack[0] = len(starts) - 1
-    pack[1:5] = (lo[0], hi[0], lo[1], hi[1])
-    pack[5:head].view(np.int64)[:] = starts
-    pack[head:] = xy.ravel()
+    passes it to the state kernel: one array to unbox per shape instead of two (one
+    concatenation: about 2 us per shape)."""
+    pack = np.concatenate(
+        ((len(starts) - 1.0,), lo, hi, starts.view(np.float64), xy.reshape(-1))
+    )
     pack.flags.writeable = False
     return pack
 

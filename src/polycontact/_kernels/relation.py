@@ -634,20 +634,21 @@ def relate_state(xa, sa, xb, sb, eps):
 
 #: Layout of a shape's kernel pack (``Shape._kernel``, built once per shape by
 #: :func:`polycontact.shape._kernel_pack`): one read-only float64 array holding the loop
-#: count, the bounding box ``(xmin, xmax, ymin, ymax)``, the loop starts (int64 bit
+#: count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the loop starts (int64 bit
 #: patterns, L + 1 of them) and then the packed coordinates row by row.
 PACK_HEAD = 5
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _unpack(pack):
-    """``(xy, starts, box)`` of a shape's kernel pack (views: nothing is allocated)."""
+    """``(xy, starts, box)`` of a shape's kernel pack (views: nothing is allocated), the
+    box as ``(xmin, xmax, ymin, ymax)``."""
     nl = int(pack[0])
     starts = pack[PACK_HEAD : PACK_HEAD + nl + 1].view(np.int64)
     n = starts[nl]
     head = PACK_HEAD + nl + 1
     xy = pack[head : head + 2 * n].reshape(n, 2)
-    return xy, starts, (pack[1], pack[2], pack[3], pack[4])
+    return xy, starts, (pack[1], pack[3], pack[2], pack[4])
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
