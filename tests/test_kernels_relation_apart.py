@@ -6,7 +6,7 @@ full test must say separate for the same pair and tolerance. The pairs are place
 the line of their bounding boxes' centres (the line ``_apart`` projects on) at a gap of
 about eps, just above it and just below it, at scales 1e-9..1e9 and offsets up to 1e9,
 so both the early exit and the fall-through are taken. Also: the state kernel with its
-scratch passed in (``relate_state_into``, what ``classify`` calls on Shapes).
+scratch passed in (``relate_shapes_into``, what ``classify`` calls on Shapes).
 """
 
 from __future__ import annotations
@@ -140,17 +140,30 @@ def test_early_exit_never_fires_for_a_body_in_a_hole():
 @examples(100)
 @given(pairs(holes=None))
 def test_state_with_passed_scratch_is_the_allocating_state(pair):
-    """relate_state_into (the scratch passed in, no allocation) gives relate_state's
-    answer; a buffer too small for a pair that needs it gives -1, never a wrong state."""
+    """relate_shapes_into (the shapes' kernel packs and the scratch passed in, no
+    allocation) gives relate_state's answer; a buffer too small for a pair that needs
+    it gives -1, never a wrong state."""
     a, b, _ = pair
     eps = default_tolerance(a.packed[0], b.packed[0])
     want = kr.relate_state(*a.packed, *b.packed, eps)
     size = a.n_vertices + b.n_vertices
     buf = np.full(kr.scratch_floats(size) + 3, np.nan)
-    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want
-    assert kr.relate_state_into(*a.packed, *b.packed, eps, buf) == want  # reused
-    small = kr.relate_state_into(*a.packed, *b.packed, eps, buf[: kr.scratch_floats(size) - 1])
+    assert kr.relate_shapes_into(a._kernel, b._kernel, eps, buf) == want
+    assert kr.relate_shapes_into(a._kernel, b._kernel, eps, buf) == want  # reused
+    small = kr.relate_shapes_into(a._kernel, b._kernel, eps, buf[: kr.scratch_floats(size) - 1])
     assert small in (-1, want) and (small == -1 or want == kr.SEPARATE)
+
+
+@examples(50)
+@given(pairs(holes=None))
+def test_kernel_pack_is_the_shape(pair):
+    """A shape's kernel pack unpacks to its packed arrays and its bounding box (what
+    relate_shapes_into reads instead of computing it), and cannot be written."""
+    for shape in pair[:2]:
+        xy, starts, box = kr._unpack(shape._kernel)
+        assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
+        assert box == kr._bbox(shape.packed[0], shape.n_vertices)
+        assert not shape._kernel.flags.writeable
 
 
 def test_scratch_views_do_not_overlap():

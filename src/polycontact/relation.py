@@ -385,7 +385,7 @@ _RAW: list[Any] = []  # [classify_raw], bound on first use
 _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
-#: The state kernels for two Shapes, bound on first use: [relate_state_into's entry point,
+#: The state kernels for two Shapes, bound on first use: [relate_shapes_into's entry point,
 #: relate_state's entry point] (see polycontact._dispatch).
 _STATE: list[Any] = []
 _new = object.__new__
@@ -444,7 +444,8 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
         # Shapes (prebuilt: a simulation's loop), the fastest path: the tolerance is
         # cached on each shape, the state kernel is called without the dispatcher's type
         # resolution (the shapes' read-only arrays have fixed types: see
-        # polycontact._dispatch) and with this thread's scratch (nothing allocated).
+        # polycontact._dispatch) with one array per shape (its kernel pack, which holds
+        # its bounding box too) and this thread's scratch (nothing allocated).
         if tolerance is None:
             eps = a._tolerance if a._tolerance > b._tolerance else b._tolerance
         else:
@@ -453,7 +454,7 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
             buf = _LOCAL.scratch
         except AttributeError:
             buf = _thread_scratch()
-        code = _STATE[0](a._xy, a._starts, b._xy, b._starts, eps, buf)
+        code = _STATE[0](a._kernel, b._kernel, eps, buf)
         if code < 0:  # more vertices than the buffer holds
             code = _STATE[1](a._xy, a._starts, b._xy, b._starts, eps)
         obj = _new(Relation)
@@ -492,8 +493,8 @@ def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relati
     sa = as_shape(a, "a")
     sb = as_shape(b, "b")
     if not _STATE:
+        into = entry_point(_kr().relate_shapes_into, (sa._kernel, sb._kernel, 1.0, np.empty(0)))
         args = (sa._xy, sa._starts, sb._xy, sb._starts, 1.0)
-        into = entry_point(_kr().relate_state_into, (*args, np.empty(0)))
         # one slice assignment: threads binding at once leave the same two entries
         _STATE[:] = [into, entry_point(_kr().relate_state, args)]
     return classify(sa, sb, tolerance=tolerance)

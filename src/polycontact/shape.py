@@ -154,7 +154,7 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_tolerance", "_input")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -229,6 +229,7 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
+        self._kernel = _kernel_pack(xy, starts, lo, hi)
         # body-frame tables of the time-of-impact search
         self._frame: tuple[Any, Any, float] | None = None
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
@@ -636,6 +637,20 @@ def _to_segment(p: np.ndarray, s: np.ndarray, e: np.ndarray) -> float:
 
 def _fmt(v: float) -> str:
     return f"{v:.12g}"
+
+
+def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The shape in one read-only float64 array, the layout of
+    :data:`polycontact._kernels.relation.PACK_HEAD`: loop count, bounding box ``(xmin,
+    ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the loop
+    ``starts`` as int64 bit patterns, then ``xy`` row by row. :func:`polycontact.classify`
+    passes it to the state kernel: one array to unbox per shape instead of two (one
+    concatenation: about 2 us per shape)."""
+    pack = np.concatenate(
+        ((len(starts) - 1.0,), lo, hi, starts.view(np.float64), xy.reshape(-1))
+    )
+    pack.flags.writeable = False
+    return pack
 
 
 def _bound(obj: Any, name: str) -> bool:

@@ -421,7 +421,7 @@ def _scratch(size):
 @njit(cache=True, nogil=True)
 def scratch_floats(size):
     """Length of a float64 buffer that holds the scratch of the state kernel for pairs
-    of up to ``size`` vertices in all (see :func:`relate_state_into`).
+    of up to ``size`` vertices in all (see :func:`relate_shapes_into`).
 
     >>> scratch_floats(24)
     554
@@ -430,7 +430,7 @@ def scratch_floats(size):
     return 22 * r + (size + 8) // 8
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _scratch_views(buf, size):
     """:func:`_scratch`'s five buffers as views of ``buf`` (of at least
     ``scratch_floats(size)`` floats): edge boxes (r, 4), edge ids (r, 4) int64, touch
@@ -632,32 +632,60 @@ def relate_state(xa, sa, xb, sb, eps):
     return _state(xa, sa, 1.0, xb, sb, 1.0, eps)
 
 
+#: Layout of a shape's kernel pack (``Shape._kernel``, built once per shape by
+#: :func:`polycontact.shape._kernel_pack`): one read-only float64 array holding the loop
+#: count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the loop starts (int64 bit
+#: patterns, L + 1 of them) and then the packed coordinates row by row.
+PACK_HEAD = 5
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _unpack(pack):
+    """``(xy, starts, box)`` of a shape's kernel pack (views: nothing is allocated), the
+    box as ``(xmin, xmax, ymin, ymax)``."""
+    nl = int(pack[0])
+    starts = pack[PACK_HEAD : PACK_HEAD + nl + 1].view(np.int64)
+    n = starts[nl]
+    head = PACK_HEAD + nl + 1
+    xy = pack[head : head + 2 * n].reshape(n, 2)
+    return xy, starts, (pack[1], pack[3], pack[2], pack[4])
+
+
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
 # arrays it is called with and passes on cost ~0.1 us per call, as much as the test of a
-# small separate pair. Nothing in it may allocate: the scratch is passed in.
+# small separate pair. Nothing in it may allocate: the scratch is passed in. It takes one
+# array per shape (each array a call unboxes costs 35-120 ns, more when other code has
+# evicted the caches) and reads the bounding boxes cached in them.
 @njit(cache=True, nogil=True, _nrt=False)
-def relate_state_into(xa, sa, xb, sb, eps, scratch):
-    """:func:`relate_state` with its scratch passed in, allocating nothing.
+def relate_shapes_into(pa, pb, eps, scratch):
+    """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),
+    with its scratch passed in, allocating nothing.
 
     ``scratch`` is a float64 buffer of at least :func:`scratch_floats` (vertices of
     both bodies) entries, used by one call at a time (one per thread); returns -1 (and
     computes nothing) when a pair that needs it finds it too small.
 
+    The boxes are those of the packs; they equal :func:`_bbox` of the coordinates (a
+    minimum or maximum is exact) up to the sign of a zero, which no use of a box sees:
+    boxes are compared, summed with a nonzero bound (a valid shape's box has positive
+    width and height) or shifted by eps before a comparison.
+
     Examples
     --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> st = np.array([0, 4])
+    >>> from polycontact import Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> buf = np.empty(scratch_floats(8))
-    >>> [relate_state_into(sq, st, sq + d, st, 1e-12, buf) for d in ([2, 0], [1, 0], [0.5, 0.5])]
+    >>> [relate_shapes_into(sq._kernel, sq.moved(d)._kernel, 1e-12, buf)
+    ...  for d in ([2, 0], [1, 0], [0.5, 0.5])]
     [0, 1, 2]
-    >>> relate_state_into(sq, st, sq, st, 1e-12, buf[:10])
+    >>> relate_shapes_into(sq._kernel, sq._kernel, 1e-12, buf[:10])
     -1
     """
+    xa, sa, ba = _unpack(pa)
+    xb, sb, bb = _unpack(pb)
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
-    apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
-    if apart:
+    if _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps):
         return SEPARATE
     if scratch.shape[0] < scratch_floats(na + nb):
         return -1
