@@ -102,21 +102,22 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False
     once per shape (as ``time_of_impact`` does) before timing, like ``Shape.packed``.
     ``compiled``: call the compiled code directly (as ``time_of_impact`` does, see
     ``polycontact._dispatch``) rather than through the Numba dispatcher."""
-    ra, ea, _ = body_frame(a)
-    rb, eb, _ = body_frame(b)
+    ra, ea, *_ = body_frame(a)
+    rb, eb, *_ = body_frame(b)
     va, vb = ma.array, mb.array
     lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
     eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
     la, lb = a.bounding_radius, b.bounding_radius
+    work = np.empty(ki.work_floats(len(ra) + len(rb)))  # (the API's is kept per thread)
 
     if method == "exact":
         kernel = ki.exact_query
         args = (ra, a.packed[1], a.centroid, va, la, ea, rb, b.packed[1], b.centroid, vb, lb,
-                eb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, lam, 1_000_000)
+                eb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, lam, 1_000_000, work)
     else:
         kernel = ki.sampled_query
         args = (ra, a.packed[1], a.centroid, va, la, rb, b.packed[1], b.centroid, vb, lb,
-                t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples)
+                t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples, work)
     if compiled:
         kernel = entry_point(kernel, args)
     return lambda: kernel(*args)

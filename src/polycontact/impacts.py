@@ -57,11 +57,6 @@ MAX_SLICES = 16
 #: margin before, was 1e3: every body within a thousand units was a candidate).
 SWEPT_ROUNDING_ULPS = 64.0
 
-#: Width of the broad-phase interval table per pair (a quartic is <= 0 on at most 3
-#: disjoint intervals).
-_MAX_INTERVALS = 6
-
-
 @dataclass(frozen=True)
 class ImpactBatch:
     """The results of :func:`time_of_impact_many`, as arrays, with each pair's full
@@ -188,6 +183,7 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
     search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
     of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
+    from ._kernels.broad_phase import MAX_INTERVALS
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
@@ -200,7 +196,7 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     iters = np.empty(p_count, np.int64)
     reached = np.empty(p_count)
     n_iv = np.empty(p_count, np.int64)
-    iv = np.empty((p_count, _MAX_INTERVALS, 2))
+    iv = np.empty((p_count, MAX_INTERVALS, 2))
     out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
 
     def run(todo: np.ndarray) -> None:
@@ -216,8 +212,6 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
         n_chunks = min(p_count // 16, 16 * threads)
         with ThreadPoolExecutor(threads) as pool:
             list(pool.map(run, [order[c::n_chunks].copy() for c in range(n_chunks)]))
-    if p_count and int(n_iv.max()) > _MAX_INTERVALS:  # a quartic has at most 3
-        raise AssertionError("broad phase returned more intervals than a quartic has")
     return out
 
 
@@ -231,9 +225,9 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
         b, mb = shape_of(p, 1), motion_of(p, 1)
         # (the intervals copied: the result keeps them, not the whole batch's array)
         return _result(a, ma, b, mb, method,
-                       (iv[p, :n_iv[p]].copy(), int(code[p]), float(t_hi[p]), float(t_lo[p]),
+                       (int(n_iv[p]), int(code[p]), float(t_hi[p]), float(t_lo[p]),
                         float(contact[p]), int(iters[p]), float(reached[p])),
-                       t_max, float(eps_rel[p]), tol)
+                       t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
 
     return make
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .impact import exact_query, sampled_query
+from .impact import exact_query, sampled_query, work_floats
 
 
 @njit(cache=True, nogil=True)
@@ -187,6 +187,10 @@ def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles,
     ``code``, ``t_hi``, ``t_lo``, ``contact``, ``iters``, ``reached``, and its broad-phase
     intervals to ``iv[p, :n_iv[p]]``.
     """
+    widest = 0
+    for s in range(v_off.shape[0] - 1):
+        widest = max(widest, v_off[s + 1] - v_off[s])
+    work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
         a = sa[p]
@@ -204,18 +208,18 @@ def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles,
                   circles[n_off[b]:n_off[b + 1]], r_len[v_off[b]:v_off[b + 1]])
             out = exact_query(ra, sta, cent[a], ma[p], la, ea, rb, stb, cent[b], mb[p], lb, eb,
                               t_max, inflate, time_tol, eps_rel[p], ulps,
-                              contact_resolution * (la + lb), max_iter)
+                              contact_resolution * (la + lb), max_iter, work)
         else:
             out = sampled_query(ra, sta, cent[a], ma[p], la, rb, stb, cent[b], mb[p], lb, t_max,
-                                inflate, time_tol, eps_rel[p], ulps, samples)
-        intervals, c, hi, lo, ct, its, got = out
+                                inflate, time_tol, eps_rel[p], ulps, samples, work)
+        n, c, hi, lo, ct, its, got = out
         code[p] = c
         t_hi[p] = hi
         t_lo[p] = lo
         contact[p] = ct
         iters[p] = its
         reached[p] = got
-        n_iv[p] = intervals.shape[0]            # the caller checks it fits in iv
-        for q in range(min(intervals.shape[0], iv.shape[1])):
-            iv[p, q, 0] = intervals[q, 0]
-            iv[p, q, 1] = intervals[q, 1]
+        n_iv[p] = n                             # (at most MAX_INTERVALS, iv's width)
+        for q in range(n):
+            iv[p, q, 0] = work[2 * q]
+            iv[p, q, 1] = work[2 * q + 1]
