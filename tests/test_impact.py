@@ -520,3 +520,19 @@ def test_a_query_kernel_refuses_a_scratch_buffer_too_short_for_its_bodies():
     assert ki.exact_query(*args, np.empty(need))[1] == ki.INITIALLY_PENETRATING
     with pytest.raises(ValueError, match="scratch buffer is too short"):
         ki.exact_query(*args, np.empty(need - 1))
+
+
+def test_the_body_frame_cached_on_a_shape_is_read_only():
+    # time_of_impact keeps each shape's body frame (vertices about the centroid, circle
+    # tree, the packed arrays the exact kernel takes) on the shape: none of it may be
+    # changed afterwards, or later queries would read a stale body
+    from polycontact.impact import body_frame
+
+    s = Shape([(0, 0), (2, 0), (2, 2), (0, 2)], [[(0.5, 0.5), (1, 0.5), (1, 1)]])
+    time_of_impact(s, Motion(velocity=(1, 0)), s.moved((5, 0)), Motion(), t_max=1.0)
+    r, tables, _, _, packed = body_frame(s)
+    assert s._frame is not None and s._frame[4] is packed
+    for arr in (r, *tables, *packed):
+        assert not arr.flags.writeable
+        with pytest.raises(ValueError):
+            arr[0] = 0

@@ -532,8 +532,8 @@ def time_of_impact(
         fa = body_frame(a, tables=exact, what="a")
     if fb is None or exact and fb[1] is None:
         fb = body_frame(b, tables=exact, what="b")
-    ra, ea, base_a, big_a = fa
-    rb, eb, base_b, big_b = fb
+    ra, ea, base_a, big_a, pa = fa
+    rb, eb, base_b, big_b, pb = fb
     la, lb = a._radius, b._radius
     if not (t_max <= _SAFE_SCALE and big_a <= _SAFE_SCALE and big_b <= _SAFE_SCALE
             and ma._largest <= _SAFE_SCALE and mb._largest <= _SAFE_SCALE) and (
@@ -554,9 +554,8 @@ def time_of_impact(
         cap, work = _grow_work(size)
     args: tuple[Any, ...]
     if exact:
-        args = (ra, a._starts, a._centroid, ma._array, la, ea, rb, b._starts, b._centroid,
-                mb._array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS,
-                CONTACT_RESOLUTION * (la + lb), int(max_iterations), work)
+        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, t_max, BROAD_PHASE_INFLATION,
+                tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations), work)
     else:
         args = (ra, a._starts, a._centroid, ma._array, la, rb, b._starts, b._centroid,
                 mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples),
@@ -596,7 +595,7 @@ def _query(method: str, args: tuple[Any, ...], fixed: bool) -> tuple[Any, ...]:
     :data:`_ENTRY` for the next calls; otherwise the call goes through the dispatcher."""
     from ._kernels import impact as ki
 
-    run = ki.exact_query if method == "exact" else ki.sampled_query
+    run = ki.exact_call if method == "exact" else ki.sampled_query
     if fixed:
         run = _ENTRY[method] = entry_point(run, args)
     out: tuple[Any, ...] = run(*args)
@@ -632,20 +631,21 @@ _INF = float("inf")
 _SAFE_SCALE = 1e15
 
 
-def body_frame(shape: Shape, tables: bool = True,
-               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None, float, float]:
-    """``(r, tables, base, big)``: the shape's vertices relative to its centroid, when
-    asked for their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
-    sampled method does not need it), how far the body reaches from the origin at
-    rest (:func:`polycontact.broad_phase.base_reach`, for the reach check) and the
-    larger of that and its bounding radius (for the reach check's shortcut). Built on
-    first use and kept with the shape (it is immutable), so that repeated queries on
-    one shape build them once. On first use the coordinates are also checked
+def body_frame(shape: Shape, tables: bool = True, what: str = "shape") -> tuple[Any, ...]:
+    """``(r, tables, base, big, packed)``: the shape's vertices relative to its
+    centroid; when asked for, their ``_kernels.advance.edge_table`` (the exact method's
+    circle tree; the sampled method does not need it); how far the body reaches from
+    the origin at rest (:func:`polycontact.broad_phase.base_reach`, for the reach
+    check) and the larger of that and its bounding radius (for the reach check's
+    shortcut); with the tables, the body as ``_kernels.impact.pack_body`` packs it for
+    the exact kernel (else None). Built on first use and kept with the shape (it is
+    immutable; the arrays are read-only), so that repeated queries on one shape build
+    them once. On first use the coordinates are also checked
     (:func:`polycontact.tolerances.check_range`, the error naming ``what``)."""
     frame = shape._frame
     if frame is not None and (frame[1] is not None or not tables):
-        return frame  # type: ignore[return-value]
-    r, tab, base, big = frame if frame is not None else (None, None, 0.0, 0.0)
+        return frame
+    r, tab, base, big, packed = frame if frame is not None else (None, None, 0.0, 0.0, None)
     if r is None:
         xy = shape.packed[0]
         check_range(xy, what)
@@ -655,9 +655,14 @@ def body_frame(shape: Shape, tables: bool = True,
         r.flags.writeable = False
     if tables and tab is None:
         from ._kernels.advance import edge_table
+        from ._kernels.impact import pack_body
 
         tab = edge_table(r, shape.packed[1])
-    shape._frame = frame = (r, tab, base, big)
+        packed = pack_body(r, shape.packed[1], np.asarray(shape.centroid, dtype=np.float64),
+                           float(shape.bounding_radius), tab)
+        for arr in (*tab, *packed):
+            arr.flags.writeable = False
+    shape._frame = frame = (r, tab, base, big, packed)
     return frame
 
 
