@@ -81,7 +81,9 @@ class Impact:
 
     ``features``, ``point`` and ``normal`` classify the bodies at the moment of impact;
     they are computed on first access (a query that only needs the time does not pay
-    for them) and cached.
+    for them) and cached. Likewise, of a result of :func:`time_of_impact` only
+    ``collides``, ``time`` and ``status`` are set when it is returned; the other fields
+    are filled in together when one of them is first read (the same values).
 
     Attributes
     ----------
