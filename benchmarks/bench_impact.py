@@ -96,27 +96,29 @@ def median_time(fn, repeat: int) -> float:
 
 
 def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False):
-    """What a query costs without building the result: broad phase + search, one kernel
-    call (``_kernels.impact.exact_query`` or ``sampled_query``, each given only what it
-    uses). The body-frame tables are built
-    once per shape (as ``time_of_impact`` does) before timing, like ``Shape.packed``.
-    ``compiled``: call the compiled code directly (as ``time_of_impact`` does, see
-    ``polycontact._dispatch``) rather than through the Numba dispatcher."""
-    ra, ea, _ = body_frame(a)
-    rb, eb, _ = body_frame(b)
+    """What a query costs without building the result: broad phase + search, the one
+    kernel call ``time_of_impact`` makes (``_kernels.impact.exact_call`` on each body's
+    packed frame, or ``sampled_query``), with a scratch buffer made once. The
+    body-frame tables are built once per shape (as ``time_of_impact`` does) before
+    timing, like ``Shape.packed``. ``compiled``: call the compiled code directly (as
+    ``time_of_impact`` does, see ``polycontact._dispatch``) rather than through the
+    Numba dispatcher."""
+    ra, _, _, _, pa = body_frame(a)
+    rb, _, _, _, pb = body_frame(b)
     va, vb = ma.array, mb.array
     lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
     eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
     la, lb = a.bounding_radius, b.bounding_radius
+    work = np.empty(ki.work_floats(len(ra) + len(rb)))  # (the API's is kept per thread)
 
     if method == "exact":
-        kernel = ki.exact_query
-        args = (ra, a.packed[1], a.centroid, va, la, ea, rb, b.packed[1], b.centroid, vb, lb,
-                eb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, lam, 1_000_000)
+        kernel = ki.exact_call
+        args = (*pa, va, *pb, vb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, lam,
+                1_000_000, work)
     else:
         kernel = ki.sampled_query
         args = (ra, a.packed[1], a.centroid, va, la, rb, b.packed[1], b.centroid, vb, lb,
-                t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples)
+                t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples, work)
     if compiled:
         kernel = entry_point(kernel, args)
     return lambda: kernel(*args)

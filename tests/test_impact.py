@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import pickle
+from typing import Any
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact import ImpactStatus, Motion, Shape, State, time_of_impact
+from polycontact import impact as impact_module
 from polycontact.broad_phase import intervals_array
 
 TOL = 1e-4
@@ -407,12 +409,16 @@ def test_impact_result_sets_every_field():
             for _ in range(2):
                 hit = time_of_impact(sq, Motion(velocity=(1, 0)), b, mb, t_max=t_max,
                                      method=method)
-                lazy = {"broad_phase", "time_tolerance"}  # filled in on first access
-                assert fields - lazy <= set(vars(hit)), fields - lazy - set(vars(hit))
+                # set at once; the others filled in together on first access
+                eager = {"collides", "time", "status"}
+                assert eager <= set(vars(hit)), eager - set(vars(hit))
+                assert fields - eager - {"_bodies"} == set(impact_module._LAZY)
                 # (pickled before the lazy fields are read; a local class cannot be)
                 copy = hit if b is sub else pickle.loads(pickle.dumps(hit))
+                hit.method  # (one lazy field read fills in all of them)
+                assert fields <= set(vars(hit)), fields - set(vars(hit))
                 built = pc.Impact(**{f: getattr(hit, f) for f in fields})
-                assert fields <= set(vars(hit)) and hit == built == copy
+                assert hit == built == copy
                 assert hit.broad_phase == tuple(map(tuple, intervals_array(
                     sq, Motion(velocity=(1, 0)), b, mb, t_max).tolist()))
                 t = hit.time if hit.time is not None else hit.searched_to
@@ -422,3 +428,111 @@ def test_impact_result_sets_every_field():
                                      t_max=t_max, method=method)
                 assert (hit.time, hit.status, hit.iterations) == (
                     ref.time, ref.status, ref.iterations)
+
+
+@examples(150)
+@given(st.sampled_from([1e-9, 1.0, 1e14, 1e15, 2e15, 1e30]),
+       st.lists(st.sampled_from([0.0, 1.0, 1e14, 1e15, 1.0000001e15, 1e20, 1e40, 1e60, 2e100]),
+                min_size=4, max_size=4),
+       st.sampled_from([0.0, 1.0, 1e15, 1.5e15, 1e30, 1e50]), st.booleans())
+def test_time_of_impact_refuses_exactly_the_motions_that_check_reach_refuses(
+        size, norms, t_max, second):
+    # time_of_impact skips the reach check when every input is below a bound that
+    # keeps the products far from overflow (_SAFE_SCALE): it must still refuse every
+    # motion check_reach refuses, naming it, and accept the others
+    from polycontact.broad_phase import check_reach
+
+    v, acc, w, alpha = norms
+    moving = Motion(velocity=(v, 0.0), acceleration=(0.0, acc), angular_velocity=w,
+                    angular_acceleration=alpha)
+    a = Shape(np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]) * size)
+    b = a.moved((-3.0 * size, 0.0))
+    ma, mb = (Motion(), moving) if second else (moving, Motion())
+    name = "motion_b" if second else "motion_a"
+    try:
+        check_reach(b if second else a, moving, t_max, name)
+    except ValueError as err:
+        with pytest.raises(ValueError, match=f"^{name}: ") as got:
+            time_of_impact(a, ma, b, mb, t_max=t_max, max_iterations=20)
+        assert str(got.value) == str(err)
+    else:
+        time_of_impact(a, ma, b, mb, t_max=t_max, max_iterations=20)
+
+
+def test_queries_reuse_one_scratch_per_thread_without_carrying_anything_over():
+    # time_of_impact hands the kernel this thread's scratch buffer (grown for larger
+    # bodies): a query's answer must not depend on the queries before it, and threads
+    # must not share a buffer. Reference: each query alone in a fresh thread.
+    import threading
+
+    rng = np.random.default_rng(7)
+
+    def star(n: int) -> Shape:
+        t = np.sort(rng.uniform(0, 2 * np.pi, n))
+        r = rng.uniform(0.5, 1.0, n)
+        return Shape(np.c_[r * np.cos(t), r * np.sin(t)])
+
+    cases = []
+    for n in (3, 8, 40, 200, 5, 700, 12):  # the buffer grows twice on the way
+        a, b = star(n), star(max(3, n // 2)).moved((2.5, 0.3))
+        cases.append((a, Motion(velocity=(1.5, 0.0), angular_velocity=2.0), b,
+                      Motion(angular_velocity=-1.0)))
+
+    def answer(case: tuple[Any, ...], method: str) -> tuple[Any, ...]:
+        hit = time_of_impact(*case, t_max=2.0, method=method)
+        return hit.status, hit.time, hit.first_contact, hit.iterations, hit.broad_phase
+
+    def fresh(case: tuple[Any, ...], method: str) -> tuple[Any, ...]:
+        out: list[Any] = []
+        worker = threading.Thread(target=lambda: out.append(answer(case, method)))
+        worker.start()
+        worker.join()
+        return out[0]
+
+    for method in ("exact", "sampled"):
+        alone = [fresh(c, method) for c in cases]
+        assert [answer(c, method) for c in cases] == alone
+        got: dict[int, list[Any]] = {}
+
+        def run(k: int) -> None:
+            got[k] = [answer(c, method) for c in cases[k:] + cases[:k]]
+
+        threads = [threading.Thread(target=run, args=(k,)) for k in range(4)]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        for k in range(4):
+            assert got[k] == alone[k:] + alone[:k]
+
+
+def test_a_query_kernel_refuses_a_scratch_buffer_too_short_for_its_bodies():
+    # the kernels take every buffer from one scratch array and never write past it
+    from polycontact._kernels import impact as ki
+    from polycontact.impact import body_frame
+
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    (r, tab, *_) = body_frame(sq)
+    m = np.zeros(6)
+    args = (r, sq.packed[1], sq.centroid, m, 1.0, tab, r, sq.packed[1], sq.centroid, m, 1.0,
+            tab, 1.0, 1e-6, 1e-4, 1e-12, 1e-14, 0.01, 100)
+    need = ki.work_floats(8)
+    assert ki.exact_query(*args, np.empty(need))[1] == ki.INITIALLY_PENETRATING
+    with pytest.raises(ValueError, match="scratch buffer is too short"):
+        ki.exact_query(*args, np.empty(need - 1))
+
+
+def test_the_body_frame_cached_on_a_shape_is_read_only():
+    # time_of_impact keeps each shape's body frame (vertices about the centroid, circle
+    # tree, the packed arrays the exact kernel takes) on the shape: none of it may be
+    # changed afterwards, or later queries would read a stale body
+    from polycontact.impact import body_frame
+
+    s = Shape([(0, 0), (2, 0), (2, 2), (0, 2)], [[(0.5, 0.5), (1, 0.5), (1, 1)]])
+    time_of_impact(s, Motion(velocity=(1, 0)), s.moved((5, 0)), Motion(), t_max=1.0)
+    r, tables, _, _, packed = body_frame(s)
+    assert s._frame is not None and s._frame[4] is packed
+    for arr in (r, *tables, *packed):
+        assert not arr.flags.writeable
+        with pytest.raises(ValueError):
+            arr[0] = 0

@@ -9,6 +9,7 @@ import numpy as np
 import shapely
 from hypothesis import assume, example, given
 from hypothesis import strategies as st
+from profiles import examples
 
 from polycontact import Motion, Shape
 from polycontact._kernels import broad_phase as kb
@@ -339,3 +340,22 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)
     for t in np.linspace(t0, t0 + step, 7):
         assert boundary_distance(*a.at(ma, t).packed, *b.at(mb, t).packed) >= lam_pair * (1 - 1e-9)
+
+
+@examples(50)
+@given(st.integers(3, 40), st.integers(0, 3), st.floats(-1e9, 1e9), st.floats(1e-9, 1e9))
+def test_a_packed_body_unpacks_to_its_arrays(n, holes, offset, radius):
+    # exact_call takes each body as pack_body's two arrays: unpacked, they must be the
+    # arrays exact_query takes, bit for bit (loops of several lengths, holes)
+    rng = np.random.default_rng(n * 7 + holes)
+    sizes = [n] + [3 + k for k in range(holes)]
+    r = rng.normal(size=(sum(sizes), 2)) * radius + offset
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    table = edge_table(r, starts)
+    centroid = np.array([offset, -offset])
+    f, i = ki.pack_body(r, starts, centroid, radius, table)
+    r2, s2, c2, rad2, table2 = ki._unpack_body(f, i)
+    assert np.array_equal(r2, r) and np.array_equal(s2, starts)
+    assert np.array_equal(c2, centroid) and rad2 == radius
+    for got, want in zip(table2, table):
+        assert got.dtype == want.dtype and np.array_equal(got, want)

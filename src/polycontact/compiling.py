@@ -41,7 +41,7 @@ __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
     "classification": ("relation.relate_state", "relation.classify_raw"),
-    "time of impact": ("impact.exact_query", "impact.sampled_query"),
+    "time of impact": ("impact.exact_call", "impact.sampled_query"),
     "no-fit polygon": ("nfp.entrance_region", "nfp.convex_sums"),
     "entrance block": ("relation.relate_state",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),

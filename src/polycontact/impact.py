@@ -18,6 +18,7 @@ the penetrating configuration at ``time``, as the paper records it).
 from __future__ import annotations
 
 import enum
+import threading
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -27,7 +28,7 @@ import numpy as np
 from ._checks import finite_number
 from ._dispatch import entry_point
 from .broad_phase import (BROAD_PHASE_INFLATION, base_reach, check_motion, check_reach,
-                          check_t_max, reach_excess)
+                          check_t_max, intervals_array, reach_excess)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
 from .bodies import BodyLike, as_shape
@@ -80,7 +81,9 @@ class Impact:
 
     ``features``, ``point`` and ``normal`` classify the bodies at the moment of impact;
     they are computed on first access (a query that only needs the time does not pay
-    for them) and cached.
+    for them) and cached. Likewise, of a result of :func:`time_of_impact` only
+    ``collides``, ``time`` and ``status`` are set when it is returned; the other fields
+    are filled in together when one of them is first read (the same values).
 
     Attributes
     ----------
@@ -139,19 +142,16 @@ class Impact:
     if not TYPE_CHECKING:  # (mypy keeps checking attribute names)
 
         def __getattr__(self, name: str) -> Any:
-            # ``broad_phase`` and ``time_tolerance`` of a result built by
-            # time_of_impact are filled in on first access, from what the kernel
-            # returned (``_lazy``): converting them cost more than the rest of the
-            # result. Only called for attributes not found the normal way.
+            # Of a result built by time_of_impact only ``collides``, ``time`` and
+            # ``status`` are set at once; the other fields are filled in together on
+            # the first access to one of them, from the kernel's answer (``_lazy``):
+            # building them cost more than the query's Python. Only called for
+            # attributes not found the normal way.
             lazy = self.__dict__.get("_lazy") if name in _LAZY else None
             if lazy is None:
                 raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-            intervals, tol, t = lazy
-            d = self.__dict__
-            d["broad_phase"] = tuple(map(tuple, intervals.tolist()))
-            # (the kernel's formula, run in Python: the same float operations)
-            d["time_tolerance"] = float(_effective_time_tolerance()(tol, t))
-            return d[name]
+            self.__dict__.update(_lazy_fields(self._bodies, *lazy))
+            return self.__dict__[name]
 
     @cached_property
     def _details(self) -> tuple[tuple[Feature, ...], np.ndarray | None, np.ndarray | None]:
@@ -284,7 +284,7 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     speed = ki.speed_bound(ma.array, la, mb.array, lb, t_lo, t_hi)
     if speed <= 0.0 or t_hi - t_lo <= lam / speed:
         return t_lo, t_hi
-    (ra, ea, _), (rb, eb, _) = body_frame(a), body_frame(b)
+    (ra, ea, *_), (rb, eb, *_) = body_frame(a), body_frame(b)
     code, hi, lo, *_ = ki._prepared_exact_search(
         ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
         lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, _ULPS, lam, MAX_ITERATIONS)
@@ -509,11 +509,22 @@ def time_of_impact(
     the number of iterations is bounded by ``max_iterations`` (status
     OUT_OF_ITERATIONS, never a hang).
     """
-    a = a if type(a) is Shape else as_shape(a, "a")
-    b = b if type(b) is Shape else as_shape(b, "b")
-    ma = motion_a if type(motion_a) is Motion else check_motion(motion_a, "motion_a")
-    mb = motion_b if type(motion_b) is Motion else check_motion(motion_b, "motion_b")
-    t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
+    # Shapes and Motions (a simulation's loop) pass as they are; their arrays have the
+    # types the compiled code was found for (see :mod:`polycontact._dispatch`)
+    fixed = (type(a) is Shape and type(b) is Shape and type(motion_a) is Motion
+             and type(motion_b) is Motion)
+    if fixed:
+        ma, mb = motion_a, motion_b
+    else:
+        a, b = as_shape(a, "a"), as_shape(b, "b")
+        ma, mb = check_motion(motion_a, "motion_a"), check_motion(motion_b, "motion_b")
+    if (type(t_max) is float and type(time_tolerance) is float and type(samples) is int
+            and type(max_iterations) is int and 0.0 <= t_max < _INF
+            and 0.0 < time_tolerance < _INF and samples >= 2 and max_iterations >= 1
+            and method in _METHODS):
+        tol = time_tolerance  # the common case, checked in one expression
+    else:
+        t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
 
     # coordinates (checked once per shape, with its body frame) and motions whose
     # products would overflow float64 are refused
@@ -523,29 +534,54 @@ def time_of_impact(
         fa = body_frame(a, tables=exact, what="a")
     if fb is None or exact and fb[1] is None:
         fb = body_frame(b, tables=exact, what="b")
-    (ra, ea, base_a), (rb, eb, base_b) = fa, fb
+    ra, ea, base_a, big_a, pa = fa
+    rb, eb, base_b, big_b, pb = fb
     la, lb = a._radius, b._radius
-    if (reach_excess(base_a, la, ma._norms, t_max) is not None
-            or reach_excess(base_b, lb, mb._norms, t_max) is not None):
+    if not (t_max <= _SAFE_SCALE and big_a <= _SAFE_SCALE and big_b <= _SAFE_SCALE
+            and ma._largest <= _SAFE_SCALE and mb._largest <= _SAFE_SCALE) and (
+                reach_excess(base_a, la, ma._norms, t_max) is not None
+                or reach_excess(base_b, lb, mb._norms, t_max) is not None):
         check_reach(a, ma, t_max, "motion_a")  # raises, naming the motion
         check_reach(b, mb, t_max, "motion_b")
     # the size term of the distance tolerance; the kernels add the float spacing of the
     # coordinates at each time they examine (never a bound over all of [0, t_max])
-    eps_rel = RELATIVE_TOLERANCE * max(a._extent, b._extent)
+    eps_rel = RELATIVE_TOLERANCE * (a._extent if a._extent > b._extent else b._extent)
+    # this thread's scratch buffer (the kernels allocate nothing), grown when needed
+    size = len(ra) + len(rb)
+    try:
+        cap, work = _LOCAL.work
+    except AttributeError:
+        cap, work = _grow_work(0)
+    if size > cap:
+        cap, work = _grow_work(size)
     args: tuple[Any, ...]
     if exact:
-        args = (ra, a._starts, a._centroid, ma._array, la, ea, rb, b._starts, b._centroid,
-                mb._array, lb, eb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS,
-                CONTACT_RESOLUTION * (la + lb), int(max_iterations))
+        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, t_max, BROAD_PHASE_INFLATION,
+                tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations), work)
     else:
         args = (ra, a._starts, a._centroid, ma._array, la, rb, b._starts, b._centroid,
-                mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples))
+                mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples),
+                work)
     # the compiled code called directly when every argument has the type it always has
-    # (Shapes and Motions: see :mod:`polycontact._dispatch`), else through the dispatcher
-    fixed = type(a) is type(b) is Shape and type(ma) is type(mb) is Motion
+    # (Shapes and Motions), else through the dispatcher
     run = _ENTRY.get(method) if fixed else None
     out = run(*args) if run is not None else _query(method, args, fixed)
-    return _result(a, ma, b, mb, method, out, t_max, eps_rel, tol)
+    # (the broad phase's intervals, left in the scratch, are recomputed if asked for)
+    return _result(a, ma, b, mb, method, out, t_max, eps_rel, tol, None)
+
+
+_LOCAL = threading.local()
+
+
+def _grow_work(size: int) -> tuple[int, np.ndarray]:
+    """A new scratch buffer for this thread's queries on bodies of up to ``size``
+    vertices in all (at least 64, doubling): ``(capacity, buffer)``, kept in
+    :data:`_LOCAL`."""
+    from ._kernels.impact import work_floats
+
+    cap = max(64, 2 * size)
+    _LOCAL.work = cap, np.empty(getattr(work_floats, "py_func", work_floats)(cap))
+    return _LOCAL.work  # type: ignore[no-any-return]
 
 
 #: The compiled entry points of the query kernels by method, once :func:`_query` has
@@ -561,7 +597,7 @@ def _query(method: str, args: tuple[Any, ...], fixed: bool) -> tuple[Any, ...]:
     :data:`_ENTRY` for the next calls; otherwise the call goes through the dispatcher."""
     from ._kernels import impact as ki
 
-    run = ki.exact_query if method == "exact" else ki.sampled_query
+    run = ki.exact_call if method == "exact" else ki.sampled_query
     if fixed:
         run = _ENTRY[method] = entry_point(run, args)
     out: tuple[Any, ...] = run(*args)
@@ -572,11 +608,6 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
                   max_iterations: int) -> tuple[float, float]:
     """The options of :func:`time_of_impact` checked (an error naming each bad one):
     ``(t_max, time_tolerance)`` as floats."""
-    if (type(t_max) is float and type(time_tolerance) is float
-            and type(samples) is int and type(max_iterations) is int
-            and 0.0 <= t_max < _INF and 0.0 < time_tolerance < _INF
-            and samples >= 2 and max_iterations >= 1 and method in _METHODS):
-        return t_max, time_tolerance  # the common case, checked in one expression
     t_max = check_t_max(t_max)
     tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
@@ -593,41 +624,77 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
 
 
 _INF = float("inf")
+#: When the body's reach at rest and radius (``body_frame``'s last entry), its motion's
+#: norms (``Motion._largest``) and t_max are all at most this, the reach check passes
+#: without computing it: with every quantity K <= 1e15, the bounds of
+#: :func:`polycontact.broad_phase.reach_excess` are at most K + K^2 + K^3 (coordinates),
+#: 2 K + 2 K^2 + K^3 (speeds), K + K^2 + (K + K^2)^2 K (accelerations, about 1e75) and
+#: K + K^2 (angular speed), far below ``COORDINATE_LIMIT`` (1e100).
+_SAFE_SCALE = 1e15
 
 
-def body_frame(shape: Shape, tables: bool = True,
-               what: str = "shape") -> tuple[np.ndarray, tuple[Any, ...] | None, float]:
-    """``(r, tables, base)``: the shape's vertices relative to its centroid, when asked
-    for their ``_kernels.advance.edge_table`` (the exact method's circle tree; the
-    sampled method does not need it), and how far the body reaches from the origin at
-    rest (:func:`polycontact.broad_phase.base_reach`, for the reach check). Built on
-    first use and kept with the shape (it is immutable), so that repeated queries on
-    one shape build them once. On first use the coordinates are also checked
+def body_frame(shape: Shape, tables: bool = True, what: str = "shape") -> tuple[Any, ...]:
+    """``(r, tables, base, big, packed)``: the shape's vertices relative to its
+    centroid; when asked for, their ``_kernels.advance.edge_table`` (the exact method's
+    circle tree; the sampled method does not need it); how far the body reaches from
+    the origin at rest (:func:`polycontact.broad_phase.base_reach`, for the reach
+    check) and the larger of that and its bounding radius (for the reach check's
+    shortcut); with the tables, the body as ``_kernels.impact.pack_body`` packs it for
+    the exact kernel (else None). Built on first use and kept with the shape (it is
+    immutable; the arrays are read-only), so that repeated queries on one shape build
+    them once. On first use the coordinates are also checked
     (:func:`polycontact.tolerances.check_range`, the error naming ``what``)."""
     frame = shape._frame
     if frame is not None and (frame[1] is not None or not tables):
         return frame
-    r, tab, base = frame if frame is not None else (None, None, 0.0)
+    r, tab, base, big, packed = frame if frame is not None else (None, None, 0.0, 0.0, None)
     if r is None:
         xy = shape.packed[0]
         check_range(xy, what)
         base = base_reach(shape)
+        big = max(base, float(shape.bounding_radius))
         r = xy - shape.centroid
         r.flags.writeable = False
     if tables and tab is None:
         from ._kernels.advance import edge_table
+        from ._kernels.impact import pack_body
 
         tab = edge_table(r, shape.packed[1])
-    shape._frame = frame = (r, tab, base)
+        packed = pack_body(r, shape.packed[1], np.asarray(shape.centroid, dtype=np.float64),
+                           float(shape.bounding_radius), tab)
+        for arr in (*tab, *packed):
+            arr.flags.writeable = False
+    shape._frame = frame = (r, tab, base, big, packed)
     return frame
 
 
 def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, out: tuple[Any, ...],
-            t_max: float, eps_rel: float, tol: float) -> Impact:
-    """The :class:`Impact` of a query kernel's answer ``out`` = (intervals, status code,
-    t_hi, t_lo, first contact, iterations, t_reached): Python floats and ints (Numba
-    boxes float64 and int64 so) and the intervals' array."""
-    intervals, code, t_hi, t_lo, t_contact, iters, reached = out
+            t_max: float, eps_rel: float, tol: float, intervals: np.ndarray | None) -> Impact:
+    """The :class:`Impact` of a query kernel's answer ``out`` = (number of intervals,
+    status code, t_hi, t_lo, first contact, iterations, t_reached): Python floats and
+    ints (Numba boxes float64 and int64 so); the broad phase's ``intervals`` (None:
+    recomputed on first access)."""
+    code = out[1]
+    # Built as the frozen dataclass's __init__ would, at a fraction of its cost per
+    # query: the fields other than these on first access (see ``Impact.__getattr__``
+    # and :func:`_lazy_fields`). The tests check that every field is there.
+    impact = _new(Impact)
+    d = impact.__dict__
+    d["collides"] = hit = code == _HIT
+    d["time"] = out[2] if hit else None
+    d["status"] = _STATUS[code]
+    d["_bodies"] = (a, ma, b, mb, eps_rel)
+    d["_lazy"] = (out, method, t_max, tol, intervals)
+    return impact
+
+
+def _lazy_fields(bodies: tuple[Any, ...], out: tuple[Any, ...], method: str, t_max: float,
+                 tol: float, intervals: np.ndarray | None) -> dict[str, Any]:
+    """The fields of an :class:`Impact` that :func:`_result` leaves to the first access:
+    ``first_contact``, ``state``, ``method``, ``time_bracket``, ``iterations``,
+    ``searched_to``, ``broad_phase`` (``intervals``, or the kernel's recomputed: the same
+    operations) and ``time_tolerance``."""
+    _, code, t_hi, t_lo, t_contact, iters, reached = out
     first_contact = t_contact if t_contact >= 0.0 else None
     state = time = bracket = None
     if code == _HIT:
@@ -639,20 +706,20 @@ def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, out: tuple[
         state = _CONTACT
     if code == _NO_HIT:
         reached = t_max
-    # Built as the frozen dataclass's __init__ would, at a fraction of its cost per
-    # query; ``broad_phase`` and ``time_tolerance`` on first access (see
-    # ``Impact.__getattr__``). The tests check that every field is there.
-    impact = _new(Impact)
-    _set_dict(impact, "__dict__", {
-        "collides": code == _HIT, "time": time, "first_contact": first_contact,
-        "state": state, "status": _STATUS[code], "method": method, "time_bracket": bracket,
-        "iterations": iters, "searched_to": reached, "_bodies": (a, ma, b, mb, eps_rel),
-        "_lazy": (intervals, tol, time if time is not None else reached)})
-    return impact
+    if intervals is None:
+        a, ma, b, mb, _ = bodies
+        intervals = intervals_array(a, ma, b, mb, t_max)
+    return {
+        "first_contact": first_contact, "state": state, "method": method,
+        "time_bracket": bracket, "iterations": iters, "searched_to": reached,
+        "broad_phase": tuple(map(tuple, intervals.tolist())),
+        # (the kernel's formula, run in Python: the same float operations)
+        "time_tolerance": float(_effective_time_tolerance()(
+            tol, time if time is not None else reached)),
+    }
 
 
 _new = object.__new__
-_set_dict = object.__setattr__
 
 
 def _effective_time_tolerance() -> Any:
@@ -663,7 +730,8 @@ def _effective_time_tolerance() -> Any:
     return getattr(effective_time_tolerance, "py_func", effective_time_tolerance)
 
 
-_LAZY = frozenset(("broad_phase", "time_tolerance"))
+_LAZY = frozenset(("first_contact", "state", "method", "time_bracket", "iterations",
+                   "searched_to", "broad_phase", "time_tolerance"))
 # the kernels' status codes (keys of _STATUS) and the states they imply, as plain names
 # (an Enum member lookup costs more than the comparisons)
 _NO_HIT, _HIT, _AT_START = 0, 1, 2

@@ -57,11 +57,6 @@ MAX_SLICES = 16
 #: margin before, was 1e3: every body within a thousand units was a candidate).
 SWEPT_ROUNDING_ULPS = 64.0
 
-#: Width of the broad-phase interval table per pair (a quartic is <= 0 on at most 3
-#: disjoint intervals).
-_MAX_INTERVALS = 6
-
-
 @dataclass(frozen=True)
 class ImpactBatch:
     """The results of :func:`time_of_impact_many`, as arrays, with each pair's full
@@ -123,6 +118,9 @@ def _sequence(items: Any, what: str) -> list[Any]:
 def _shapes(items: Any, what: str) -> list[Shape]:
     out = []
     for k, obj in enumerate(_sequence(items, what)):
+        if type(obj) is Shape:
+            out.append(obj)
+            continue
         name = f"{what}[{k}]"
         try:
             shape = as_shape(obj, name)
@@ -139,7 +137,8 @@ def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion
     if len(motions) != count:
         raise ValueError(f"{what}: expected {count} motions (one per shape of {shapes_what}), "
                          f"got {len(motions)}")
-    return [check_motion(m, f"{what}[{k}]") for k, m in enumerate(motions)]
+    return [m if type(m) is Motion else check_motion(m, f"{what}[{k}]")
+            for k, m in enumerate(motions)]
 
 
 def _options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -153,33 +152,19 @@ def _options(t_max: float, method: str, time_tolerance: float, samples: int,
 
 
 # -- the batched search ----------------------------------------------------------------
-def _pack(shapes: list[Shape], exact: bool) -> tuple[Any, ...]:
-    """The shapes' body-frame tables one after another (see ``impacts_chunk``)."""
-    frames: list[Any] = [body_frame(s, tables=exact) for s in shapes]
-    n = len(shapes)
-    nv = np.array([len(f[0]) for f in frames], dtype=np.int64)
-    v_off = np.zeros(n + 1, np.int64)
-    np.cumsum(nv, out=v_off[1:])
-    s_off = np.zeros(n + 1, np.int64)
-    np.cumsum([len(s.packed[1]) for s in shapes], out=s_off[1:])
-    n_off = np.zeros(n + 1, np.int64)
-    np.cumsum(2 * nv - 1 if exact else np.zeros(n, np.int64), out=n_off[1:])
-    r = np.concatenate([f[0] for f in frames]) if n else np.empty((0, 2))
-    starts = np.concatenate([s.packed[1] for s in shapes]) if n else np.empty(0, np.int64)
-    if exact and n:
-        nxt = np.concatenate([f[1][0] for f in frames])
-        links = np.concatenate([f[1][1] for f in frames])
-        circles = np.concatenate([f[1][2] for f in frames])
-        r_len = np.concatenate([f[1][3] for f in frames])
-    else:
-        nxt = np.empty(0, np.int64)
-        links = np.empty((0, 3), np.int64)
-        circles = np.empty((0, 4))
-        r_len = np.empty(0)
-    cent = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2)
-    rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
-    return (r, starts.astype(np.int64), nxt, links, circles, r_len, v_off, s_off, n_off, cent,
-            rad)
+def _pack(shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The shapes' packed body frames (``_kernels.impact.pack_body``, built once per
+    shape) one after another, with their offsets: ``(floats, f_off, ints, i_off)``
+    (see ``impacts_chunk``)."""
+    packs = [body_frame(s)[4] for s in shapes]
+    f_off = np.zeros(len(packs) + 1, np.int64)
+    i_off = np.zeros(len(packs) + 1, np.int64)
+    np.cumsum([len(f) for f, _ in packs], out=f_off[1:])
+    np.cumsum([len(i) for _, i in packs], out=i_off[1:])
+    if not packs:
+        return np.empty(0), f_off, np.empty(0, np.int64), i_off
+    return (np.concatenate([f for f, _ in packs]), f_off,
+            np.concatenate([i for _, i in packs]), i_off)
 
 
 def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
@@ -188,10 +173,11 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
     search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
     of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
+    from ._kernels.broad_phase import MAX_INTERVALS
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
-    tables = _pack(shapes, exact)
+    tables = _pack(shapes)
     p_count = len(sa)
     code = np.zeros(p_count, np.int8)
     t_hi = np.empty(p_count)
@@ -200,7 +186,7 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     iters = np.empty(p_count, np.int64)
     reached = np.empty(p_count)
     n_iv = np.empty(p_count, np.int64)
-    iv = np.empty((p_count, _MAX_INTERVALS, 2))
+    iv = np.empty((p_count, MAX_INTERVALS, 2))
     out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
 
     def run(todo: np.ndarray) -> None:
@@ -216,8 +202,6 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
         n_chunks = min(p_count // 16, 16 * threads)
         with ThreadPoolExecutor(threads) as pool:
             list(pool.map(run, [order[c::n_chunks].copy() for c in range(n_chunks)]))
-    if p_count and int(n_iv.max()) > _MAX_INTERVALS:  # a quartic has at most 3
-        raise AssertionError("broad phase returned more intervals than a quartic has")
     return out
 
 
@@ -231,9 +215,9 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
         b, mb = shape_of(p, 1), motion_of(p, 1)
         # (the intervals copied: the result keeps them, not the whole batch's array)
         return _result(a, ma, b, mb, method,
-                       (iv[p, :n_iv[p]].copy(), int(code[p]), float(t_hi[p]), float(t_lo[p]),
+                       (int(n_iv[p]), int(code[p]), float(t_hi[p]), float(t_lo[p]),
                         float(contact[p]), int(iters[p]), float(reached[p])),
-                       t_max, float(eps_rel[p]), tol)
+                       t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
 
     return make
 
@@ -258,18 +242,24 @@ def _motion_array(motions: list[Motion]) -> np.ndarray:
     return np.array([m._array for m in motions], dtype=np.float64).reshape(len(motions), 6)
 
 
-def _extents(shapes: list[Shape], motions: list[Motion], names: list[tuple[str, str]],
-             t_max: float) -> np.ndarray:
+def _names(k: int) -> tuple[str, str]:
+    """The names of body k's arguments in ``first_impacts`` and ``candidate_pairs``."""
+    return f"shapes[{k}]", f"motions[{k}]"
+
+
+def _extents(shapes: list[Shape], motions: list[Motion],
+             name_of: Callable[[int], tuple[str, str]], t_max: float) -> np.ndarray:
     """Each body's extent (:func:`polycontact.impact._extent`: its pairs' distance
     tolerance has the size term ``RELATIVE_TOLERANCE * max(extent_a, extent_b)``, as in
     ``time_of_impact``), after the checks ``time_of_impact`` makes: the coordinates
     (once per shape, with its body frame), then motions that would carry coordinates,
     speeds or accelerations beyond float64's safe range within [0, t_max]. Errors name
-    the body's arguments, ``names[k] = (shape's, motion's)``."""
-    bases = [body_frame(s, tables=False, what=what)[2] for s, (what, _) in zip(shapes, names)]
-    for s, m, base, (_, what) in zip(shapes, motions, bases, names):
+    the body's arguments, ``name_of(k) = (shape's, motion's)`` (made only for an error)."""
+    bases = [(s._frame or body_frame(s, tables=False, what=name_of(k)[0]))[2]
+             for k, s in enumerate(shapes)]
+    for k, (s, m, base) in enumerate(zip(shapes, motions, bases)):
         if reach_excess(base, s.bounding_radius, m._norms, t_max) is not None:
-            check_reach(s, m, t_max, what)  # raises, naming the motion
+            check_reach(s, m, t_max, name_of(k)[1])  # raises, naming the motion
     return np.array([_extent(s) for s in shapes], dtype=np.float64)
 
 
@@ -365,16 +355,21 @@ def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
     body = np.empty(2 * p_count, np.int64)
     b_shapes: list[Shape] = []
     b_motions: list[Motion] = []
-    names: list[tuple[str, str]] = []          # where each body first appears
+    first: list[int] = []                      # where each body first appears
     for k, (s, m) in enumerate(zip(a + b, ma + mb)):
         u = seen.setdefault((id(s), id(m)), len(b_shapes))
         if u == len(b_shapes):
             b_shapes.append(s)
             b_motions.append(m)
-            side, q = ("a", k) if k < p_count else ("b", k - p_count)
-            names.append((f"shapes_{side}[{q}]", f"motions_{side}[{q}]"))
+            first.append(k)
         body[k] = u
-    extent = _extents(b_shapes, b_motions, names, t_max)
+
+    def name_of(u: int) -> tuple[str, str]:
+        k = first[u]
+        side, q = ("a", k) if k < p_count else ("b", k - p_count)
+        return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
+
+    extent = _extents(b_shapes, b_motions, name_of, t_max)
     uniq, index = _unique(b_shapes)
     rows = _motion_array(b_motions)
     ba, bb = body[:p_count], body[p_count:]
@@ -425,8 +420,7 @@ def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
     shapes = _shapes(shapes, "shapes")
     motions = _motions(motions, "motions", len(shapes), "shapes")
     t_max = check_t_max(t_max)
-    _extents(shapes, motions, [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))],
-             t_max)
+    _extents(shapes, motions, _names, t_max)
     return _candidates(shapes, motions, t_max)
 
 
@@ -532,8 +526,7 @@ def first_impacts(
     t_max, tol, samples, max_iterations, threads = _options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
-    extent = _extents(shapes, motions,
-                      [(f"shapes[{k}]", f"motions[{k}]") for k in range(len(shapes))], t_max)
+    extent = _extents(shapes, motions, _names, t_max)
     pairs = _candidates(shapes, motions, t_max)
     if len(pairs) == 0:
         return []

@@ -59,9 +59,10 @@ class Motion:
     acceleration: tuple[float, float] = (0.0, 0.0)
     angular_velocity: float = 0.0
     angular_acceleration: float = 0.0
-    # derived in __post_init__: the kernel vector and |v|, |a|, |ω|, |α|
+    # derived in __post_init__: the kernel vector, |v|, |a|, |ω|, |α| and the largest
     _array: np.ndarray = field(init=False, repr=False, compare=False)
     _norms: tuple[float, float, float, float] = field(init=False, repr=False, compare=False)
+    _largest: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
@@ -83,6 +84,7 @@ class Motion:
         object.__setattr__(self, "_norms", (
             math.hypot(*self.velocity), math.hypot(*self.acceleration),
             abs(self.angular_velocity), abs(self.angular_acceleration)))
+        object.__setattr__(self, "_largest", max(self._norms))
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
         """``(translation, angle)`` at time ``t``: centroid displacement and rotation.

@@ -231,7 +231,7 @@ class Shape:
         self._starts = starts
         self._kernel = _kernel_pack(xy, starts, lo, hi)
         # body-frame tables of the time-of-impact search
-        self._frame: tuple[Any, Any, float] | None = None
+        self._frame: tuple[Any, ...] | None = None
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
         # Area and centroid (paper Eq. 3-4), summed over every loop: the clockwise holes
         # contribute negative area, which removes them. Coordinates are taken relative to

@@ -23,13 +23,27 @@ import numpy as np
 from numba import njit
 
 _ULP = 2.0**-52
+#: Breakpoints of f on [lo, hi]: both ends and at most one root per derivative of
+#: degree 1 to 3 (f has degree <= 4).
+WORK_POINTS = 6
+#: The most intervals a quartic's nonpositive set has within [lo, hi] (its roots cut it
+#: in at most five pieces, every other one nonpositive).
+MAX_INTERVALS = 3
+#: Scratch floats of :func:`overlap_intervals_into`: the motion ``p`` and two levels of
+#: breakpoints.
+BROAD_PHASE_FLOATS = 6 + 2 * WORK_POINTS
 
 
 @njit(cache=True, nogil=True)
 def relative_motion(ca, ma, cb, mb):
     """``p`` of shape (3, 2): rows d0, dv, h of D(t) = d0 + dv t + h t², the centroid of
     A relative to B's (``ma``, ``mb``: motion vectors ``[vx, vy, ax, ay, ω, α]``)."""
-    p = np.empty((3, 2))
+    return _relative_motion_into(ca, ma, cb, mb, np.empty((3, 2)))
+
+
+@njit(cache=True, nogil=True)
+def _relative_motion_into(ca, ma, cb, mb, p):
+    """:func:`relative_motion` written into ``p`` (3, 2); returns ``p``."""
     for k in range(2):
         p[0, k] = ca[k] - cb[k]
         p[1, k] = ma[k] - mb[k]
@@ -112,14 +126,24 @@ def _bisect(p, r, k, a, b, fa):
 def monotone_breakpoints(p, lo, hi):
     """Sorted points from lo to hi between which f = |D|² − R² is monotone (``p`` from
     :func:`relative_motion`)."""
+    work = np.empty(2 * WORK_POINTS)
+    n = _breakpoints_into(p, lo, hi, work)
+    return work[:n].copy()
+
+
+@njit(cache=True, nogil=True)
+def _breakpoints_into(p, lo, hi, work):
+    """:func:`monotone_breakpoints` in ``work[:n]``; returns n. ``work``: at least
+    2 :data:`WORK_POINTS` floats (the points of two levels, in turn)."""
     deg = degree(p)
-    pts = np.empty(deg + 2)
+    pts = work[:WORK_POINTS]
+    new = work[WORK_POINTS:2 * WORK_POINTS]
+    second = False  # whether pts is the second half
     pts[0] = lo
     pts[1] = hi
     npts = 2
     # the (deg − 1)-th derivative is linear, hence monotone on [lo, hi]; walk down to f'
     for k in range(deg - 1, 0, -1):
-        new = np.empty(deg + 2)
         new[0] = lo
         nn = 1
         for s in range(npts - 1):
@@ -138,20 +162,31 @@ def monotone_breakpoints(p, lo, hi):
                 nn += 1
         new[nn] = hi
         nn += 1
-        pts = new
+        pts, new = new, pts
         npts = nn
-    return pts[:npts]
+        second = not second
+    if second:
+        work[:npts] = pts[:npts]
+    return npts
 
 
 @njit(cache=True, nogil=True)
 def nonpositive_intervals(p, r, lo, hi):
     """Closed intervals of [lo, hi] where |D(t)| <= r, merged, as (k, 2)."""
-    pts = monotone_breakpoints(p, lo, hi)
-    out = np.empty((pts.shape[0], 2))
+    out = np.empty((MAX_INTERVALS, 2))
+    n = _intervals_into(p, r, lo, hi, out, np.empty(2 * WORK_POINTS))
+    return out[:n].copy()
+
+
+@njit(cache=True, nogil=True)
+def _intervals_into(p, r, lo, hi, out, work):
+    """:func:`nonpositive_intervals` in ``out[:n]`` ((:data:`MAX_INTERVALS`, 2)); returns
+    n. ``work``: scratch of :func:`_breakpoints_into`."""
+    npts = _breakpoints_into(p, lo, hi, work)
     n = 0
-    for s in range(pts.shape[0] - 1):
-        a = pts[s]
-        b = pts[s + 1]
+    for s in range(npts - 1):
+        a = work[s]
+        b = work[s + 1]
         fa = derivative(p, r, 0, a)
         fb = derivative(p, r, 0, b)
         if fa <= 0.0 and fb <= 0.0:
@@ -162,13 +197,15 @@ def nonpositive_intervals(p, r, lo, hi):
             x0, x1 = (b if fb == 0.0 else _bisect(p, r, 0, a, b, fa)), b
         else:
             continue
-        if n > 0 and x0 <= out[n - 1, 1]:
+        if n > 0 and (x0 <= out[n - 1, 1] or n == out.shape[0]):
+            # (touching the last one; or, never for a quartic, no room: the last one
+            # grown over this one, which only adds time to search)
             out[n - 1, 1] = max(out[n - 1, 1], x1)
         else:
             out[n, 0] = x0
             out[n, 1] = x1
             n += 1
-    return out[:n].copy()
+    return n
 
 
 @njit(cache=True, nogil=True)
@@ -189,6 +226,18 @@ def overlap_intervals(ca, ma, ra, cb, mb, rb, t_max, inflate):
     the sum of their radii R enlarged by ``inflate`` (relative), or by the rounding of
     the positions (:func:`rounding_allowance`) where that is larger (far from the
     origin, at long travel), so that no instant of overlap is dropped."""
+    out = np.empty((MAX_INTERVALS, 2))
+    n = overlap_intervals_into(ca, ma, ra, cb, mb, rb, t_max, inflate, out,
+                               np.empty(BROAD_PHASE_FLOATS))
+    return out[:n].copy()
+
+
+@njit(cache=True, nogil=True)
+def overlap_intervals_into(ca, ma, ra, cb, mb, rb, t_max, inflate, out, work):
+    """:func:`overlap_intervals` written into ``out[:n]`` ((:data:`MAX_INTERVALS`, 2));
+    returns n. ``work``: :data:`BROAD_PHASE_FLOATS` floats of scratch. Nothing is
+    allocated (for callers that query many times)."""
     big = ra + rb
     r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, t_max))
-    return nonpositive_intervals(relative_motion(ca, ma, cb, mb), r, 0.0, t_max)
+    p = _relative_motion_into(ca, ma, cb, mb, work[:6].reshape(3, 2))
+    return _intervals_into(p, r, 0.0, t_max, out, work[6:])

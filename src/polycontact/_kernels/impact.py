@@ -25,10 +25,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .advance import (_line_time, edge_table, outward_normal, pair_step, traversal_stack,
-                      window_kinematics)
-from .broad_phase import overlap_intervals
-from .relation import _scratch, _state_in
+from .advance import STACK_SIZE, _line_time, edge_table, outward_normal, pair_step, window_kinematics
+from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
+from .relation import _scratch_views, _state_in, scratch_floats
 from .validate import closest_on_segment
 
 NO_HIT = 0
@@ -271,9 +270,46 @@ def _placed_state(xa, sa, xb, sb, eps, scratch):
 
 
 @njit(cache=True, nogil=True)
-def _search_scratch(ra, rb):
-    """Placed vertices of A and B and the state kernel's scratch (see :func:`state_at`)."""
-    return np.empty_like(ra), np.empty_like(rb), _scratch(ra.shape[0] + rb.shape[0])
+def work_floats(size):
+    """Length of the float64 scratch ``work`` of :func:`exact_query` and
+    :func:`sampled_query` for two bodies of ``size`` vertices in all (see
+    :func:`_work_views`).
+
+    >>> work_floats(16)
+    921
+    """
+    return (2 * MAX_INTERVALS + BROAD_PHASE_FLOATS + 4 + 3 * STACK_SIZE + 4 + 2 * size
+            + scratch_floats(size))
+
+
+@njit(cache=True, nogil=True)
+def _work_views(work, na, nb):
+    """The buffers of a query on bodies of ``na`` and ``nb`` vertices as views of
+    ``work`` (at least :func:`work_floats` (na + nb) floats; a shorter one raises):
+    ``(intervals (MAX_INTERVALS, 2), broad-phase scratch, pa, pb, crit (3, int64),
+    stack (STACK_SIZE, 2, int64), stau, xa (na, 2), xb (nb, 2), state scratch)``.
+    ``crit`` is set to −1 (what :func:`pair_step` expects before the first step)."""
+    size = na + nb
+    if work.shape[0] < work_floats(size):
+        raise ValueError("time of impact: the scratch buffer is too short for the bodies")
+    k = 2 * MAX_INTERVALS
+    iv = work[:k].reshape(MAX_INTERVALS, 2)
+    bw = work[k:k + BROAD_PHASE_FLOATS]
+    k += BROAD_PHASE_FLOATS
+    pa = work[k:k + 2]
+    pb = work[k + 2:k + 4]
+    ints = work[k + 4:k + 8 + 2 * STACK_SIZE].view(np.int64)  # (4: crit, with a spare)
+    crit = ints[:3]
+    crit[:] = -1
+    stack = ints[4:].reshape(STACK_SIZE, 2)
+    k += 8 + 2 * STACK_SIZE
+    stau = work[k:k + STACK_SIZE]
+    k += STACK_SIZE
+    xa = work[k:k + 2 * na].reshape(na, 2)
+    xb = work[k + 2 * na:k + 2 * size].reshape(nb, 2)
+    k += 2 * size
+    return (iv, bw, pa, pb, crit, stack, stau, xa, xb,
+            _scratch_views(work[k:k + scratch_floats(size)], size))
 
 
 @njit(cache=True, nogil=True)
@@ -335,11 +371,11 @@ def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, inter
                            eps_rel, ulps, lam, max_iter):
     """:func:`exact_search` with each body's :func:`edge_table` given (built once per
     shape by the caller)."""
-    xa, xb, scratch = _search_scratch(ra, rb)
-    stack, stau = traversal_stack()
+    _, _, pa, pb, crit, stack, stau, xa, xb, scratch = _work_views(
+        np.empty(work_floats(ra.shape[0] + rb.shape[0])), ra.shape[0], rb.shape[0])
     return _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
-                         eps_rel, ulps, lam, max_iter, xa, xb, np.empty(2), np.empty(2),
-                         np.full(3, -1, np.int64), stack, stau, scratch)
+                         eps_rel, ulps, lam, max_iter, xa, xb, pa, pb, crit, stack, stau,
+                         scratch)
 
 
 @njit(cache=True, nogil=True)
@@ -491,7 +527,8 @@ def sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold,
     Returns ``(status, t_hi, t_lo, first_contact, evaluations)``; ``first_contact`` is
     the earliest sample in contact (−1 if none).
     """
-    xa, xb, scratch = _search_scratch(ra, rb)
+    _, _, _, _, _, _, _, xa, xb, scratch = _work_views(
+        np.empty(work_floats(ra.shape[0] + rb.shape[0])), ra.shape[0], rb.shape[0])
     return _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n,
                            eps_rel, ulps, xa, xb, scratch)
 
@@ -539,24 +576,89 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
 
 @njit(cache=True, nogil=True)
 def exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, time_tol,
-                eps_rel, ulps, lam, max_iter):
+                eps_rel, ulps, lam, max_iter, work):
     """Broad phase and :func:`exact_search` in one call (one dispatch from Python), with
-    each body's :func:`edge_table` given. Returns ``(intervals, status, t_hi, t_lo,
-    first_contact, iterations, t_reached)``."""
-    iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
-    code, hi, lo, contact, its, reached = _prepared_exact_search(
-        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv, time_tol, eps_rel, ulps, lam,
-        max_iter)
-    return iv, code, hi, lo, contact, its, reached
+    each body's :func:`edge_table` given and every buffer a view of ``work`` (at least
+    :func:`work_floats` of both bodies' vertices; nothing is allocated). Returns
+    ``(n, status, t_hi, t_lo, first_contact, iterations, t_reached)``, the n broad-phase
+    intervals in ``work[:2 n]`` as (start, end) pairs."""
+    iv, bw, pa, pb, crit, stack, stau, xa, xb, scratch = _work_views(work, ra.shape[0],
+                                                                     rb.shape[0])
+    n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
+    code, hi, lo, contact, its, reached = _exact_search(
+        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv[:n], time_tol, eps_rel, ulps, lam,
+        max_iter, xa, xb, pa, pb, crit, stack, stau, scratch)
+    return n, code, hi, lo, contact, its, reached
+
+
+@njit(cache=True, nogil=True)
+def pack_body(r, starts, centroid, radius, table):
+    """One body's arguments of :func:`exact_query` in two arrays, for
+    :func:`exact_call`: floats ``[cx, cy, radius, r (n, 2), circles (m, 4), r_len (n)]``
+    and ints ``[n, len(starts), m, starts, nxt (n), links (m, 3)]`` (``table``: the
+    body's :func:`edge_table`, m nodes). Passing two arrays instead of eight costs a
+    call from Python less unboxing.
+
+    >>> import numpy as np
+    >>> sq = np.array([[-1.0, -1], [1, -1], [1, 1], [-1, 1]])
+    >>> st = np.array([0, 4])
+    >>> f, i = pack_body(sq, st, np.zeros(2), 1.5, edge_table(sq, st))
+    >>> f.shape, i[:5].tolist()
+    ((43,), [4, 2, 7, 0, 4])
+    """
+    nxt, links, circles, r_len = table
+    n = r.shape[0]
+    k = starts.shape[0]
+    m = links.shape[0]
+    f = np.empty(3 + 3 * n + 4 * m)
+    f[0] = centroid[0]
+    f[1] = centroid[1]
+    f[2] = radius
+    f[3:3 + 2 * n] = r.ravel()
+    f[3 + 2 * n:3 + 2 * n + 4 * m] = circles.ravel()
+    f[3 + 2 * n + 4 * m:] = r_len
+    i = np.empty(3 + k + n + 3 * m, np.int64)
+    i[0] = n
+    i[1] = k
+    i[2] = m
+    i[3:3 + k] = starts
+    i[3 + k:3 + k + n] = nxt
+    i[3 + k + n:] = links.ravel()
+    return f, i
+
+
+@njit(cache=True, nogil=True)
+def _unpack_body(f, i):
+    """``(r, starts, centroid, radius, table)`` of a :func:`pack_body`, as views."""
+    n = i[0]
+    k = i[1]
+    m = i[2]
+    table = (i[3 + k:3 + k + n], i[3 + k + n:3 + k + n + 3 * m].reshape(m, 3),
+             f[3 + 2 * n:3 + 2 * n + 4 * m].reshape(m, 4),
+             f[3 + 2 * n + 4 * m:3 + 3 * n + 4 * m])
+    return f[3:3 + 2 * n].reshape(n, 2), i[3:3 + k], f[:2], f[2], table
+
+
+@njit(cache=True, nogil=True)
+def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter,
+               work):
+    """:func:`exact_query` with each body given as its :func:`pack_body` (the call
+    ``polycontact.time_of_impact`` makes)."""
+    ra, sa, ca, la, ea = _unpack_body(fa, ia)
+    rb, sb, cb, lb, eb = _unpack_body(fb, ib)
+    return exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate,
+                       time_tol, eps_rel, ulps, lam, max_iter, work)
 
 
 @njit(cache=True, nogil=True)
 def sampled_query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, time_tol, eps_rel,
-                  ulps, samples):
+                  ulps, samples, work):
     """Broad phase and :func:`sampled_search` with ``samples`` points in one call; returns
     what :func:`exact_query` does (``iterations``: the classifications; ``t_reached``:
-    t_hi on a hit, else t_max)."""
-    iv = overlap_intervals(ca, ma, la, cb, mb, lb, t_max, inflate)
-    code, hi, lo, contact, its = sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, iv,
-                                                time_tol, samples, eps_rel, ulps)
-    return iv, code, hi, lo, contact, its, hi if code == HIT else t_max
+    t_hi on a hit, else t_max), with its buffers in ``work`` as there."""
+    iv, bw, _, _, _, _, _, xa, xb, scratch = _work_views(work, ra.shape[0], rb.shape[0])
+    n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
+    code, hi, lo, contact, its = _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb,
+                                                 iv[:n], time_tol, samples, eps_rel, ulps,
+                                                 xa, xb, scratch)
+    return n, code, hi, lo, contact, its, hi if code == HIT else t_max

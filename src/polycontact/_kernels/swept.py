@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .impact import exact_query, sampled_query
+from .impact import _unpack_body, exact_query, sampled_query, work_floats
 
 
 @njit(cache=True, nogil=True)
@@ -167,55 +167,50 @@ def box_pairs(boxes, owner, n_bodies):
 
 
 @njit(cache=True, nogil=True)
-def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, r, starts, nxt, links, circles, r_len, v_off,
-                  s_off, n_off, cent, rad, t_max, inflate, time_tol, ulps, contact_resolution,
-                  max_iter, exact, samples, code, t_hi, t_lo, contact, iters, reached,
-                  n_iv, iv):
+def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, floats, f_off, ints, i_off, t_max, inflate,
+                  time_tol, ulps, contact_resolution, max_iter, exact, samples, code, t_hi,
+                  t_lo, contact, iters, reached, n_iv, iv):
     """Time of impact of the pairs ``todo`` (indices into the pair arrays), results
     written in place at those indices.
 
     Pair p is shape ``sa[p]`` moving with ``ma[p]`` against shape ``sb[p]`` moving with
     ``mb[p]``, the size term of its distance tolerance ``eps_rel[p]`` (the kernels add
     ``ulps`` times the largest |coordinate| at each time they examine). Shape s is
-    packed as rows ``v_off[s]:v_off[s + 1]`` of ``r`` (vertices about its centroid),
-    ``nxt`` and ``r_len``; loop starts ``starts[s_off[s]:s_off[s + 1]]``; circle tree
-    rows ``n_off[s]:n_off[s + 1]`` of ``links`` and ``circles`` (the ``edge_table`` of
-    :mod:`polycontact._kernels.advance`, body-local indices); centroid ``cent[s]``,
-    bounding radius ``rad[s]``. Each pair runs ``exact_query`` (``exact``) or
-    ``sampled_query`` with the same arguments as ``polycontact.time_of_impact``
-    (contact resolution ``contact_resolution * (rad[a] + rad[b])``); its outputs go to
-    ``code``, ``t_hi``, ``t_lo``, ``contact``, ``iters``, ``reached``, and its broad-phase
-    intervals to ``iv[p, :n_iv[p]]``.
+    ``floats[f_off[s]:f_off[s + 1]]`` and ``ints[i_off[s]:i_off[s + 1]]``, its
+    :func:`polycontact._kernels.impact.pack_body` (vertices about its centroid, loop
+    starts, centroid, bounding radius, circle tree). Each pair runs ``exact_query``
+    (``exact``) or ``sampled_query`` with the same arguments as
+    ``polycontact.time_of_impact`` (contact resolution ``contact_resolution`` times the
+    sum of the radii); its outputs go to ``code``, ``t_hi``, ``t_lo``, ``contact``,
+    ``iters``, ``reached``, and its broad-phase intervals to ``iv[p, :n_iv[p]]``.
     """
+    widest = 0
+    for s in range(i_off.shape[0] - 1):
+        widest = max(widest, ints[i_off[s]])
+    work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
         a = sa[p]
         b = sb[p]
-        ra = r[v_off[a]:v_off[a + 1]]
-        rb = r[v_off[b]:v_off[b + 1]]
-        sta = starts[s_off[a]:s_off[a + 1]]
-        stb = starts[s_off[b]:s_off[b + 1]]
-        la = rad[a]
-        lb = rad[b]
+        ra, sta, ca, la, ea = _unpack_body(floats[f_off[a]:f_off[a + 1]],
+                                           ints[i_off[a]:i_off[a + 1]])
+        rb, stb, cb, lb, eb = _unpack_body(floats[f_off[b]:f_off[b + 1]],
+                                           ints[i_off[b]:i_off[b + 1]])
         if exact:
-            ea = (nxt[v_off[a]:v_off[a + 1]], links[n_off[a]:n_off[a + 1]],
-                  circles[n_off[a]:n_off[a + 1]], r_len[v_off[a]:v_off[a + 1]])
-            eb = (nxt[v_off[b]:v_off[b + 1]], links[n_off[b]:n_off[b + 1]],
-                  circles[n_off[b]:n_off[b + 1]], r_len[v_off[b]:v_off[b + 1]])
-            out = exact_query(ra, sta, cent[a], ma[p], la, ea, rb, stb, cent[b], mb[p], lb, eb,
-                              t_max, inflate, time_tol, eps_rel[p], ulps,
-                              contact_resolution * (la + lb), max_iter)
+            out = exact_query(ra, sta, ca, ma[p], la, ea, rb, stb, cb, mb[p], lb, eb, t_max,
+                              inflate, time_tol, eps_rel[p], ulps,
+                              contact_resolution * (la + lb), max_iter, work)
         else:
-            out = sampled_query(ra, sta, cent[a], ma[p], la, rb, stb, cent[b], mb[p], lb, t_max,
-                                inflate, time_tol, eps_rel[p], ulps, samples)
-        intervals, c, hi, lo, ct, its, got = out
+            out = sampled_query(ra, sta, ca, ma[p], la, rb, stb, cb, mb[p], lb, t_max,
+                                inflate, time_tol, eps_rel[p], ulps, samples, work)
+        n, c, hi, lo, ct, its, got = out
         code[p] = c
         t_hi[p] = hi
         t_lo[p] = lo
         contact[p] = ct
         iters[p] = its
         reached[p] = got
-        n_iv[p] = intervals.shape[0]            # the caller checks it fits in iv
-        for q in range(min(intervals.shape[0], iv.shape[1])):
-            iv[p, q, 0] = intervals[q, 0]
-            iv[p, q, 1] = intervals[q, 1]
+        n_iv[p] = n                             # (at most MAX_INTERVALS, iv's width)
+        for q in range(n):
+            iv[p, q, 0] = work[2 * q]
+            iv[p, q, 1] = work[2 * q + 1]
