@@ -41,7 +41,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -80,6 +80,10 @@ _NO_FITS = np.empty((0, 2))
 _NO_FITS.flags.writeable = False
 _NO_SLIDES = np.empty((0, 2, 2))
 _NO_SLIDES.flags.writeable = False
+
+#: The reference "origin" of every result that asks for it, shared: read-only.
+_ORIGIN = np.zeros(2)
+_ORIGIN.flags.writeable = False
 
 #: How many regions GEOS has built since import because the outline parts did not link
 #: into rings (see :func:`fallback_count`).
@@ -131,6 +135,14 @@ _PIECES_CACHE_SIZE = 4096
 class NoFitPolygon:
     """The no-fit polygon of A orbiting a fixed B.
 
+    ``region`` is built on first access and cached: :func:`no_fit_polygon` keeps the
+    outline's rings as its kernel returned them (private arrays) and makes the Shapely
+    geometry only when asked for it, as a nesting code that tests a few placements
+    against most of its no-fit polygons never needs (building it was about a third of
+    a small NFP's time). The object is immutable, so the cached geometry cannot go
+    stale; pickling and copying carry the built geometry. The coordinates are also
+    offered as data, without a geometry: :attr:`rings`.
+
     Attributes
     ----------
     region : shapely Polygon or MultiPolygon
@@ -158,6 +170,57 @@ class NoFitPolygon:
     a: Shape = field(repr=False)
     b: Shape = field(repr=False)
     tolerance: float = 0.0
+
+    if not TYPE_CHECKING:  # (mypy keeps checking attribute names)
+
+        def __getattr__(self, name: str) -> Any:
+            # ``region`` of a result of no_fit_polygon is built from the kernel's rings
+            # (``_rings``) on first access. Only called for attributes not found the
+            # normal way.
+            d = self.__dict__
+            rings = d.get("_rings") if name == "region" else None
+            if rings is None:
+                raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+            region = d["region"] = _polygon_from_rings(*rings)
+            return region
+
+    def __getstate__(self) -> dict[str, Any]:
+        # pickles and copies carry the geometry, not the private rings (an unpickled
+        # array would be writable again)
+        state = dict(self.__dict__, region=self.region)
+        state.pop("_rings", None)
+        return state
+
+    @property
+    def rings(self) -> tuple[np.ndarray, ...]:
+        """The region's boundary as coordinates: read-only (n, 2) float64 arrays,
+        each ring closed (its first vertex repeated last), outer boundaries
+        counter-clockwise and holes clockwise, polygon by polygon (each exterior
+        followed by its holes), the same coordinates as ``region``'s.
+
+        A region of one ring (the common case) is given without building ``region``.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> pc.no_fit_polygon(sq, sq, reference="origin").rings[0].tolist()
+        [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]
+        """
+        rings = self.__dict__.get("_rings")
+        if rings is not None and _one_ring(*rings):
+            # (the kernel's array, private until now: read-only from here on)
+            rings[0].setflags(write=False)
+            return (rings[0],)
+        out = []
+        for part in shapely.get_parts(shapely.orient_polygons(self.region)):
+            if part.is_empty:
+                continue
+            for ring in (part.exterior, *part.interiors):
+                xy = shapely.get_coordinates(ring)
+                xy.flags.writeable = False
+                out.append(xy)
+        return tuple(out)
 
     def contains(self, point: Any, *, tolerance: float | None = None) -> Any:
         """How A placed with its reference at ``point`` relates to B: a ``State``.
@@ -294,7 +357,17 @@ def no_fit_polygon(
     fits, slides = _clean_degenerate(
         pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
     )
-    return NoFitPolygon(region, fits, slides, a0, a, b, eps)
+    # Built as the frozen dataclass's __init__ would, at a fraction of its cost; with
+    # the kernel's rings, ``region`` is made on first access (NoFitPolygon.__getattr__)
+    nfp = _new(NoFitPolygon)
+    _set_dict(nfp, "__dict__", {
+        "exact_fits": fits, "slides": slides, "reference": a0, "a": a, "b": b,
+        "tolerance": eps, ("_rings" if type(region) is tuple else "region"): region})
+    return nfp
+
+
+_new = object.__new__
+_set_dict = object.__setattr__
 
 
 def inner_fit_polygon(
@@ -343,6 +416,8 @@ def inner_fit_polygon(
     fxy, fst = _pieces_of_geometry(outside)
     blocked, pts, segs, eps = _entrance_result(
         _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
+    if type(blocked) is tuple:
+        blocked = _polygon_from_rings(*blocked)
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -379,18 +454,18 @@ def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
     if reference is None or (isinstance(reference, str) and reference == "centroid"):
         return np.array(a.centroid, dtype=np.float64)
     if isinstance(reference, str):
-        if reference == "origin":
-            a0 = np.zeros(2)
-        else:
+        if reference != "origin":
             raise ValueError(
                 f"reference: expected 'centroid', 'origin' or a point (x, y), "
                 f"got {reference!r}"
             )
+        a0, off = _ORIGIN, 0.0
     else:
         a0 = point_arg(reference, "reference")
         check_range(a0.reshape(1, 2), "reference")
+        off = float(np.abs(a0).max())
     # the shapes' largest |coordinate| and extent are cached on them
-    reach = max(abs(float(a0[0])), abs(float(a0[1]))) + a._magnitude + b._magnitude
+    reach = off + a._magnitude + b._magnitude
     size = min(a._extent, b._extent)
     if tolerance_for(0.0, reach) >= size:
         raise ValueError(
@@ -474,9 +549,12 @@ def _entrance_result(
     (:func:`polycontact._kernels.nfp.entrance_region`) for E = B ⊕ R.
 
     The outline is assembled from the uncovered parts of the sums' edges (see
-    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
-    should), GEOS unions the sums of the convex pieces ``pieces()`` (B's, then R's)
-    instead. Rings thinner than the tolerance (rounding seams and pinholes) are dropped.
+    :mod:`polycontact._kernels.nfp`); the region is then given as the arguments of
+    :func:`_polygon_from_rings` (a tuple: the rings and the width under which a ring is
+    dropped), for the caller to build when needed. If the parts do not link
+    into rings (they always should), GEOS unions the sums of the convex pieces
+    ``pieces()`` (B's, then R's) instead, and the region is that geometry. Rings
+    thinner than the tolerance (rounding seams and pinholes) are dropped.
     """
     rxy_, rst_, stats, cand, meta = out
     eps, status, n_pts = meta.tolist()
@@ -485,8 +563,9 @@ def _entrance_result(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
             "(coordinates or reference point too large)"
         )
+    region: Any
     if status:
-        region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
+        region = (rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
     else:
         global _FALLBACKS
         _FALLBACKS += 1
@@ -511,7 +590,7 @@ def _polygon_from_rings(
     xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float
 ) -> Any:
     """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
-    if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
+    if _one_ring(xy, starts, stats, width):
         # one ring, the common case: WKB is the quickest way to hand it to GEOS
         header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, len(xy))
         return shapely.from_wkb(header + xy.tobytes())
@@ -536,6 +615,12 @@ def _polygon_from_rings(
         best = min(inside, key=lambda k: shell_polys[k].area) if inside else 0
         owned[best].append(h)
     return shapely.MultiPolygon([shapely.Polygon(r, hs) for r, hs in zip(shells, owned)])
+
+
+def _one_ring(xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float) -> bool:
+    """Whether the rings are one shell kept by :func:`_polygon_from_rings` (the region
+    is then that one ring, without holes)."""
+    return len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]
 
 
 def _drop_slivers(geom: Any, eps: float) -> Any:
