@@ -2,7 +2,7 @@
 
 - Two rings without holes go through one kernel call that decomposes them itself
   (``ring_entrance``); shapes with holes, rings too large for ear clipping and sums past
-  the memory budget take the cached-pieces path (``entrance_region``).
+  the memory budget take the cached-pieces path (``entrance_packed``).
 - The outline clips each sum edge by the other sums: with a grid of cells covered whole
   by sums from ``_GRID_MIN_SUMS`` sums on, by a scan of the sums' boxes below.
 """
@@ -55,17 +55,39 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     a0 = nfp_module._reference(a, reference, b)
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
-    want = kn.entrance_region(bxy, bst, a0 - axy, ast, *ARGS)
-    ok, *got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS,
-                                nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
-    assert ok
-    for g, w in zip(got, want):
+    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS)
+    head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS,
+                                 nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
+    assert head[0] == 1.0
+    assert head == want_head
+    np.testing.assert_array_equal(got, want)
+
+
+@examples(50)
+@given(rings(), rings(), st.booleans())
+def test_packed_answer_holds_entrance_region_s(a, b, hole):
+    # entrance_packed returns entrance_region's five arrays in one (boxing each array
+    # costs); unpacked, they are the same bit for bit (rings, starts, stats, candidates)
+    if hole:  # a frame around the star: several rings, candidates where A fits
+        (x0, y0), (x1, y1) = b.exterior.min(axis=0) - 1.0, b.exterior.max(axis=0) + 1.0
+        b = pc.Shape([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], [b.exterior[::-1]])
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(a)
+    r = a.centroid - axy
+    ring_xy, ring_starts, stats, cand, meta = kn.entrance_region(bxy, bst, r, ast, *ARGS)
+    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS)
+    ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
+    assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
+    assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
+    for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
+                    (ring_xy, ring_starts, stats, cand)):
+        assert g.dtype == w.dtype
         np.testing.assert_array_equal(g, w)
 
 
 def _count_paths(monkeypatch):
     calls = {"ring": 0, "pieces": 0}
-    real_ring, real_pieces = kn.ring_entrance, kn.entrance_region
+    real_ring, real_pieces = kn.ring_entrance, kn.entrance_packed
 
     def ring(*args):
         calls["ring"] += 1
@@ -76,7 +98,7 @@ def _count_paths(monkeypatch):
         return real_pieces(*args)
 
     monkeypatch.setattr(kn, "ring_entrance", ring)
-    monkeypatch.setattr(kn, "entrance_region", pieces)
+    monkeypatch.setattr(kn, "entrance_packed", pieces)
     return calls
 
 

@@ -80,6 +80,8 @@ _NO_FITS = np.empty((0, 2))
 _NO_FITS.flags.writeable = False
 _NO_SLIDES = np.empty((0, 2, 2))
 _NO_SLIDES.flags.writeable = False
+_NO_CANDIDATES = np.empty((0, 4))
+_NO_CANDIDATES.flags.writeable = False
 
 #: The reference "origin" of every result that asks for it, shared: read-only.
 _ORIGIN = np.zeros(2)
@@ -181,7 +183,7 @@ class NoFitPolygon:
             rings = d.get("_rings") if name == "region" else None
             if rings is None:
                 raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-            region = d["region"] = _polygon_from_rings(*rings)
+            region = d["region"] = _region_of(*rings)
             return region
 
     def __getstate__(self) -> dict[str, Any]:
@@ -210,8 +212,9 @@ class NoFitPolygon:
         rings = self.__dict__.get("_rings")
         if rings is not None and _one_ring(*rings):
             # (the kernel's array, private until now: read-only from here on)
-            rings[0].setflags(write=False)
-            return (rings[0],)
+            buf, _, vertices, _ = rings
+            buf.setflags(write=False)
+            return (buf[: 2 * int(vertices)].reshape(-1, 2),)
         out = []
         for part in shapely.get_parts(shapely.orient_polygons(self.region)):
             if part.is_empty:
@@ -346,13 +349,15 @@ def no_fit_polygon(
 
     xa, sa = a.packed
     xb, sb = b.packed
-    out: tuple[Any, ...] = (False,)
+    out = None
     if len(sa) == 2 and len(sb) == 2:
         # two rings: decomposed and summed in one kernel call (see _pieces_packed)
+        ax, ay = a0.tolist()
         out = _kernels().nfp.ring_entrance(
-            xb, xa, float(a0[0]), float(a0[1]), _tolerance(tolerance), RELATIVE_TOLERANCE,
+            xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE,
             ROUNDING_ULPS, ANGLE_TOLERANCE, _EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
-    out = out[1:] if out[0] else _entrance_kernel(*pieces(), tolerance)
+    if out is None or not out[0][0]:
+        out = _entrance_kernel(*pieces(), tolerance)
     region, pts, segs, eps = _entrance_result(out, pieces)
     fits, slides = _clean_degenerate(
         pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
@@ -417,7 +422,7 @@ def inner_fit_polygon(
     blocked, pts, segs, eps = _entrance_result(
         _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
     if type(blocked) is tuple:
-        blocked = _polygon_from_rings(*blocked)
+        blocked = _region_of(*blocked)
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -535,7 +540,7 @@ def _entrance_kernel(
             f"shapes' pieces would hold {total:.3g} vertices, more than "
             f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
         )
-    out: tuple[Any, ...] = _kernels().nfp.entrance_region(
+    out: tuple[Any, ...] = _kernels().nfp.entrance_packed(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
         ANGLE_TOLERANCE
     )
@@ -546,18 +551,17 @@ def _entrance_result(
     out: tuple[Any, ...], pieces: Callable[[], tuple[np.ndarray, ...]]
 ) -> tuple[Any, np.ndarray, np.ndarray, float]:
     """(region, candidate fits, candidate slides, eps) from the kernel's answer ``out``
-    (:func:`polycontact._kernels.nfp.entrance_region`) for E = B ⊕ R.
+    (:func:`polycontact._kernels.nfp.entrance_packed`) for E = B ⊕ R.
 
     The outline is assembled from the uncovered parts of the sums' edges (see
     :mod:`polycontact._kernels.nfp`); the region is then given as the arguments of
-    :func:`_polygon_from_rings` (a tuple: the rings and the width under which a ring is
-    dropped), for the caller to build when needed. If the parts do not link
+    :func:`_region_of` (a tuple: the kernel's array, its numbers of rings and vertices,
+    and the width under which a ring is dropped), for the caller to build when needed. If the parts do not link
     into rings (they always should), GEOS unions the sums of the convex pieces
     ``pieces()`` (B's, then R's) instead, and the region is that geometry. Rings
     thinner than the tolerance (rounding seams and pinholes) are dropped.
     """
-    rxy_, rst_, stats, cand, meta = out
-    eps, status, n_pts = meta.tolist()
+    (_, eps, status, n_pts, n_rings, n_vertices, n_cand), buf = out
     if status < 0.0:
         raise InvalidShapeError(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
@@ -565,16 +569,42 @@ def _entrance_result(
         )
     region: Any
     if status:
-        region = (rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
+        region = (buf, n_rings, n_vertices, HOLE_WIDTH_FACTOR * eps)
     else:
         global _FALLBACKS
         _FALLBACKS += 1
         sums, starts = _kernels().nfp.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
-    if len(cand) == 0:
-        return region, _NO_FITS, cand, eps
+    if not n_cand:
+        return region, _NO_FITS, _NO_CANDIDATES, eps
+    cand = _unpack(buf, n_rings, n_vertices)[3]
     return region, cand[: int(n_pts), :2], cand[int(n_pts) :], eps
+
+
+def _unpack(
+    buf: np.ndarray, rings: float, vertices: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(ring_xy, ring_starts, ring_stats, candidates)`` of
+    :func:`polycontact._kernels.nfp.entrance_region` from the ``buf`` of
+    :func:`~polycontact._kernels.nfp.entrance_packed` and its numbers of rings and
+    vertices: views of ``buf`` (the starts a copy, as integers)."""
+    nr = int(rings)
+    nv = int(vertices)
+    s = 2 * nv + nr + 1
+    return (buf[: 2 * nv].reshape(nv, 2), buf[2 * nv : s].astype(np.int64),
+            buf[s : s + 2 * nr].reshape(nr, 2), buf[s + 2 * nr :].reshape(-1, 4))
+
+
+def _region_of(buf: np.ndarray, rings: float, vertices: float, width: float) -> Any:
+    """The region from the kernel's rings (``_rings`` of a :class:`NoFitPolygon`, see
+    :func:`_entrance_result`)."""
+    if _one_ring(buf, rings, vertices, width):
+        # one ring, the common case: WKB is the quickest way to hand it to GEOS
+        nv = int(vertices)
+        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, nv)
+        return shapely.from_wkb(header + buf[: 2 * nv].tobytes())
+    return _polygon_from_rings(*_unpack(buf, rings, vertices)[:3], width)
 
 
 def _union_of_sums(polys: Any, eps: float) -> Any:
@@ -590,10 +620,6 @@ def _polygon_from_rings(
     xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float
 ) -> Any:
     """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
-    if _one_ring(xy, starts, stats, width):
-        # one ring, the common case: WKB is the quickest way to hand it to GEOS
-        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, len(xy))
-        return shapely.from_wkb(header + xy.tobytes())
     shells: list[Any] = []
     holes: list[Any] = []
     for k in range(len(starts) - 1):
@@ -617,10 +643,13 @@ def _polygon_from_rings(
     return shapely.MultiPolygon([shapely.Polygon(r, hs) for r, hs in zip(shells, owned)])
 
 
-def _one_ring(xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float) -> bool:
-    """Whether the rings are one shell kept by :func:`_polygon_from_rings` (the region
-    is then that one ring, without holes)."""
-    return len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]
+def _one_ring(buf: np.ndarray, rings: float, vertices: float, width: float) -> bool:
+    """Whether the kernel's rings (see :func:`_region_of`) are one shell that is kept
+    (not thinner than ``width``): the region is then that ring, without holes."""
+    if rings != 1.0:
+        return False
+    s = 2 * int(vertices) + 2  # the ring's (area, length) follow its coordinates and starts
+    return bool(2.0 * buf[s] > width * buf[s + 1])
 
 
 def _drop_slivers(geom: Any, eps: float) -> Any:
