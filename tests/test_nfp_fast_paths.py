@@ -31,6 +31,8 @@ def no_geos_fallback():
 
 
 ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, nfp_module.ANGLE_TOLERANCE)
+# the candidates' snapping and merging factors of the packed answers
+EXACT = (nfp_module._SNAP_FACTOR, nfp_module.HOLE_WIDTH_FACTOR)
 
 
 def star(n: int, seed: int, centre=(0.0, 0.0), lo=0.6, hi=3.0) -> np.ndarray:
@@ -55,8 +57,8 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     a0 = nfp_module._reference(a, reference, b)
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
-    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS)
-    head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS,
+    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT)
+    head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS, *EXACT,
                                  nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
     assert head[0] == 1.0
     assert head == want_head
@@ -73,16 +75,52 @@ def test_packed_answer_holds_entrance_region_s(a, b, hole):
         b = pc.Shape([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], [b.exterior[::-1]])
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
-    r = a.centroid - axy
+    _check_packed(bxy, bst, a.centroid - axy, ast)
+
+
+SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
+
+
+@pytest.mark.parametrize("b", [
+    pc.Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]),  # slot
+    pc.Shape([(-1, -1), (2, -1), (2, 2), (-1, 2)], [[(0, 0), (0, 1), (1, 1), (1, 0)]]),
+    pc.Shape([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)]),  # loose slot
+], ids=["slot", "socket", "loose slot"])
+def test_packed_candidates_are_the_snapped_merged_sorted_ones(b):
+    # exact fits and slides: the candidates made exact in the kernel are those of the
+    # Python steps they replace (snap, merge_collinear, sort by ends)
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(pc.Shape(SQUARE))
+    n_cand = _check_packed(bxy, bst, -axy, ast)
+    assert n_cand > 0 or b.exterior.max() == 4
+
+
+def _check_packed(bxy, bst, r, ast):
+    """entrance_packed = entrance_region, its candidates snapped, merged and sorted as
+    the Python code did before the kernel took it over; returns the candidates' count."""
     ring_xy, ring_starts, stats, cand, meta = kn.entrance_region(bxy, bst, r, ast, *ARGS)
-    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS)
+    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS, *EXACT)
     ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
     assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
+    if len(cand):
+        cand = _exact_candidates(cand, int(n_pts), *kn.convex_sums(bxy, bst, r, ast), eps)
     assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
     for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
                     (ring_xy, ring_starts, stats, cand)):
         assert g.dtype == w.dtype
         np.testing.assert_array_equal(g, w)
+    return int(n_cand)
+
+
+def _exact_candidates(cand, n_pts, sums, starts, eps):
+    snap_tol, near = (f * eps for f in EXACT)
+    pts = kn.snap(cand[:n_pts, :2], np.zeros((n_pts, 2)), sums, starts, snap_tol)
+    segs = cand[n_pts:]
+    along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
+    ends = kn.snap(segs.reshape(-1, 2), along, sums, starts, snap_tol)
+    merged = kn.merge_collinear(ends.reshape(-1, 4), near)
+    merged = merged[np.lexsort(merged.T[::-1])]
+    return np.vstack([np.hstack([pts, pts]), merged])
 
 
 def _count_paths(monkeypatch):

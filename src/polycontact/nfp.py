@@ -63,6 +63,10 @@ __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_coun
 #: fits: they are filled.
 HOLE_WIDTH_FACTOR = 16.0
 
+#: Candidate exact fits and slide ends are snapped to the sums' vertices and edge
+#: crossings within ``_SNAP_FACTOR * tolerance`` (they are found within a few).
+_SNAP_FACTOR = 64.0
+
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
@@ -354,14 +358,13 @@ def no_fit_polygon(
         # two rings: decomposed and summed in one kernel call (see _pieces_packed)
         ax, ay = a0.tolist()
         out = _kernels().nfp.ring_entrance(
-            xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE,
-            ROUNDING_ULPS, ANGLE_TOLERANCE, _EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
+            xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
+            ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR, _EAR_CLIPPING_MAX,
+            MAX_SUM_VERTICES)
     if out is None or not out[0][0]:
         out = _entrance_kernel(*pieces(), tolerance)
     region, pts, segs, eps = _entrance_result(out, pieces)
-    fits, slides = _clean_degenerate(
-        pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
-    )
+    fits, slides = _clean_degenerate(pts, segs, eps, lambda: _touching(a, b, a0, eps))
     # Built as the frozen dataclass's __init__ would, at a fraction of its cost; with
     # the kernel's rings, ``region`` is made on first access (NoFitPolygon.__getattr__)
     nfp = _new(NoFitPolygon)
@@ -435,8 +438,7 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(
-        pts, segs, lambda: (fxy, fst, r, ast), eps, lambda: fits)
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: fits)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -542,7 +544,7 @@ def _entrance_kernel(
         )
     out: tuple[Any, ...] = _kernels().nfp.entrance_packed(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        ANGLE_TOLERANCE
+        ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR
     )
     return out
 
@@ -703,32 +705,24 @@ def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: Callable[[], tuple[np.ndarray, ...]],
-    eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
+    """The verified exact fits and slides among the candidates, duplicates merged.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
-    of sum edges, and are snapped to them (within ``64 eps``). ``pieces()`` gives the
-    convex pieces the sums are made of; ``make_check()`` the verifying predicate.
+    of sum edges, and the kernel has snapped them to those (within
+    ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_check()`` gives the
+    verifying predicate; fits on a kept slide or near a kept fit are dropped.
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
     near = HOLE_WIDTH_FACTOR * eps
-    snap = 64.0 * eps
     slides = _NO_SLIDES
     check = make_check()
-    kn = _kernels().nfp
-    sums, starts = kn.convex_sums(*pieces())
-    pts = kn.snap(pts, np.zeros_like(pts), sums, starts, snap)
     if len(segs):
-        flat = segs.reshape(-1, 2)
-        along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
-        ends = kn.snap(flat, along, sums, starts, snap).reshape(-1, 2, 2)
-        merged = kn.merge_collinear(ends.reshape(-1, 4), near)
-        merged = merged[np.lexsort(merged.T[::-1])].reshape(-1, 2, 2)  # sorted
-        kept = [s for s in merged if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
+        kept = [s for s in segs.reshape(-1, 2, 2)
+                if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
         if kept:
             slides = np.array(kept)
     fits: list[np.ndarray] = []
