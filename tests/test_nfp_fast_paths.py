@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 from nfp_reference import reference_region, same_region
@@ -178,3 +179,15 @@ def test_outline_with_and_without_the_grid(n_sums):
     nfp = pc.no_fit_polygon(a, b)
     ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
     assert same_region(nfp.region, ref) is None
+
+
+@examples(50)
+@given(st.integers(1, 5), st.integers(1, 5), st.integers(0, 2**32 - 1))
+def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
+    # (the kernel that tells which candidate fits lie on a kept slide)
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-3, 3, (n_pts, 2))
+    segs = rng.uniform(-3, 3, (n_segs, 2, 2))
+    want = [min(shapely.distance(shapely.Point(q), shapely.LineString(s)) for s in segs)
+            for q in p]
+    np.testing.assert_allclose(kn.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)

@@ -693,17 +693,6 @@ def _touching(
     return check
 
 
-def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
-    """Distance from each point p (P, 2) to the nearest of the segments (S, 2, 2): (P,)."""
-    a = segs[None, :, 0]
-    u = segs[None, :, 1] - a
-    d = p[:, None, :] - a
-    t = np.clip((d * u).sum(axis=2) / (u * u).sum(axis=2), 0.0, 1.0)
-    off = d - t[:, :, None] * u
-    dist: np.ndarray = np.hypot(off[:, :, 0], off[:, :, 1]).min(axis=1)
-    return dist
-
-
 def _clean_degenerate(
     pts: np.ndarray, segs: np.ndarray, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -726,8 +715,8 @@ def _clean_degenerate(
         if kept:
             slides = np.array(kept)
     fits: list[np.ndarray] = []
-    on_slide = (_distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
-                else np.zeros(len(pts), dtype=bool))
+    on_slide = (_kernels().nfp.distance_to_segments(pts, slides) <= near
+                if len(slides) and len(pts) else np.zeros(len(pts), dtype=bool))
     for p, skip in zip(pts, on_slide.tolist()):
         if skip or any(np.hypot(*(p - q)) <= near for q in fits):
             continue

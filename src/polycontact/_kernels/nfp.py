@@ -758,6 +758,28 @@ def _exact_candidates(cand, n_pts, sums, starts, snap_tol, near):
 
 
 @njit(cache=True, nogil=True)
+def distance_to_segments(p, segs):
+    """Distance from each point ``p`` (P, 2) to the nearest of the segments (S, 2, 2): (P,).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> distance_to_segments(np.array([[0.5, 1.0], [3.0, 0.0]]),
+    ...                      np.array([[[0.0, 0.0], [1.0, 0.0]]])).tolist()
+    [1.0, 2.0]
+    """
+    out = np.full(p.shape[0], np.inf)
+    for k in range(p.shape[0]):
+        for m in range(segs.shape[0]):
+            ax, ay = segs[m, 0, 0], segs[m, 0, 1]
+            ux, uy = segs[m, 1, 0] - ax, segs[m, 1, 1] - ay
+            dx, dy = p[k, 0] - ax, p[k, 1] - ay
+            t = min(max((dx * ux + dy * uy) / (ux * ux + uy * uy), 0.0), 1.0)
+            out[k] = min(out[k], np.hypot(dx - t * ux, dy - t * uy))
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _closed(xy, starts):
     """The packed loops with each loop's first point repeated at its end."""
     n = starts.shape[0] - 1
