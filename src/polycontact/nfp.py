@@ -119,9 +119,7 @@ def fallback_count() -> int:
 def _kernels() -> SimpleNamespace:
     """The compiled kernels, imported on first use (Numba loads only when needed)."""
     from ._kernels import decompose, nfp
-    from ._kernels.relation import relate_state
-
-    return SimpleNamespace(nfp=nfp, decompose=decompose, relate_state=relate_state)
+    return SimpleNamespace(nfp=nfp, decompose=decompose)
 
 
 #: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
@@ -438,7 +436,8 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: fits)
+    fit_pts, slide_segs = _clean_degenerate(
+        pts, segs, eps, lambda: lambda points: [fits(p) for p in points])
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -680,15 +679,17 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 def _touching(
     a: Shape, b: Shape, a0: np.ndarray, eps: float
-) -> Callable[[np.ndarray], bool]:
-    """Check that A with its reference at p touches B without overlapping (classifier)."""
-    relate_state = _kernels().relate_state
+) -> Callable[[np.ndarray], Any]:
+    """Check, for each point p (K, 2), that A with its reference at p touches B without
+    overlapping (the classifier, all points in one kernel call)."""
+    touching = _kernels().nfp.touching
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
+    ax, ay = a0.tolist()
 
-    def check(p: np.ndarray) -> bool:
-        return bool(relate_state(xa + (p - a0), sa, xb, sb, tol) == 1)
+    def check(p: np.ndarray) -> Any:
+        return touching(np.ascontiguousarray(p), xa, sa, xb, sb, ax, ay, tol)
 
     return check
 
@@ -702,7 +703,8 @@ def _clean_degenerate(
     the true positions; exact fits and slide ends are vertices of some sum or crossings
     of sum edges, and the kernel has snapped them to those (within
     ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_check()`` gives the
-    verifying predicate; fits on a kept slide or near a kept fit are dropped.
+    verifying predicate, called on points (K, 2) at once (a bool per point); fits on a
+    kept slide or near a kept fit are dropped.
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
@@ -710,17 +712,20 @@ def _clean_degenerate(
     slides = _NO_SLIDES
     check = make_check()
     if len(segs):
-        kept = [s for s in segs.reshape(-1, 2, 2)
-                if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
-        if kept:
-            slides = np.array(kept)
+        # a slide is kept when its middle and both ends check
+        s = segs.reshape(-1, 2, 2)
+        ok = np.asarray(check(np.concatenate((0.5 * (s[:, 0] + s[:, 1]), s[:, 0], s[:, 1]))))
+        kept = s[ok.reshape(3, -1).all(axis=0)]
+        if len(kept):
+            slides = kept
     fits: list[np.ndarray] = []
     on_slide = (_kernels().nfp.distance_to_segments(pts, slides) <= near
                 if len(slides) and len(pts) else np.zeros(len(pts), dtype=bool))
-    for p, skip in zip(pts, on_slide.tolist()):
+    checked = np.asarray(check(pts)).tolist() if len(pts) else []
+    for p, skip, ok_p in zip(pts, on_slide.tolist(), checked):
         if skip or any(np.hypot(*(p - q)) <= near for q in fits):
             continue
-        if check(p):
+        if ok_p:
             fits.append(p)
     if not fits:
         return _NO_FITS, slides

@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit
 
 from .decompose import ring_pieces
+from .relation import relate_state
 from .tolerance import tolerance_of
 
 
@@ -754,6 +755,23 @@ def _exact_candidates(cand, n_pts, sums, starts, snap_tol, near):
         out[k, 1] = out[k, 3] = pts[k, 1]
     for k in range(merged.shape[0]):
         out[n_pts + k] = merged[order[k]]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def touching(points, xa, sa, xb, sb, a0x, a0y, tol):
+    """For each point p (K, 2), whether A (packed ``xa``, ``sa``) moved so that its
+    reference ``(a0x, a0y)`` is at p touches B without overlapping
+    (:func:`polycontact._kernels.relation.relate_state` is 1, contact, within ``tol``)."""
+    out = np.empty(points.shape[0], np.bool_)
+    moved = np.empty_like(xa)
+    for k in range(points.shape[0]):
+        dx = points[k, 0] - a0x
+        dy = points[k, 1] - a0y
+        for i in range(xa.shape[0]):
+            moved[i, 0] = xa[i, 0] + dx
+            moved[i, 1] = xa[i, 1] + dy
+        out[k] = relate_state(moved, sa, xb, sb, tol) == 1
     return out
 
 
