@@ -436,8 +436,11 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(
-        pts, segs, eps, lambda: lambda points: [fits(p) for p in points])
+    def check(pts: np.ndarray, segs: np.ndarray) -> tuple[list[bool], list[bool]]:
+        return [fits(p) for p in pts], [
+            fits(0.5 * (s[:2] + s[2:])) and fits(s[:2]) and fits(s[2:]) for s in segs]
+
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: check)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -679,17 +682,18 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 def _touching(
     a: Shape, b: Shape, a0: np.ndarray, eps: float
-) -> Callable[[np.ndarray], Any]:
-    """Check, for each point p (K, 2), that A with its reference at p touches B without
-    overlapping (the classifier, all points in one kernel call)."""
+) -> Callable[[np.ndarray, np.ndarray], Any]:
+    """The check of :func:`_clean_degenerate` for the no-fit polygon: A with its
+    reference at a candidate point (or at a slide's middle and both ends) touches B
+    without overlapping (the classifier, every candidate in one kernel call)."""
     touching = _kernels().nfp.touching
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
     ax, ay = a0.tolist()
 
-    def check(p: np.ndarray) -> Any:
-        return touching(np.ascontiguousarray(p), xa, sa, xb, sb, ax, ay, tol)
+    def check(pts: np.ndarray, segs: np.ndarray) -> Any:
+        return touching(np.ascontiguousarray(pts), segs, xa, sa, xb, sb, ax, ay, tol)
 
     return check
 
@@ -703,25 +707,21 @@ def _clean_degenerate(
     the true positions; exact fits and slide ends are vertices of some sum or crossings
     of sum edges, and the kernel has snapped them to those (within
     ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_check()`` gives the
-    verifying predicate, called on points (K, 2) at once (a bool per point); fits on a
-    kept slide or near a kept fit are dropped.
+    verifying predicate ``check(pts, segs)``: whether each point (P, 2) and each slide
+    (S, 4: its middle and both ends) verifies, two bool sequences, all in one call; fits
+    on a kept slide or near a kept fit are dropped.
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
     near = HOLE_WIDTH_FACTOR * eps
     slides = _NO_SLIDES
-    check = make_check()
-    if len(segs):
-        # a slide is kept when its middle and both ends check
-        s = segs.reshape(-1, 2, 2)
-        ok = np.asarray(check(np.concatenate((0.5 * (s[:, 0] + s[:, 1]), s[:, 0], s[:, 1]))))
-        kept = s[ok.reshape(3, -1).all(axis=0)]
-        if len(kept):
-            slides = kept
+    checked, kept = make_check()(pts, segs)
+    kept = np.asarray(kept, dtype=bool)
+    if kept.any():
+        slides = segs[kept].reshape(-1, 2, 2)
     fits: list[np.ndarray] = []
     on_slide = (_kernels().nfp.distance_to_segments(pts, slides) <= near
                 if len(slides) and len(pts) else np.zeros(len(pts), dtype=bool))
-    checked = np.asarray(check(pts)).tolist() if len(pts) else []
     for p, skip, ok_p in zip(pts, on_slide.tolist(), checked):
         if skip or any(np.hypot(*(p - q)) <= near for q in fits):
             continue
@@ -730,4 +730,4 @@ def _clean_degenerate(
     if not fits:
         return _NO_FITS, slides
     out = np.array(fits)
-    return out[np.lexsort((out[:, 1], out[:, 0]))], slides
+    return (out[np.lexsort((out[:, 1], out[:, 0]))] if len(out) > 1 else out), slides

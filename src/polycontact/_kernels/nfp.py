@@ -759,20 +759,35 @@ def _exact_candidates(cand, n_pts, sums, starts, snap_tol, near):
 
 
 @njit(cache=True, nogil=True)
-def touching(points, xa, sa, xb, sb, a0x, a0y, tol):
-    """For each point p (K, 2), whether A (packed ``xa``, ``sa``) moved so that its
-    reference ``(a0x, a0y)`` is at p touches B without overlapping
-    (:func:`polycontact._kernels.relation.relate_state` is 1, contact, within ``tol``)."""
-    out = np.empty(points.shape[0], np.bool_)
+def touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol):
+    """Whether A (packed ``xa``, ``sa``) moved so that its reference ``(a0x, a0y)`` is at
+    each point (P, 2), and at the middle and both ends of each segment (S, 4), touches B
+    without overlapping (:func:`polycontact._kernels.relation.relate_state` is 1,
+    contact, within ``tol``): ``(points' (P,), segments' (S,))`` bool arrays."""
     moved = np.empty_like(xa)
+    at_pts = np.empty(points.shape[0], np.bool_)
     for k in range(points.shape[0]):
-        dx = points[k, 0] - a0x
-        dy = points[k, 1] - a0y
-        for i in range(xa.shape[0]):
-            moved[i, 0] = xa[i, 0] + dx
-            moved[i, 1] = xa[i, 1] + dy
-        out[k] = relate_state(moved, sa, xb, sb, tol) == 1
-    return out
+        at_pts[k] = _touches_at(points[k, 0], points[k, 1], moved, xa, sa, xb, sb, a0x, a0y,
+                                tol)
+    at_segs = np.empty(segs.shape[0], np.bool_)
+    for k in range(segs.shape[0]):
+        x0, y0, x1, y1 = segs[k, 0], segs[k, 1], segs[k, 2], segs[k, 3]
+        at_segs[k] = (
+            _touches_at(0.5 * (x0 + x1), 0.5 * (y0 + y1), moved, xa, sa, xb, sb, a0x, a0y, tol)
+            and _touches_at(x0, y0, moved, xa, sa, xb, sb, a0x, a0y, tol)
+            and _touches_at(x1, y1, moved, xa, sa, xb, sb, a0x, a0y, tol))
+    return at_pts, at_segs
+
+
+@njit(cache=True, nogil=True)
+def _touches_at(px, py, moved, xa, sa, xb, sb, a0x, a0y, tol):
+    """relate_state of A moved by p - a0 (into ``moved``) against B is contact."""
+    dx = px - a0x
+    dy = py - a0y
+    for i in range(xa.shape[0]):
+        moved[i, 0] = xa[i, 0] + dx
+        moved[i, 1] = xa[i, 1] + dy
+    return relate_state(moved, sa, xb, sb, tol) == 1
 
 
 @njit(cache=True, nogil=True)
