@@ -10,7 +10,11 @@ Timed, in the same run and on the same prepared inputs:
   convex-decomposition cache before each NFP (every NFP decomposes both its pieces);
   "warm" clears it once at the start of each build of the instance, so each piece at
   each orientation is decomposed once and reused across its pairs, as a nesting code
-  building all NFPs of an instance does (the decompositions are inside the timing);
+  building all NFPs of an instance does (the decompositions are inside the timing).
+  The result's Shapely ``region`` is built on first access, not by the call (the
+  outline's coordinates are in the result: ``rings``), as pyclipper returns paths and
+  no geometry; "pc+region" is warm with ``region`` accessed on every result, the
+  time of a caller that wants the Shapely geometry of every NFP;
 - ``pyclipper.MinkowskiSum2`` on integer coordinates scaled by a power of two so the
   largest reaches 2**50 (Clipper needs integers);
 - ``pysfcgal`` ``Polygon.minkowski_sum`` (CGAL, exact arithmetic; ESICUP has no holes).
@@ -108,20 +112,26 @@ def run(path: Path, repeat: int, check: bool) -> dict:
             out.append(pc.no_fit_polygon(shapes[i], shapes[j], "origin"))
         return out
 
+    def t_pc_region():
+        nfp_module._PIECES_CACHE.clear()
+        return [pc.no_fit_polygon(shapes[i], shapes[j], "origin").region for i, j in pairs]
+
     def t_clipper():
         return [pyclipper.MinkowskiSum2(neg_ints[i], [ints[j]], True) for i, j in pairs]
 
     def t_sfcgal():
         return [sf[j].minkowski_sum(sf_neg[i]) for i, j in pairs]
 
-    times: dict[str, list[float]] = {"pc_cold": [], "pc_warm": [], "pyclipper": [], "pysfcgal": []}
+    times: dict[str, list[float]] = {"pc_cold": [], "pc_warm": [], "pc_region": [],
+                                     "pyclipper": [], "pysfcgal": []}
     results = {}
     # small instances are built several times per timed run (at least 2000 NFPs), so
     # that a run lasts long enough to be measured on a busy machine
     inner = max(1, -(-2000 // len(pairs)))
     for _ in range(repeat):
         for name, fn in (("pc_cold", t_pc_cold), ("pc_warm", t_pc_warm),
-                         ("pyclipper", t_clipper), ("pysfcgal", t_sfcgal)):
+                         ("pc_region", t_pc_region), ("pyclipper", t_clipper),
+                         ("pysfcgal", t_sfcgal)):
             # as timeit does: the previous results freed and the cyclic garbage
             # collector run before the clock starts, and kept from running while it runs
             results.pop(name, None)
@@ -177,12 +187,13 @@ def main() -> int:
     pc.no_fit_polygon([(0, 0), (2, 0), (2, 2), (0, 2)], frame)
     head = (f"{'instance':10} {'NFPs':>6} {'pc cold s':>9} {'pc warm s':>9} {'pyclipper s':>11} "
             f"{'pysfcgal s':>10} {'clip/cold':>9} {'sfcgal/cold':>11} {'clip/warm':>9} "
-            f"{'sfcgal/warm':>11}")
+            f"{'sfcgal/warm':>11} {'pc+region s':>11} {'clip/+reg':>9}")
     if args.check:
         head += (f" {'wrong pc':>8} {'wrong clip':>10} {'false holes clip':>16}"
                  f" {'wrong sfcgal':>12} {'fits+slides':>11}")
     print(head)
-    total = {"pc_cold": 0.0, "pc_warm": 0.0, "pyclipper": 0.0, "pysfcgal": 0.0, "nfps": 0}
+    total = {"pc_cold": 0.0, "pc_warm": 0.0, "pc_region": 0.0, "pyclipper": 0.0,
+             "pysfcgal": 0.0, "nfps": 0}
     for path in paths:
         r = run(path, args.repeat, args.check)
         for key in total:
@@ -196,7 +207,8 @@ def _line(r: dict, check: bool) -> str:
     line = (f"{r['instance']:10} {r['nfps']:6d} {r['pc_cold']:9.3f} {r['pc_warm']:9.3f} "
             f"{r['pyclipper']:11.3f} {r['pysfcgal']:10.3f} "
             f"{r['pyclipper'] / r['pc_cold']:9.2f} {r['pysfcgal'] / r['pc_cold']:11.2f} "
-            f"{r['pyclipper'] / r['pc_warm']:9.2f} {r['pysfcgal'] / r['pc_warm']:11.2f}")
+            f"{r['pyclipper'] / r['pc_warm']:9.2f} {r['pysfcgal'] / r['pc_warm']:11.2f} "
+            f"{r['pc_region']:11.3f} {r['pyclipper'] / r['pc_region']:9.2f}")
     if check:
         line += (f" {r['wrong_pc']:8d} {r['wrong_clip']:10d} {r['clip_false_holes']:16d}"
                  f" {r['wrong_sfcgal']:12d} {r['pc_exact_fits_and_slides']:11d}")

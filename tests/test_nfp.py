@@ -193,23 +193,15 @@ def _force_geos_fallback(monkeypatch):
     """Make the outline assembly report failure, so that GEOS unions the sums."""
     from polycontact._kernels import nfp as kn
 
-    real = kn.entrance_region
+    real = kn.entrance_packed
     real_rings = kn.ring_entrance
 
-    def unlinked(*args):
-        rings, starts, stats, cand, meta = real(*args)
-        meta = meta.copy()
-        meta[1] = 0.0
-        return rings, starts, stats, cand, meta
+    def unlinked(answer):
+        (ok, eps, _, *rest), buf = answer
+        return (ok, eps, 0.0, *rest), buf  # status 0: the parts did not link
 
-    def rings_unlinked(*args):
-        ok, *out = real_rings(*args)
-        out[-1] = out[-1].copy()
-        out[-1][1] = 0.0
-        return ok, *out
-
-    monkeypatch.setattr(kn, "entrance_region", unlinked)
-    monkeypatch.setattr(kn, "ring_entrance", rings_unlinked)
+    monkeypatch.setattr(kn, "entrance_packed", lambda *args: unlinked(real(*args)))
+    monkeypatch.setattr(kn, "ring_entrance", lambda *args: unlinked(real_rings(*args)))
     # (this deliberate fallback is not counted against the module: restored at teardown)
     monkeypatch.setattr(nfp_module, "_FALLBACKS", nfp_module.fallback_count())
 

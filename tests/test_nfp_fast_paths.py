@@ -2,7 +2,7 @@
 
 - Two rings without holes go through one kernel call that decomposes them itself
   (``ring_entrance``); shapes with holes, rings too large for ear clipping and sums past
-  the memory budget take the cached-pieces path (``entrance_region``).
+  the memory budget take the cached-pieces path (``entrance_packed``).
 - The outline clips each sum edge by the other sums: with a grid of cells covered whole
   by sums from ``_GRID_MIN_SUMS`` sums on, by a scan of the sums' boxes below.
 """
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 from nfp_reference import reference_region, same_region
@@ -31,6 +32,8 @@ def no_geos_fallback():
 
 
 ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, nfp_module.ANGLE_TOLERANCE)
+# the candidates' snapping and merging factors of the packed answers
+EXACT = (nfp_module._SNAP_FACTOR, nfp_module.HOLE_WIDTH_FACTOR)
 
 
 def star(n: int, seed: int, centre=(0.0, 0.0), lo=0.6, hi=3.0) -> np.ndarray:
@@ -55,17 +58,75 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     a0 = nfp_module._reference(a, reference, b)
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
-    want = kn.entrance_region(bxy, bst, a0 - axy, ast, *ARGS)
-    ok, *got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS,
-                                nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
-    assert ok
-    for g, w in zip(got, want):
+    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT)
+    head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS, *EXACT,
+                                 nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
+    assert head[0] == 1.0
+    assert head == want_head
+    np.testing.assert_array_equal(got, want)
+
+
+@examples(50)
+@given(rings(), rings(), st.booleans())
+def test_packed_answer_holds_entrance_region_s(a, b, hole):
+    # entrance_packed returns entrance_region's five arrays in one (boxing each array
+    # costs); unpacked, they are the same bit for bit (rings, starts, stats, candidates)
+    if hole:  # a frame around the star: several rings, candidates where A fits
+        (x0, y0), (x1, y1) = b.exterior.min(axis=0) - 1.0, b.exterior.max(axis=0) + 1.0
+        b = pc.Shape([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], [b.exterior[::-1]])
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(a)
+    _check_packed(bxy, bst, a.centroid - axy, ast)
+
+
+SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
+
+
+@pytest.mark.parametrize("b", [
+    pc.Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]),  # slot
+    pc.Shape([(-1, -1), (2, -1), (2, 2), (-1, 2)], [[(0, 0), (0, 1), (1, 1), (1, 0)]]),
+    pc.Shape([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)]),  # loose slot
+], ids=["slot", "socket", "loose slot"])
+def test_packed_candidates_are_the_snapped_merged_sorted_ones(b):
+    # exact fits and slides: the candidates made exact in the kernel are those of the
+    # Python steps they replace (snap, merge_collinear, sort by ends)
+    bxy, bst = nfp_module._convex_pieces(b)
+    axy, ast = nfp_module._convex_pieces(pc.Shape(SQUARE))
+    n_cand = _check_packed(bxy, bst, -axy, ast)
+    assert n_cand > 0 or b.exterior.max() == 4
+
+
+def _check_packed(bxy, bst, r, ast):
+    """entrance_packed = entrance_region, its candidates snapped, merged and sorted as
+    the Python code did before the kernel took it over; returns the candidates' count."""
+    ring_xy, ring_starts, stats, cand, meta = kn.entrance_region(bxy, bst, r, ast, *ARGS)
+    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS, *EXACT)
+    ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
+    assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
+    if len(cand):
+        cand = _exact_candidates(cand, int(n_pts), *kn.convex_sums(bxy, bst, r, ast), eps)
+    assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
+    for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
+                    (ring_xy, ring_starts, stats, cand)):
+        assert g.dtype == w.dtype
         np.testing.assert_array_equal(g, w)
+    return int(n_cand)
+
+
+def _exact_candidates(cand, n_pts, sums, starts, eps):
+    snap_tol, near = (f * eps for f in EXACT)
+    pts = kn.snap(cand[:n_pts, :2], np.zeros((n_pts, 2)), sums, starts, snap_tol)
+    segs = cand[n_pts:]
+    along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
+    ends = kn.snap(segs.reshape(-1, 2), along, sums, starts, snap_tol)
+    merged = kn.merge_collinear(ends.reshape(-1, 4), near)
+    merged = merged[np.lexsort(merged.T[::-1])]
+    return np.vstack([np.hstack([pts, pts]), merged])
 
 
 def _count_paths(monkeypatch):
     calls = {"ring": 0, "pieces": 0}
-    real_ring, real_pieces = kn.ring_entrance, kn.entrance_region
+    real_ring, real_pieces = kn.ring_entrance, kn.entrance_packed
 
     def ring(*args):
         calls["ring"] += 1
@@ -76,7 +137,7 @@ def _count_paths(monkeypatch):
         return real_pieces(*args)
 
     monkeypatch.setattr(kn, "ring_entrance", ring)
-    monkeypatch.setattr(kn, "entrance_region", pieces)
+    monkeypatch.setattr(kn, "entrance_packed", pieces)
     return calls
 
 
@@ -118,3 +179,15 @@ def test_outline_with_and_without_the_grid(n_sums):
     nfp = pc.no_fit_polygon(a, b)
     ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
     assert same_region(nfp.region, ref) is None
+
+
+@examples(50)
+@given(st.integers(1, 5), st.integers(1, 5), st.integers(0, 2**32 - 1))
+def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
+    # (the kernel that tells which candidate fits lie on a kept slide)
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-3, 3, (n_pts, 2))
+    segs = rng.uniform(-3, 3, (n_segs, 2, 2))
+    want = [min(shapely.distance(shapely.Point(q), shapely.LineString(s)) for s in segs)
+            for q in p]
+    np.testing.assert_allclose(kn.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)

@@ -41,7 +41,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -63,6 +63,10 @@ __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_coun
 #: fits: they are filled.
 HOLE_WIDTH_FACTOR = 16.0
 
+#: Candidate exact fits and slide ends are snapped to the sums' vertices and edge
+#: crossings within ``_SNAP_FACTOR * tolerance`` (they are found within a few).
+_SNAP_FACTOR = 64.0
+
 #: Angular gap (radians) below which the sums around a point are taken to close up:
 #: edge directions of sums computed in float64 carry errors near 1e-15 rad.
 ANGLE_TOLERANCE = 1e-9
@@ -80,6 +84,12 @@ _NO_FITS = np.empty((0, 2))
 _NO_FITS.flags.writeable = False
 _NO_SLIDES = np.empty((0, 2, 2))
 _NO_SLIDES.flags.writeable = False
+_NO_CANDIDATES = np.empty((0, 4))
+_NO_CANDIDATES.flags.writeable = False
+
+#: The reference "origin" of every result that asks for it, shared: read-only.
+_ORIGIN = np.zeros(2)
+_ORIGIN.flags.writeable = False
 
 #: How many regions GEOS has built since import because the outline parts did not link
 #: into rings (see :func:`fallback_count`).
@@ -109,9 +119,7 @@ def fallback_count() -> int:
 def _kernels() -> SimpleNamespace:
     """The compiled kernels, imported on first use (Numba loads only when needed)."""
     from ._kernels import decompose, nfp
-    from ._kernels.relation import relate_state
-
-    return SimpleNamespace(nfp=nfp, decompose=decompose, relate_state=relate_state)
+    return SimpleNamespace(nfp=nfp, decompose=decompose)
 
 
 #: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
@@ -130,6 +138,14 @@ _PIECES_CACHE_SIZE = 4096
 @dataclass(frozen=True, eq=False)
 class NoFitPolygon:
     """The no-fit polygon of A orbiting a fixed B.
+
+    ``region`` is built on first access and cached: :func:`no_fit_polygon` keeps the
+    outline's rings as its kernel returned them (private arrays) and makes the Shapely
+    geometry only when asked for it, as a nesting code that tests a few placements
+    against most of its no-fit polygons never needs (building it was about a third of
+    a small NFP's time). The object is immutable, so the cached geometry cannot go
+    stale; pickling and copying carry the built geometry. The coordinates are also
+    offered as data, without a geometry: :attr:`rings`.
 
     Attributes
     ----------
@@ -158,6 +174,58 @@ class NoFitPolygon:
     a: Shape = field(repr=False)
     b: Shape = field(repr=False)
     tolerance: float = 0.0
+
+    if not TYPE_CHECKING:  # (mypy keeps checking attribute names)
+
+        def __getattr__(self, name: str) -> Any:
+            # ``region`` of a result of no_fit_polygon is built from the kernel's rings
+            # (``_rings``) on first access. Only called for attributes not found the
+            # normal way.
+            d = self.__dict__
+            rings = d.get("_rings") if name == "region" else None
+            if rings is None:
+                raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+            region = d["region"] = _region_of(*rings)
+            return region
+
+    def __getstate__(self) -> dict[str, Any]:
+        # pickles and copies carry the geometry, not the private rings (an unpickled
+        # array would be writable again)
+        state = dict(self.__dict__, region=self.region)
+        state.pop("_rings", None)
+        return state
+
+    @property
+    def rings(self) -> tuple[np.ndarray, ...]:
+        """The region's boundary as coordinates: read-only (n, 2) float64 arrays,
+        each ring closed (its first vertex repeated last), outer boundaries
+        counter-clockwise and holes clockwise, polygon by polygon (each exterior
+        followed by its holes), the same coordinates as ``region``'s.
+
+        A region of one ring (the common case) is given without building ``region``.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> pc.no_fit_polygon(sq, sq, reference="origin").rings[0].tolist()
+        [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]
+        """
+        rings = self.__dict__.get("_rings")
+        if rings is not None and _one_ring(*rings):
+            # (the kernel's array, private until now: read-only from here on)
+            buf, _, vertices, _ = rings
+            buf.setflags(write=False)
+            return (buf[: 2 * int(vertices)].reshape(-1, 2),)
+        out = []
+        for part in shapely.get_parts(shapely.orient_polygons(self.region)):
+            if part.is_empty:
+                continue
+            for ring in (part.exterior, *part.interiors):
+                xy = shapely.get_coordinates(ring)
+                xy.flags.writeable = False
+                out.append(xy)
+        return tuple(out)
 
     def contains(self, point: Any, *, tolerance: float | None = None) -> Any:
         """How A placed with its reference at ``point`` relates to B: a ``State``.
@@ -283,18 +351,29 @@ def no_fit_polygon(
 
     xa, sa = a.packed
     xb, sb = b.packed
-    out: tuple[Any, ...] = (False,)
+    out = None
     if len(sa) == 2 and len(sb) == 2:
         # two rings: decomposed and summed in one kernel call (see _pieces_packed)
+        ax, ay = a0.tolist()
         out = _kernels().nfp.ring_entrance(
-            xb, xa, float(a0[0]), float(a0[1]), _tolerance(tolerance), RELATIVE_TOLERANCE,
-            ROUNDING_ULPS, ANGLE_TOLERANCE, _EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
-    out = out[1:] if out[0] else _entrance_kernel(*pieces(), tolerance)
+            xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
+            ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR, _EAR_CLIPPING_MAX,
+            MAX_SUM_VERTICES)
+    if out is None or not out[0][0]:
+        out = _entrance_kernel(*pieces(), tolerance)
     region, pts, segs, eps = _entrance_result(out, pieces)
-    fits, slides = _clean_degenerate(
-        pts, segs, pieces, eps, lambda: _touching(a, b, a0, eps)
-    )
-    return NoFitPolygon(region, fits, slides, a0, a, b, eps)
+    fits, slides = _clean_degenerate(pts, segs, eps, lambda: _touching(a, b, a0, eps))
+    # Built as the frozen dataclass's __init__ would, at a fraction of its cost; with
+    # the kernel's rings, ``region`` is made on first access (NoFitPolygon.__getattr__)
+    nfp = _new(NoFitPolygon)
+    _set_dict(nfp, "__dict__", {
+        "exact_fits": fits, "slides": slides, "reference": a0, "a": a, "b": b,
+        "tolerance": eps, ("_rings" if type(region) is tuple else "region"): region})
+    return nfp
+
+
+_new = object.__new__
+_set_dict = object.__setattr__
 
 
 def inner_fit_polygon(
@@ -343,6 +422,8 @@ def inner_fit_polygon(
     fxy, fst = _pieces_of_geometry(outside)
     blocked, pts, segs, eps = _entrance_result(
         _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
+    if type(blocked) is tuple:
+        blocked = _region_of(*blocked)
     cx0, cy0 = c.exterior.min(axis=0) + r.min(axis=0)
     cx1, cy1 = c.exterior.max(axis=0) + r.max(axis=0)
     free = shapely.box(cx0, cy0, cx1, cy1).difference(blocked)
@@ -355,8 +436,11 @@ def inner_fit_polygon(
         spill = placed.difference(c_poly)
         return bool(spill.area <= eps * (placed.length + c_poly.length))
 
-    fit_pts, slide_segs = _clean_degenerate(
-        pts, segs, lambda: (fxy, fst, r, ast), eps, lambda: fits)
+    def check(pts: np.ndarray, segs: np.ndarray) -> tuple[list[bool], list[bool]]:
+        return [fits(p) for p in pts], [
+            fits(0.5 * (s[:2] + s[2:])) and fits(s[:2]) and fits(s[2:]) for s in segs]
+
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: check)
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -379,18 +463,18 @@ def _reference(a: Shape, reference: Any, b: Shape) -> np.ndarray:
     if reference is None or (isinstance(reference, str) and reference == "centroid"):
         return np.array(a.centroid, dtype=np.float64)
     if isinstance(reference, str):
-        if reference == "origin":
-            a0 = np.zeros(2)
-        else:
+        if reference != "origin":
             raise ValueError(
                 f"reference: expected 'centroid', 'origin' or a point (x, y), "
                 f"got {reference!r}"
             )
+        a0, off = _ORIGIN, 0.0
     else:
         a0 = point_arg(reference, "reference")
         check_range(a0.reshape(1, 2), "reference")
+        off = float(np.abs(a0).max())
     # the shapes' largest |coordinate| and extent are cached on them
-    reach = max(abs(float(a0[0])), abs(float(a0[1]))) + a._magnitude + b._magnitude
+    reach = off + a._magnitude + b._magnitude
     size = min(a._extent, b._extent)
     if tolerance_for(0.0, reach) >= size:
         raise ValueError(
@@ -460,9 +544,9 @@ def _entrance_kernel(
             f"shapes' pieces would hold {total:.3g} vertices, more than "
             f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
         )
-    out: tuple[Any, ...] = _kernels().nfp.entrance_region(
+    out: tuple[Any, ...] = _kernels().nfp.entrance_packed(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        ANGLE_TOLERANCE
+        ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR
     )
     return out
 
@@ -471,31 +555,60 @@ def _entrance_result(
     out: tuple[Any, ...], pieces: Callable[[], tuple[np.ndarray, ...]]
 ) -> tuple[Any, np.ndarray, np.ndarray, float]:
     """(region, candidate fits, candidate slides, eps) from the kernel's answer ``out``
-    (:func:`polycontact._kernels.nfp.entrance_region`) for E = B ⊕ R.
+    (:func:`polycontact._kernels.nfp.entrance_packed`) for E = B ⊕ R.
 
     The outline is assembled from the uncovered parts of the sums' edges (see
-    :mod:`polycontact._kernels.nfp`); if they do not link into rings (they always
-    should), GEOS unions the sums of the convex pieces ``pieces()`` (B's, then R's)
-    instead. Rings thinner than the tolerance (rounding seams and pinholes) are dropped.
+    :mod:`polycontact._kernels.nfp`); the region is then given as the arguments of
+    :func:`_region_of` (a tuple: the kernel's array, its numbers of rings and vertices,
+    and the width under which a ring is dropped), for the caller to build when needed. If the parts do not link
+    into rings (they always should), GEOS unions the sums of the convex pieces
+    ``pieces()`` (B's, then R's) instead, and the region is that geometry. Rings
+    thinner than the tolerance (rounding seams and pinholes) are dropped.
     """
-    rxy_, rst_, stats, cand, meta = out
-    eps, status, n_pts = meta.tolist()
+    (_, eps, status, n_pts, n_rings, n_vertices, n_cand), buf = out
     if status < 0.0:
         raise InvalidShapeError(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
             "(coordinates or reference point too large)"
         )
+    region: Any
     if status:
-        region = _polygon_from_rings(rxy_, rst_, stats, HOLE_WIDTH_FACTOR * eps)
+        region = (buf, n_rings, n_vertices, HOLE_WIDTH_FACTOR * eps)
     else:
         global _FALLBACKS
         _FALLBACKS += 1
         sums, starts = _kernels().nfp.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
-    if len(cand) == 0:
-        return region, _NO_FITS, cand, eps
+    if not n_cand:
+        return region, _NO_FITS, _NO_CANDIDATES, eps
+    cand = _unpack(buf, n_rings, n_vertices)[3]
     return region, cand[: int(n_pts), :2], cand[int(n_pts) :], eps
+
+
+def _unpack(
+    buf: np.ndarray, rings: float, vertices: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(ring_xy, ring_starts, ring_stats, candidates)`` of
+    :func:`polycontact._kernels.nfp.entrance_region` from the ``buf`` of
+    :func:`~polycontact._kernels.nfp.entrance_packed` and its numbers of rings and
+    vertices: views of ``buf`` (the starts a copy, as integers)."""
+    nr = int(rings)
+    nv = int(vertices)
+    s = 2 * nv + nr + 1
+    return (buf[: 2 * nv].reshape(nv, 2), buf[2 * nv : s].astype(np.int64),
+            buf[s : s + 2 * nr].reshape(nr, 2), buf[s + 2 * nr :].reshape(-1, 4))
+
+
+def _region_of(buf: np.ndarray, rings: float, vertices: float, width: float) -> Any:
+    """The region from the kernel's rings (``_rings`` of a :class:`NoFitPolygon`, see
+    :func:`_entrance_result`)."""
+    if _one_ring(buf, rings, vertices, width):
+        # one ring, the common case: WKB is the quickest way to hand it to GEOS
+        nv = int(vertices)
+        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, nv)
+        return shapely.from_wkb(header + buf[: 2 * nv].tobytes())
+    return _polygon_from_rings(*_unpack(buf, rings, vertices)[:3], width)
 
 
 def _union_of_sums(polys: Any, eps: float) -> Any:
@@ -511,10 +624,6 @@ def _polygon_from_rings(
     xy: np.ndarray, starts: np.ndarray, stats: np.ndarray, width: float
 ) -> Any:
     """(Multi)Polygon from closed CCW shells and CW holes; rings thinner than width dropped."""
-    if len(starts) == 2 and 2.0 * stats[0, 0] > width * stats[0, 1]:
-        # one ring, the common case: WKB is the quickest way to hand it to GEOS
-        header = _WKB_POLYGON.pack(_WKB_BYTE_ORDER, 3, 1, len(xy))
-        return shapely.from_wkb(header + xy.tobytes())
     shells: list[Any] = []
     holes: list[Any] = []
     for k in range(len(starts) - 1):
@@ -536,6 +645,15 @@ def _polygon_from_rings(
         best = min(inside, key=lambda k: shell_polys[k].area) if inside else 0
         owned[best].append(h)
     return shapely.MultiPolygon([shapely.Polygon(r, hs) for r, hs in zip(shells, owned)])
+
+
+def _one_ring(buf: np.ndarray, rings: float, vertices: float, width: float) -> bool:
+    """Whether the kernel's rings (see :func:`_region_of`) are one shell that is kept
+    (not thinner than ``width``): the region is then that ring, without holes."""
+    if rings != 1.0:
+        return False
+    s = 2 * int(vertices) + 2  # the ring's (area, length) follow its coordinates and starts
+    return bool(2.0 * buf[s] > width * buf[s + 1])
 
 
 def _drop_slivers(geom: Any, eps: float) -> Any:
@@ -564,68 +682,52 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 def _touching(
     a: Shape, b: Shape, a0: np.ndarray, eps: float
-) -> Callable[[np.ndarray], bool]:
-    """Check that A with its reference at p touches B without overlapping (classifier)."""
-    relate_state = _kernels().relate_state
+) -> Callable[[np.ndarray, np.ndarray], Any]:
+    """The check of :func:`_clean_degenerate` for the no-fit polygon: A with its
+    reference at a candidate point (or at a slide's middle and both ends) touches B
+    without overlapping (the classifier, every candidate in one kernel call)."""
+    touching = _kernels().nfp.touching
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
+    ax, ay = a0.tolist()
 
-    def check(p: np.ndarray) -> bool:
-        return bool(relate_state(xa + (p - a0), sa, xb, sb, tol) == 1)
+    def check(pts: np.ndarray, segs: np.ndarray) -> Any:
+        return touching(np.ascontiguousarray(pts), segs, xa, sa, xb, sb, ax, ay, tol)
 
     return check
 
 
-def _distance_to_segments(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
-    """Distance from each point p (P, 2) to the nearest of the segments (S, 2, 2): (P,)."""
-    a = segs[None, :, 0]
-    u = segs[None, :, 1] - a
-    d = p[:, None, :] - a
-    t = np.clip((d * u).sum(axis=2) / (u * u).sum(axis=2), 0.0, 1.0)
-    off = d - t[:, :, None] * u
-    dist: np.ndarray = np.hypot(off[:, :, 0], off[:, :, 1]).min(axis=1)
-    return dist
-
-
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, pieces: Callable[[], tuple[np.ndarray, ...]],
-    eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, eps: float, make_check: Any
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Snap candidates to the sums' vertices, merge duplicates, keep verified ones.
+    """The verified exact fits and slides among the candidates, duplicates merged.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
-    of sum edges, and are snapped to them (within ``64 eps``). ``pieces()`` gives the
-    convex pieces the sums are made of; ``make_check()`` the verifying predicate.
+    of sum edges, and the kernel has snapped them to those (within
+    ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_check()`` gives the
+    verifying predicate ``check(pts, segs)``: whether each point (P, 2) and each slide
+    (S, 4: its middle and both ends) verifies, two bool sequences, all in one call; fits
+    on a kept slide or near a kept fit are dropped.
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
     near = HOLE_WIDTH_FACTOR * eps
-    snap = 64.0 * eps
     slides = _NO_SLIDES
-    check = make_check()
-    kn = _kernels().nfp
-    sums, starts = kn.convex_sums(*pieces())
-    pts = kn.snap(pts, np.zeros_like(pts), sums, starts, snap)
-    if len(segs):
-        flat = segs.reshape(-1, 2)
-        along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
-        ends = kn.snap(flat, along, sums, starts, snap).reshape(-1, 2, 2)
-        merged = kn.merge_collinear(ends.reshape(-1, 4), near)
-        merged = merged[np.lexsort(merged.T[::-1])].reshape(-1, 2, 2)  # sorted
-        kept = [s for s in merged if check(0.5 * (s[0] + s[1])) and check(s[0]) and check(s[1])]
-        if kept:
-            slides = np.array(kept)
+    checked, kept = make_check()(pts, segs)
+    kept = np.asarray(kept, dtype=bool)
+    if kept.any():
+        slides = segs[kept].reshape(-1, 2, 2)
     fits: list[np.ndarray] = []
-    on_slide = (_distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
-                else np.zeros(len(pts), dtype=bool))
-    for p, skip in zip(pts, on_slide.tolist()):
+    on_slide = (_kernels().nfp.distance_to_segments(pts, slides) <= near
+                if len(slides) and len(pts) else np.zeros(len(pts), dtype=bool))
+    for p, skip, ok_p in zip(pts, on_slide.tolist(), checked):
         if skip or any(np.hypot(*(p - q)) <= near for q in fits):
             continue
-        if check(p):
+        if ok_p:
             fits.append(p)
     if not fits:
         return _NO_FITS, slides
     out = np.array(fits)
-    return out[np.lexsort((out[:, 1], out[:, 0]))], slides
+    return (out[np.lexsort((out[:, 1], out[:, 0]))] if len(out) > 1 else out), slides

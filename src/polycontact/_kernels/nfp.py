@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit
 
 from .decompose import ring_pieces
+from .relation import relate_state
 from .tolerance import tolerance_of
 
 
@@ -604,11 +605,18 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     did not link into rings (the caller then unions the sums another way), -1 when the
     sums are not finite (input beyond float64: the caller refuses it).
     """
+    return _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol)[2:]
+
+
+@njit(cache=True, nogil=True)
+def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
+    """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
     if not np.isfinite(sums).all():
         # error code, not a crash: the caller refuses the input
         meta = np.array([1.0, -1.0, 0.0])
-        return sums[:0], np.zeros(1, np.int64), np.empty((0, 2)), np.empty((0, 4)), meta
+        return (sums, starts, sums[:0], np.zeros(1, np.int64), np.empty((0, 2)),
+                np.empty((0, 4)), meta)
     if eps <= 0.0:
         eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])
@@ -616,7 +624,8 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
         rs = np.array([0, sums.shape[0]], np.int64)
         area, length = _ring_stats(sums, rs)
         ring_xy, ring_starts = _closed(sums, rs)
-        return ring_xy, ring_starts, np.column_stack((area, length)), np.empty((0, 4)), meta
+        return (sums, starts, ring_xy, ring_starts, np.column_stack((area, length)),
+                np.empty((0, 4)), meta)
     bb = _bboxes(sums, starts)
     fr = _frames(sums, starts)
     outline, loose = edge_cover(sums, starts, bb, fr, eps)
@@ -630,34 +639,177 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     meta[1] = 1.0 if ok else 0.0
     meta[2] = pts.shape[0]
     ring_xy, ring_starts = _closed(ring_xy, ring_starts)
-    return ring_xy, ring_starts, np.column_stack((area, length)), cand, meta
+    return sums, starts, ring_xy, ring_starts, np.column_stack((area, length)), cand, meta
 
 
 @njit(cache=True, nogil=True)
-def ring_entrance(bxy, axy, a0x, a0y, eps, rel_tol, ulps, ang_tol, max_ear, max_sum):
+def ring_entrance(bxy, axy, a0x, a0y, eps, rel_tol, ulps, ang_tol, snap_f, near_f, max_ear,
+                  max_sum):
     """:func:`entrance_region` of two simple CCW rings B and A (no holes), each cut into
     convex pieces here (:func:`polycontact._kernels.decompose.ring_pieces`, up to
     ``max_ear`` vertices), A's reflected through ``(a0x, a0y)``: one call where a
     decomposition cached by the caller would cost more to look up than to redo.
 
-    Returns ``(ok, ring_xy, ring_starts, ring_stats, candidates, meta)``; ``ok`` is
-    False (and the rest empty) when a ring is too large or has no ear left, or the sums
-    would hold more than ``max_sum`` vertices: the caller then decomposes the rings
-    another way (or refuses them) and calls :func:`entrance_region`.
+    Returns ``(head, buf)`` as :func:`entrance_packed`; ``head[0]`` (ok) is 0 (and the
+    rest empty) when a ring is too large or has no ear left, or the sums would hold more
+    than ``max_sum`` vertices: the caller then decomposes the rings another way (or
+    refuses them) and calls :func:`entrance_packed`.
     """
     okb, bp, bst = ring_pieces(bxy, rel_tol, ulps, max_ear)
     oka, ap, ast = ring_pieces(axy, rel_tol, ulps, max_ear)
     total = bp.shape[0] * (ast.shape[0] - 1) + ap.shape[0] * (bst.shape[0] - 1)
     if not (okb and oka) or total > max_sum:
-        return (False, bp[:0], np.zeros(1, np.int64), np.empty((0, 2)), np.empty((0, 4)),
-                np.zeros(3))
+        return _pack(False, bp, bst, bp[:0], np.zeros(1, np.int64), np.empty((0, 2)),
+                     np.empty((0, 4)), np.zeros(3), snap_f, near_f)
     r = np.empty_like(ap)
     for i in range(ap.shape[0]):
         r[i, 0] = a0x - ap[i, 0]
         r[i, 1] = a0y - ap[i, 1]
-    ring_xy, ring_starts, stats, cand, meta = entrance_region(
-        bp, bst, r, ast, eps, rel_tol, ulps, ang_tol)
-    return True, ring_xy, ring_starts, stats, cand, meta
+    return _pack(True, *_entrance(bp, bst, r, ast, eps, rel_tol, ulps, ang_tol), snap_f,
+                 near_f)
+
+
+@njit(cache=True, nogil=True)
+def entrance_packed(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, snap_f, near_f):
+    """:func:`entrance_region`'s answer as two objects, ``(head, buf)``: returning an
+    array to Python costs about half a microsecond each, a third of a small no-fit
+    polygon's kernel time with five. The candidates are made exact here, where the sums
+    are at hand (see :func:`_exact_candidates`; ``snap_f`` and ``near_f`` times the
+    tolerance are its ``snap`` and ``near``).
+
+    ``head`` = ``(ok, eps, status, candidate fits, rings, ring vertices, candidates)``,
+    floats (``ok`` = 1; ``status`` is
+    ``meta[1]`` of :func:`entrance_region`); ``buf`` (float64) holds, one after the
+    other, the rings' coordinates (x0, y0, x1, ...), their starts (rings + 1), their
+    (area, length) and the candidates (4 each); see
+    :func:`polycontact.nfp._unpack`.
+    """
+    return _pack(True, *_entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol),
+                 snap_f, near_f)
+
+
+@njit(cache=True, nogil=True)
+def _pack(ok, sums, starts, ring_xy, ring_starts, stats, cand, meta, snap_f, near_f):
+    """``(head, buf)`` of :func:`entrance_packed` from :func:`_entrance`'s answer."""
+    if cand.shape[0]:
+        n_pts = int(meta[2])
+        cand = _exact_candidates(cand, n_pts, sums, starts, snap_f * meta[0],
+                                 near_f * meta[0])
+    nv = ring_xy.shape[0]
+    nr = ring_starts.shape[0] - 1
+    nc = cand.shape[0]
+    buf = np.empty(2 * nv + (nr + 1) + 2 * nr + 4 * nc)
+    w = 0
+    for i in range(nv):
+        buf[w] = ring_xy[i, 0]
+        buf[w + 1] = ring_xy[i, 1]
+        w += 2
+    for k in range(nr + 1):
+        buf[w] = ring_starts[k]
+        w += 1
+    for k in range(nr):
+        buf[w] = stats[k, 0]
+        buf[w + 1] = stats[k, 1]
+        w += 2
+    for k in range(nc):
+        for c in range(4):
+            buf[w] = cand[k, c]
+            w += 1
+    head = (1.0 if ok else 0.0, meta[0], meta[1], meta[2], float(nr), float(nv), float(nc))
+    return head, buf
+
+
+@njit(cache=True, nogil=True)
+def _exact_candidates(cand, n_pts, sums, starts, snap_tol, near):
+    """Candidates (C, 4) of :func:`entrance_region` (its ``n_pts`` exact fits first)
+    made exact: each snapped to the sums' vertices or edge crossings within ``snap_tol``
+    (:func:`snap`; a slide's ends along the slide), the slides then merged where
+    collinear (:func:`merge_collinear` within ``near``) and sorted by their ends; the
+    exact fits stay first, as points repeated."""
+    pts = snap(cand[:n_pts, :2].copy(), np.zeros((n_pts, 2)), sums, starts, snap_tol)
+    ns = cand.shape[0] - n_pts
+    ends = np.empty((2 * ns, 2))
+    along = np.empty((2 * ns, 2))
+    for k in range(ns):
+        row = cand[n_pts + k]
+        for e in range(2):
+            ends[2 * k + e, 0] = row[2 * e]
+            ends[2 * k + e, 1] = row[2 * e + 1]
+            along[2 * k + e, 0] = row[2] - row[0]
+            along[2 * k + e, 1] = row[3] - row[1]
+    merged = merge_collinear(snap(ends, along, sums, starts, snap_tol).reshape(-1, 4), near)
+    # sorted by (x0, y0, x1, y1), stably (insertion: a few slides)
+    order = np.arange(merged.shape[0])
+    for i in range(1, order.shape[0]):
+        j = i
+        while j > 0 and (merged[order[j], 0], merged[order[j], 1], merged[order[j], 2],
+                         merged[order[j], 3]) < (merged[order[j - 1], 0],
+                                                 merged[order[j - 1], 1],
+                                                 merged[order[j - 1], 2],
+                                                 merged[order[j - 1], 3]):
+            order[j], order[j - 1] = order[j - 1], order[j]
+            j -= 1
+    out = np.empty((n_pts + merged.shape[0], 4))
+    for k in range(n_pts):
+        out[k, 0] = out[k, 2] = pts[k, 0]
+        out[k, 1] = out[k, 3] = pts[k, 1]
+    for k in range(merged.shape[0]):
+        out[n_pts + k] = merged[order[k]]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol):
+    """Whether A (packed ``xa``, ``sa``) moved so that its reference ``(a0x, a0y)`` is at
+    each point (P, 2), and at the middle and both ends of each segment (S, 4), touches B
+    without overlapping (:func:`polycontact._kernels.relation.relate_state` is 1,
+    contact, within ``tol``): ``(points' (P,), segments' (S,))`` bool arrays."""
+    moved = np.empty_like(xa)
+    at_pts = np.empty(points.shape[0], np.bool_)
+    for k in range(points.shape[0]):
+        at_pts[k] = _touches_at(points[k, 0], points[k, 1], moved, xa, sa, xb, sb, a0x, a0y,
+                                tol)
+    at_segs = np.empty(segs.shape[0], np.bool_)
+    for k in range(segs.shape[0]):
+        x0, y0, x1, y1 = segs[k, 0], segs[k, 1], segs[k, 2], segs[k, 3]
+        at_segs[k] = (
+            _touches_at(0.5 * (x0 + x1), 0.5 * (y0 + y1), moved, xa, sa, xb, sb, a0x, a0y, tol)
+            and _touches_at(x0, y0, moved, xa, sa, xb, sb, a0x, a0y, tol)
+            and _touches_at(x1, y1, moved, xa, sa, xb, sb, a0x, a0y, tol))
+    return at_pts, at_segs
+
+
+@njit(cache=True, nogil=True)
+def _touches_at(px, py, moved, xa, sa, xb, sb, a0x, a0y, tol):
+    """relate_state of A moved by p - a0 (into ``moved``) against B is contact."""
+    dx = px - a0x
+    dy = py - a0y
+    for i in range(xa.shape[0]):
+        moved[i, 0] = xa[i, 0] + dx
+        moved[i, 1] = xa[i, 1] + dy
+    return relate_state(moved, sa, xb, sb, tol) == 1
+
+
+@njit(cache=True, nogil=True)
+def distance_to_segments(p, segs):
+    """Distance from each point ``p`` (P, 2) to the nearest of the segments (S, 2, 2): (P,).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> distance_to_segments(np.array([[0.5, 1.0], [3.0, 0.0]]),
+    ...                      np.array([[[0.0, 0.0], [1.0, 0.0]]])).tolist()
+    [1.0, 2.0]
+    """
+    out = np.full(p.shape[0], np.inf)
+    for k in range(p.shape[0]):
+        for m in range(segs.shape[0]):
+            ax, ay = segs[m, 0, 0], segs[m, 0, 1]
+            ux, uy = segs[m, 1, 0] - ax, segs[m, 1, 1] - ay
+            dx, dy = p[k, 0] - ax, p[k, 1] - ay
+            t = min(max((dx * ux + dy * uy) / (ux * ux + uy * uy), 0.0), 1.0)
+            out[k] = min(out[k], np.hypot(dx - t * ux, dy - t * uy))
+    return out
 
 
 @njit(cache=True, nogil=True)
