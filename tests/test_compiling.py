@@ -84,6 +84,19 @@ def test_warmup_command_reports_every_family(tmp_path):
     assert out.stdout.startswith("kernels ready in")
 
 
+def test_a_warmed_up_cache_is_warm_for_every_family(tmp_path):
+    # is_warm reads the cache index of the kernels each family lists: they must be the
+    # kernels the family's functions compile (an entry point renamed or no longer
+    # called leaves is_warm False forever: every start announced a compile)
+    out = _run([sys.executable, "-c",
+                "from polycontact import compiling\n"
+                "compiling.warmup()\n"
+                "print([f for f in compiling.FAMILIES if not compiling.is_warm([f])])\n"],
+               {"NUMBA_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+
+
 def test_version():
     out = _run([sys.executable, "-m", "polycontact", "--version"], {})
     assert out.stdout.strip() == f"polycontact {polycontact.__version__}"

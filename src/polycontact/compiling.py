@@ -42,7 +42,7 @@ __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint
 FAMILIES: dict[str, tuple[str, ...]] = {
     "classification": ("relation.relate_state", "relation.classify_raw"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
-    "no-fit polygon": ("nfp.entrance_region", "nfp.convex_sums"),
+    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed"),
     "entrance block": ("relation.relate_state",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
 }
