@@ -223,6 +223,9 @@ INTERRUPTED_BUILD = """
 import os, signal, sys
 import polycontact as pc
 
+# Ctrl-C as in a terminal: a process started in the background of a non-interactive
+# shell inherits SIGINT ignored, and Python then leaves it so (no KeyboardInterrupt)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 inst = pc.read_esicup(sys.argv[1])
 
 def progress(done, total):
