@@ -511,12 +511,11 @@ def time_of_impact(
     """
     # Shapes and Motions (a simulation's loop) pass as they are; their arrays have the
     # types the compiled code was found for (see :mod:`polycontact._dispatch`)
-    fixed = (type(a) is Shape and type(b) is Shape and type(motion_a) is Motion
-             and type(motion_b) is Motion)
-    if fixed:
-        ma, mb = motion_a, motion_b
+    if (type(a) is Shape and type(b) is Shape and type(motion_a) is Motion
+            and type(motion_b) is Motion):
+        fixed, ma, mb = True, motion_a, motion_b
     else:
-        a, b = as_shape(a, "a"), as_shape(b, "b")
+        fixed, a, b = False, as_shape(a, "a"), as_shape(b, "b")
         ma, mb = check_motion(motion_a, "motion_a"), check_motion(motion_b, "motion_b")
     if (type(t_max) is float and type(time_tolerance) is float and type(samples) is int
             and type(max_iterations) is int and 0.0 <= t_max < _INF
