@@ -103,8 +103,8 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False
     timing, like ``Shape.packed``. ``compiled``: call the compiled code directly (as
     ``time_of_impact`` does, see ``polycontact._dispatch``) rather than through the
     Numba dispatcher."""
-    ra, _, _, _, pa = body_frame(a)
-    rb, _, _, _, pb = body_frame(b)
+    ra, _, _, pa = body_frame(a)
+    rb, _, _, pb = body_frame(b)
     va, vb = ma.array, mb.array
     lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
     eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))

@@ -530,8 +530,8 @@ def test_the_body_frame_cached_on_a_shape_is_read_only():
 
     s = Shape([(0, 0), (2, 0), (2, 2), (0, 2)], [[(0.5, 0.5), (1, 0.5), (1, 1)]])
     time_of_impact(s, Motion(velocity=(1, 0)), s.moved((5, 0)), Motion(), t_max=1.0)
-    r, tables, _, _, packed = body_frame(s)
-    assert s._frame is not None and s._frame[4] is packed
+    r, tables, _, packed = body_frame(s)
+    assert s._frame is not None and s._frame[3] is packed
     for arr in (r, *tables, *packed):
         assert not arr.flags.writeable
         with pytest.raises(ValueError):

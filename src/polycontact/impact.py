@@ -533,10 +533,10 @@ def time_of_impact(
         fa = body_frame(a, tables=exact, what="a")
     if fb is None or exact and fb[1] is None:
         fb = body_frame(b, tables=exact, what="b")
-    ra, ea, base_a, big_a, pa = fa
-    rb, eb, base_b, big_b, pb = fb
+    ra, ea, base_a, pa = fa
+    rb, eb, base_b, pb = fb
     la, lb = a._radius, b._radius
-    if not (t_max <= _SAFE_SCALE and big_a <= _SAFE_SCALE and big_b <= _SAFE_SCALE
+    if not (t_max <= _SAFE_SCALE and base_a <= _SAFE_SCALE and base_b <= _SAFE_SCALE
             and ma._largest <= _SAFE_SCALE and mb._largest <= _SAFE_SCALE) and (
                 reach_excess(base_a, la, ma._norms, t_max) is not None
                 or reach_excess(base_b, lb, mb._norms, t_max) is not None):
@@ -623,8 +623,9 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
 
 
 _INF = float("inf")
-#: When the body's reach at rest and radius (``body_frame``'s last entry), its motion's
-#: norms (``Motion._largest``) and t_max are all at most this, the reach check passes
+#: When the body's reach at rest (``body_frame``'s ``base``, which is at least its
+#: bounding radius), its motion's norms (``Motion._largest``) and t_max are all at most
+#: this, the reach check passes
 #: without computing it: with every quantity K <= 1e15, the bounds of
 #: :func:`polycontact.broad_phase.reach_excess` are at most K + K^2 + K^3 (coordinates),
 #: 2 K + 2 K^2 + K^3 (speeds), K + K^2 + (K + K^2)^2 K (accelerations, about 1e75) and
@@ -633,25 +634,23 @@ _SAFE_SCALE = 1e15
 
 
 def body_frame(shape: Shape, tables: bool = True, what: str = "shape") -> tuple[Any, ...]:
-    """``(r, tables, base, big, packed)``: the shape's vertices relative to its
-    centroid; when asked for, their ``_kernels.advance.edge_table`` (the exact method's
-    circle tree; the sampled method does not need it); how far the body reaches from
-    the origin at rest (:func:`polycontact.broad_phase.base_reach`, for the reach
-    check) and the larger of that and its bounding radius (for the reach check's
-    shortcut); with the tables, the body as ``_kernels.impact.pack_body`` packs it for
-    the exact kernel (else None). Built on first use and kept with the shape (it is
+    """``(r, tables, base, packed)``: the shape's vertices relative to its centroid;
+    when asked for, their ``_kernels.advance.edge_table`` (the exact method's circle
+    tree; the sampled method does not need it); how far the body reaches from the
+    origin at rest (:func:`polycontact.broad_phase.base_reach`, for the reach check;
+    at least the bounding radius); with the tables, the body as
+    ``_kernels.impact.pack_body`` packs it for the exact kernel (else None). Built on first use and kept with the shape (it is
     immutable; the arrays are read-only), so that repeated queries on one shape build
     them once. On first use the coordinates are also checked
     (:func:`polycontact.tolerances.check_range`, the error naming ``what``)."""
     frame = shape._frame
     if frame is not None and (frame[1] is not None or not tables):
         return frame
-    r, tab, base, big, packed = frame if frame is not None else (None, None, 0.0, 0.0, None)
+    r, tab, base, packed = frame if frame is not None else (None, None, 0.0, None)
     if r is None:
         xy = shape.packed[0]
         check_range(xy, what)
         base = base_reach(shape)
-        big = max(base, float(shape.bounding_radius))
         r = xy - shape.centroid
         r.flags.writeable = False
     if tables and tab is None:
@@ -663,7 +662,7 @@ def body_frame(shape: Shape, tables: bool = True, what: str = "shape") -> tuple[
                            float(shape.bounding_radius), tab)
         for arr in (*tab, *packed):
             arr.flags.writeable = False
-    shape._frame = frame = (r, tab, base, big, packed)
+    shape._frame = frame = (r, tab, base, packed)
     return frame
 
 

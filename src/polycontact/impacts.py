@@ -156,7 +156,7 @@ def _pack(shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
     """The shapes' packed body frames (``_kernels.impact.pack_body``, built once per
     shape) one after another, with their offsets: ``(floats, f_off, ints, i_off)``
     (see ``impacts_chunk``)."""
-    packs = [body_frame(s)[4] for s in shapes]
+    packs = [body_frame(s)[3] for s in shapes]
     f_off = np.zeros(len(packs) + 1, np.int64)
     i_off = np.zeros(len(packs) + 1, np.int64)
     np.cumsum([len(f) for f, _ in packs], out=f_off[1:])
