@@ -385,10 +385,35 @@ _RAW: list[Any] = []  # [classify_raw], bound on first use
 _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
-#: The state kernels for two Shapes, bound on first use: [relate_shapes_into's entry point,
-#: relate_state's entry point] (see polycontact._dispatch).
-_STATE: list[Any] = []
 _new = object.__new__
+
+
+def _bind_state_into(pa: np.ndarray, pb: np.ndarray, eps: float, scratch: np.ndarray) -> int:
+    """The first call of :func:`classify` on two Shapes: binds ``relate_shapes_into``'s
+    entry point (see polycontact._dispatch) to ``_state_into``, then classifies.
+
+    Binding replaces this function, so the calls after it check nothing (threads
+    binding at once bind the same entry point).
+    """
+    global _state_into
+    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, 1.0, np.empty(0)))
+    return int(_state_into(pa, pb, eps, scratch))
+
+
+def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
+                     eps: float) -> int:
+    """:func:`_bind_state_into` for ``relate_state`` on the shapes' arrays (``_state_full``)."""
+    global _state_full
+    _state_full = entry_point(_kr().relate_state, (xa, sa, xb, sb, 1.0))
+    return int(_state_full(xa, sa, xb, sb, eps))
+
+
+#: The state kernels for two Shapes: ``relate_shapes_into`` on the shapes' kernel packs,
+#: and ``relate_state`` on their arrays for pairs with more vertices than the thread's
+#: scratch holds; each bound on its first call.
+_state_into: Callable[[np.ndarray, np.ndarray, float, np.ndarray], int] = _bind_state_into
+_state_full: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], int] = (
+    _bind_state_full)
 
 #: Vertices (both bodies together) that each thread's scratch buffer for :func:`classify`
 #: holds (~90 kB); larger pairs allocate their own, which costs little beside their test.
@@ -440,7 +465,7 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
     >>> round(classify(sq, sq + [0.75, 0.5]).distance, 12)
     -0.25
     """
-    if isinstance(a, Shape) and isinstance(b, Shape) and _STATE:
+    if isinstance(a, Shape) and isinstance(b, Shape):
         # Shapes (prebuilt: a simulation's loop), the fastest path: the tolerance is
         # cached on each shape, the state kernel is called without the dispatcher's type
         # resolution (the shapes' read-only arrays have fixed types: see
@@ -454,9 +479,9 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
             buf = _LOCAL.scratch
         except AttributeError:
             buf = _thread_scratch()
-        code = _STATE[0](a._kernel, b._kernel, eps, buf)
+        code = _state_into(a._kernel, b._kernel, eps, buf)
         if code < 0:  # more vertices than the buffer holds
-            code = _STATE[1](a._xy, a._starts, b._xy, b._starts, eps)
+            code = _state_full(a._xy, a._starts, b._xy, b._starts, eps)
         obj = _new(Relation)
         d = obj.__dict__
         d["state"] = _STATES[code]
@@ -490,14 +515,7 @@ def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relati
             d["tolerance"] = eps
             d["_pair"] = ((a.tobytes(), na, fa), (b.tobytes(), nb, fb))
             return obj
-    sa = as_shape(a, "a")
-    sb = as_shape(b, "b")
-    if not _STATE:
-        into = entry_point(_kr().relate_shapes_into, (sa._kernel, sb._kernel, 1.0, np.empty(0)))
-        args = (sa._xy, sa._starts, sb._xy, sb._starts, 1.0)
-        # one slice assignment: threads binding at once leave the same two entries
-        _STATE[:] = [into, entry_point(_kr().relate_state, args)]
-    return classify(sa, sb, tolerance=tolerance)
+    return classify(as_shape(a, "a"), as_shape(b, "b"), tolerance=tolerance)
 
 
 @dataclass(frozen=True, eq=False)
