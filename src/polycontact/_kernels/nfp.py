@@ -225,8 +225,14 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
     (:func:`_frames`).
     """
     k = starts.shape[0] - 1
-    starts_a = np.empty(k)
-    lens = np.empty(k)
+    return _surrounded(px, py, starts, bb, fr, eps, ang_tol, np.empty((2, k)))
+
+
+@njit(cache=True, nogil=True)
+def _surrounded(px, py, starts, bb, fr, eps, ang_tol, arcs):
+    """:func:`surrounded` with a work array ``arcs`` (2, number of sums), for callers
+    asking about many points."""
+    k = starts.shape[0] - 1
     n = 0
     for p in range(k):
         if px < bb[p, 0] - eps or px > bb[p, 2] + eps or py < bb[p, 1] - eps or py > bb[p, 3] + eps:
@@ -235,20 +241,26 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
         if kind == 1:
             return True
         if kind == 2:
-            starts_a[n] = st
-            lens[n] = ln
+            # kept sorted by start (insertion: a few arcs; the order among equal starts
+            # does not change the sweep's answer)
+            i = n
+            while i > 0 and arcs[0, i - 1] > st:
+                arcs[0, i] = arcs[0, i - 1]
+                arcs[1, i] = arcs[1, i - 1]
+                i -= 1
+            arcs[0, i] = st
+            arcs[1, i] = ln
             n += 1
     if n == 0:
         return False
-    order = np.argsort(starts_a[:n])
-    first = starts_a[order[0]]
+    first = arcs[0, 0]
     reach = first
     for rep in range(2):
         for oi in range(n):
-            st = starts_a[order[oi]] + 2.0 * np.pi * rep
+            st = arcs[0, oi] + 2.0 * np.pi * rep
             if st > reach + ang_tol:
                 return False
-            reach = max(reach, st + lens[order[oi]])
+            reach = max(reach, st + arcs[1, oi])
             if reach >= first + 2.0 * np.pi - ang_tol:
                 return True
     return reach >= first + 2.0 * np.pi - ang_tol
@@ -511,8 +523,12 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
     ``(points (P, 2), segments (S, 4))``, not deduplicated: the same exact fit is found
     on every edge through it, a slide on the edges of both sides.
     """
-    pts = []
-    slides = []
+    pts = np.empty((loose.shape[0], 2))
+    slides = np.empty((loose.shape[0], 4))
+    n_pts = 0
+    n_slides = 0
+    arcs = np.empty((2, starts.shape[0] - 1))
+    ts = np.empty(xy.shape[0] + 2)
     off = 64.0 * eps
     for r in range(loose.shape[0]):
         ax, ay, bx, by = loose[r, 0], loose[r, 1], loose[r, 2], loose[r, 3]
@@ -520,12 +536,17 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
         if ln <= 8.0 * eps:
             mx = 0.5 * (ax + bx)
             my = 0.5 * (ay + by)
-            if surrounded(mx, my, starts, bb, fr, eps, ang_tol):
-                pts.append((mx, my))
+            if _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs):
+                pts[n_pts, 0] = mx
+                pts[n_pts, 1] = my
+                n_pts += 1
             continue
         ux = (bx - ax) / ln
         uy = (by - ay) / ln
-        ts = [0.0, ln]
+        # the cuts: both ends and the sums' vertices on the part, sorted (insertion)
+        ts[0] = 0.0
+        ts[1] = ln
+        nt = 2
         x0 = min(ax, bx) - eps
         x1 = max(ax, bx) + eps
         y0 = min(ay, by) - eps
@@ -541,34 +562,44 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
                 if abs(ux * dy - uy * dx) <= eps:
                     t = ux * dx + uy * dy
                     if 0.0 < t < ln:
-                        ts.append(t)
-        tarr = np.sort(np.array(ts))
+                        i = nt
+                        while i > 1 and ts[i - 1] > t:
+                            ts[i] = ts[i - 1]
+                            i -= 1
+                        ts[i] = t
+                        nt += 1
         open_at = -1.0
-        for q in range(tarr.shape[0] - 1):
-            t0 = tarr[q]
-            t1 = tarr[q + 1]
+        for q in range(nt - 1):
+            t0 = ts[q]
+            t1 = ts[q + 1]
             if t1 - t0 <= eps:
                 continue
             tm = 0.5 * (t0 + t1)
             mx = ax + tm * ux
             my = ay + tm * uy
-            inside = _in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr) and surrounded(
-                mx, my, starts, bb, fr, eps, ang_tol
+            inside = _in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr) and _surrounded(
+                mx, my, starts, bb, fr, eps, ang_tol, arcs
             )
             if inside and open_at < 0.0:
                 open_at = t0
             if not inside and open_at >= 0.0:
-                slides.append((ax + open_at * ux, ay + open_at * uy, ax + t0 * ux, ay + t0 * uy))
+                if n_slides == slides.shape[0]:
+                    slides = _grow(slides)
+                slides[n_slides, 0] = ax + open_at * ux
+                slides[n_slides, 1] = ay + open_at * uy
+                slides[n_slides, 2] = ax + t0 * ux
+                slides[n_slides, 3] = ay + t0 * uy
+                n_slides += 1
                 open_at = -1.0
         if open_at >= 0.0:
-            slides.append((ax + open_at * ux, ay + open_at * uy, bx, by))
-    p_out = np.empty((len(pts), 2))
-    for r in range(len(pts)):
-        p_out[r, 0], p_out[r, 1] = pts[r]
-    s_out = np.empty((len(slides), 4))
-    for r in range(len(slides)):
-        s_out[r, 0], s_out[r, 1], s_out[r, 2], s_out[r, 3] = slides[r]
-    return p_out, s_out
+            if n_slides == slides.shape[0]:
+                slides = _grow(slides)
+            slides[n_slides, 0] = ax + open_at * ux
+            slides[n_slides, 1] = ay + open_at * uy
+            slides[n_slides, 2] = bx
+            slides[n_slides, 3] = by
+            n_slides += 1
+    return pts[:n_pts], slides[:n_slides]
 
 
 @njit(cache=True, nogil=True)
