@@ -191,3 +191,71 @@ def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
     want = [min(shapely.distance(shapely.Point(q), shapely.LineString(s)) for s in segs)
             for q in p]
     np.testing.assert_allclose(kn.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)
+
+
+def _former_selection(pts, pts_ok, segs, segs_ok, near):
+    """The Python steps select_contacts replaced (nfp._clean_degenerate until session 9)."""
+    slides = segs[segs_ok].reshape(-1, 2, 2)
+    on_slide = (kn.distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
+                else np.zeros(len(pts), dtype=bool))
+    fits = []
+    for p, skip, ok_p in zip(pts, on_slide.tolist(), pts_ok):
+        if skip or any(np.hypot(*(p - q)) <= near for q in fits):
+            continue
+        if ok_p:
+            fits.append(p)
+    out = np.array(fits).reshape(-1, 2)
+    return out[np.lexsort((out[:, 1], out[:, 0]))], slides
+
+
+@examples(100)
+@given(st.integers(0, 8), st.integers(0, 4), st.integers(0, 2**32 - 1))
+def test_selected_contacts_are_the_former_python_steps_bit_for_bit(n_pts, n_segs, seed):
+    # candidates on a small lattice, repeated, moved by less and more than `near`, on
+    # slides and at their ends, each verified or not at random
+    rng = np.random.default_rng(seed)
+    near = 1e-3
+    pts = rng.integers(-2, 3, (n_pts, 2)).astype(float)
+    pts += rng.choice([0.0, 0.0, 0.4 * near, 3.0 * near], (n_pts, 2))
+    segs = np.tile(rng.integers(-2, 3, (n_segs, 2)).astype(float), 2)
+    segs[:, 2:] += np.array([(1, 0), (0, 1), (1, 1), (2, -1)])[rng.integers(0, 4, n_segs)]
+    if n_pts and n_segs:
+        pts[0] = segs[0, :2] + 0.5 * near  # a fit at a slide's end
+    pts_ok = rng.random(n_pts) < 0.7
+    segs_ok = rng.random(n_segs) < 0.6
+    fits, slides = kn.select_contacts(pts, pts_ok, segs, segs_ok, near)
+    want_fits, want_slides = _former_selection(pts, pts_ok, segs, segs_ok, near)
+    assert fits.shape == want_fits.shape and slides.shape == want_slides.shape
+    np.testing.assert_array_equal(fits, want_fits)
+    np.testing.assert_array_equal(slides, want_slides)
+
+
+@pytest.mark.parametrize("b, fits, slides", [
+    (pc.Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]),  # slot
+     [], [[[1.0, 1.0], [1.0, 3.0]]]),
+    (pc.Shape([(-1, -1), (2, -1), (2, 2), (-1, 2)], [[(0, 0), (0, 1), (1, 1), (1, 0)]]),
+     [[0.0, 0.0]], []),  # socket
+    (pc.Shape([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)]),
+     [], []),  # loose slot: no candidate survives
+], ids=["slot", "socket", "loose slot"])
+def test_no_fit_polygon_selects_its_candidates_in_one_kernel_call(monkeypatch, b, fits, slides):
+    # the no-fit polygon verifies and selects its candidates in the kernel
+    # (touching_contacts); the same selection from the classifier's verdicts taken one
+    # by one in Python (the path inner_fit_polygon's Shapely check takes) agrees
+    nfp = pc.no_fit_polygon(SQUARE, b, "origin")
+    assert nfp.exact_fits.tolist() == fits and nfp.slides.tolist() == slides
+
+    def check(pts, segs):
+        def touches(p):
+            moved = pc.Shape(SQUARE).moved(p)
+            return pc.classify(moved, b, tolerance=16 * nfp.tolerance).state.value == "contact"
+        return [touches(p) for p in pts], [
+            touches(0.5 * (s[:2] + s[2:])) and touches(s[:2]) and touches(s[2:]) for s in segs]
+
+    calls = []
+    monkeypatch.setattr(nfp_module, "_touching", lambda *args: calls.append(1) or (
+        nfp_module._checked(check)))
+    slow = pc.no_fit_polygon(SQUARE, b, "origin")
+    assert len(calls) == (b.exterior.max() != 4 or len(b.holes) > 0)
+    np.testing.assert_array_equal(slow.exact_fits, nfp.exact_fits)
+    np.testing.assert_array_equal(slow.slides, nfp.slides)

@@ -811,6 +811,70 @@ def touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol):
 
 
 @njit(cache=True, nogil=True)
+def select_contacts(pts, pts_ok, segs, segs_ok, near):
+    """The exact fits and slides kept among verified candidates, duplicates merged.
+
+    ``pts`` (P, 2) candidate exact fits and ``segs`` (S, 4) candidate slides, with
+    whether each verified (``pts_ok``, ``segs_ok``). The verified slides are kept; a
+    point is dropped when it lies within ``near`` of a kept slide or of a point kept
+    before it, else kept when verified. Returns ``(fits (F, 2), slides (K, 2, 2))``,
+    the fits sorted by x then y.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pts = np.array([[2.0, 0.0], [0.5, 0.0], [1.0, 3.0], [1.0, 3.0 + 1e-12]])
+    >>> segs = np.array([[0.0, 0.0, 1.0, 0.0]])
+    >>> fits, slides = select_contacts(pts, np.ones(4, np.bool_), segs,
+    ...                                np.ones(1, np.bool_), 1e-9)
+    >>> fits.tolist(), slides.shape
+    ([[1.0, 3.0], [2.0, 0.0]], (1, 2, 2))
+    """
+    ns = 0
+    slides = np.empty((segs.shape[0], 2, 2))
+    for k in range(segs.shape[0]):
+        if segs_ok[k]:
+            for e in range(2):
+                slides[ns, e, 0] = segs[k, 2 * e]
+                slides[ns, e, 1] = segs[k, 2 * e + 1]
+            ns += 1
+    slides = slides[:ns]
+    on_slide = distance_to_segments(pts, slides)
+    fits = np.empty((pts.shape[0], 2))
+    nf = 0
+    for k in range(pts.shape[0]):
+        if on_slide[k] <= near:
+            continue
+        px = pts[k, 0]
+        py = pts[k, 1]
+        dup = False
+        for f in range(nf):
+            if np.hypot(px - fits[f, 0], py - fits[f, 1]) <= near:
+                dup = True
+                break
+        if dup or not pts_ok[k]:
+            continue
+        # kept sorted by (x, y), stably (insertion: a few fits)
+        i = nf
+        while i > 0 and (fits[i - 1, 0] > px or (fits[i - 1, 0] == px and fits[i - 1, 1] > py)):
+            fits[i, 0] = fits[i - 1, 0]
+            fits[i, 1] = fits[i - 1, 1]
+            i -= 1
+        fits[i, 0] = px
+        fits[i, 1] = py
+        nf += 1
+    return fits[:nf], slides
+
+
+@njit(cache=True, nogil=True)
+def touching_contacts(points, segs, near, xa, sa, xb, sb, a0x, a0y, tol):
+    """:func:`select_contacts` of the candidates verified by :func:`touching` (A placed
+    there touches B without overlapping), in one call."""
+    pts_ok, segs_ok = touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol)
+    return select_contacts(points, pts_ok, segs, segs_ok, near)
+
+
+@njit(cache=True, nogil=True)
 def _touches_at(px, py, moved, xa, sa, xb, sb, a0x, a0y, tol):
     """relate_state of A moved by p - a0 (into ``moved``) against B is contact."""
     dx = px - a0x
