@@ -259,3 +259,44 @@ def test_no_fit_polygon_selects_its_candidates_in_one_kernel_call(monkeypatch, b
     assert len(calls) == (b.exterior.max() != 4 or len(b.holes) > 0)
     np.testing.assert_array_equal(slow.exact_fits, nfp.exact_fits)
     np.testing.assert_array_equal(slow.slides, nfp.slides)
+
+
+def _former_assembly(segs, tol):
+    """assemble_rings until session 9: every end linked by the clockwise rule
+    (_first_clockwise), also where a single start is there."""
+    seg = segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > tol]
+    n = len(seg)
+    order = np.argsort(seg[:, 0], kind="stable")
+    sx = seg[order, 0]
+    nxt = [kn._first_clockwise(seg, order, sx, np.searchsorted(sx, seg[r, 2] - tol), r, tol)
+           for r in range(n)]
+    assert min(nxt, default=0) >= 0 and len(set(nxt)) == n
+    xy, starts, seen = [], [0], set()
+    for r0 in range(n):
+        r = r0
+        while r not in seen:
+            seen.add(r)
+            xy.append(seg[r, :2])
+            r = nxt[r]
+        if len(xy) > starts[-1]:
+            starts.append(len(xy))
+    xy = np.array(xy).reshape(-1, 2)
+    return xy, kn._split_pinched(xy, np.array(starts, np.int64), tol)
+
+
+@examples(60)
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), min_size=1, max_size=12,
+                unique=True))
+def test_rings_are_linked_as_by_the_clockwise_rule_bit_for_bit(cells):
+    # unions of lattice squares: rings touching at corners (several starts at a point,
+    # where the clockwise rule decides) and plain vertices (one start, taken at once)
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy = np.concatenate([sq + c for c in cells])
+    starts = np.arange(0, 4 * len(cells) + 1, 4, dtype=np.int64)
+    outline, _ = kn.edge_cover(xy, starts, kn._bboxes(xy, starts), kn._frames(xy, starts),
+                               1e-12)
+    ok, got_xy, got_starts = kn.assemble_rings(outline, 4e-12)
+    assert ok
+    want_xy, want_starts = _former_assembly(outline, 4e-12)
+    np.testing.assert_array_equal(got_xy, want_xy)
+    np.testing.assert_array_equal(got_starts, want_starts)

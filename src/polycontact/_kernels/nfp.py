@@ -389,6 +389,35 @@ def _grow(arr):
 
 
 @njit(cache=True, nogil=True)
+def _first_clockwise(seg, order, sx, lo, r, tol):
+    """Of the segments starting within ``tol`` of segment r's end (``order``, ``sx``:
+    the segments sorted by their start's x, from ``lo``), the one first clockwise from
+    the way back along r (see :func:`assemble_rings`)."""
+    n = seg.shape[0]
+    ex = seg[r, 2]
+    ey = seg[r, 3]
+    back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
+    best = -1
+    best_turn = np.inf
+    for oi in range(lo, n):
+        c = order[oi]
+        if sx[oi] > ex + tol:
+            break
+        if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
+            continue
+        ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
+        turn = back - ang  # clockwise angle from the way back
+        while turn <= 0.0:
+            turn += 2.0 * np.pi
+        while turn > 2.0 * np.pi:
+            turn -= 2.0 * np.pi
+        if turn < best_turn:
+            best_turn = turn
+            best = c
+    return best
+
+
+@njit(cache=True, nogil=True)
 def assemble_rings(segs, tol):
     """Link outline segments (interior on the left) into closed rings.
 
@@ -412,25 +441,20 @@ def assemble_rings(segs, tol):
     for r in range(n):
         ex = seg[r, 2]
         ey = seg[r, 3]
-        back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
         best = -1
-        best_turn = np.inf
         lo = np.searchsorted(sx, ex - tol)
+        # one start there (the common case): it, without comparing turns
+        starts_there = 0
         for oi in range(lo, n):
             c = order[oi]
             if sx[oi] > ex + tol:
                 break
             if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
                 continue
-            ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
-            turn = back - ang  # clockwise angle from the way back
-            while turn <= 0.0:
-                turn += 2.0 * np.pi
-            while turn > 2.0 * np.pi:
-                turn -= 2.0 * np.pi
-            if turn < best_turn:
-                best_turn = turn
-                best = c
+            starts_there += 1
+            best = c
+        if starts_there > 1:
+            best = _first_clockwise(seg, order, sx, lo, r, tol)
         if best < 0 or taken[best]:
             return False, np.empty((0, 2)), np.zeros(1, np.int64)
         taken[best] = True
