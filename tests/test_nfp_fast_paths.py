@@ -300,3 +300,60 @@ def test_rings_are_linked_as_by_the_clockwise_rule_bit_for_bit(cells):
     want_xy, want_starts = _former_assembly(outline, 4e-12)
     np.testing.assert_array_equal(got_xy, want_xy)
     np.testing.assert_array_equal(got_starts, want_starts)
+
+
+@st.composite
+def lattice_sums(draw):
+    """A few convex polygons on a small lattice (squares, triangles, hulls): shared
+    corners and edges, where the closed ones surround points on their boundaries."""
+    polys = []
+    for _ in range(draw(st.integers(1, 6))):
+        pts = draw(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3)), min_size=3,
+                            max_size=6, unique=True))
+        hull = shapely.convex_hull(shapely.MultiPoint(pts))
+        if hull.geom_type == "Polygon":
+            polys.append(np.asarray(shapely.orient_polygons(hull).exterior.coords)[:-1])
+    if not polys:
+        polys.append(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]))
+    xy = np.concatenate(polys).astype(float)
+    starts = np.r_[0, np.cumsum([len(p) for p in polys])].astype(np.int64)
+    return xy, starts
+
+
+DIRECTIONS = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 2), (0, 0), (0.6, -0.8)]
+
+
+@examples(100)
+@given(lattice_sums(), st.integers(0, 2**32 - 1))
+def test_may_be_surrounded_is_false_only_where_not_surrounded(sums, seed):
+    # the pre-test of degenerate_contacts' short parts: at the sums' vertices, edge
+    # middles and lattice points (shared corners and edges, outline vertices), in
+    # every direction (along the edges too), never False where surrounded is True
+    xy, starts = sums
+    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
+    eps, ang = 1e-12, nfp_module.ANGLE_TOLERANCE
+    rng = np.random.default_rng(seed)
+    pts = np.vstack([xy, 0.5 * (xy + np.roll(xy, -1, axis=0)),
+                     rng.integers(0, 4, (8, 2)) + rng.choice([0.0, 0.5, 3e-13], (8, 2))])
+    rejected = 0
+    for px, py in pts:
+        around = kn.surrounded(px, py, starts, bb, fr, eps, ang)
+        for vx, vy in DIRECTIONS:
+            may = kn._may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang)
+            assert may or not around, (px, py, vx, vy)
+            rejected += not may
+    assert rejected > 0  # (outline vertices at least: the pre-test does reject)
+
+
+def test_may_be_surrounded_at_a_corner_of_four_squares_and_of_one():
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy = np.concatenate([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
+    starts = np.arange(0, 17, 4, dtype=np.int64)
+    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
+    args = (starts, bb, fr, 1e-12, nfp_module.ANGLE_TOLERANCE)
+    for v in DIRECTIONS:  # the shared corner: every direction is entered
+        assert kn._may_be_surrounded(1.0, 1.0, *v, *args)
+    assert kn._may_be_surrounded(2.0, 1.0, -1.0, 0.0, *args)  # (surrounded says no)
+    assert not kn._may_be_surrounded(2.0, 1.0, 1.0, 0.0, *args)  # outline: out of it
+    assert not kn._may_be_surrounded(2.0, 2.0, 1.0, 1.0, *args)
+    assert not kn._may_be_surrounded(2.0, 2.0, 0.0, 0.0, *args)  # no direction: (1, 0)

@@ -266,6 +266,46 @@ def _surrounded(px, py, starts, bb, fr, eps, ang_tol, arcs):
     return reach >= first + 2.0 * np.pi - ang_tol
 
 
+@njit(cache=True, nogil=True)
+def _may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang_tol):
+    """False only where :func:`surrounded` is False, at a fraction of its cost (no
+    angles): no sum near p (within its box, not outside it by more than eps) enters
+    direction v (any non-zero vector; (1, 0) when v is zero), within an angle well
+    above ``ang_tol``.
+
+    Why: surrounded(p) holds when some sum holds p inside by more than eps (it has no
+    edge within eps of p, and enters every direction), or when the arcs of entering
+    directions of the sums around p leave no gap wider than ``ang_tol``; then v is
+    within ``ang_tol`` of the arc of some sum s, the intersection of the half-turns
+    {d : cross(u, d) >= 0} of the edges u of s within eps of p, so cross(u, v) >=
+    -sin(ang_tol) for each of them (unit u and v) and s passes here, where the same
+    tests tell which sums are near and which edges within eps.
+    """
+    ln = np.hypot(vx, vy)
+    if ln > 0.0:
+        vx /= ln
+        vy /= ln
+    else:
+        vx = 1.0
+        vy = 0.0
+    # (the arcs' angles and these products are rounded: 1e-15 of a turn and a unit)
+    slack = 2.0 * ang_tol + 1e-15
+    for q in range(starts.shape[0] - 1):
+        if px < bb[q, 0] - eps or px > bb[q, 2] + eps or py < bb[q, 1] - eps or py > bb[q, 3] + eps:
+            continue
+        enters = True
+        for i in range(starts[q], starts[q + 1]):
+            if fr[i, 3] == 0.0:
+                continue
+            f = fr[i, 0] * py - fr[i, 1] * px - fr[i, 2]
+            if f < -eps or (f <= eps and fr[i, 0] * vy - fr[i, 1] * vx < -slack):
+                enters = False
+                break
+        if enters:
+            return True
+    return False
+
+
 #: Sums remembered per grid cell as containing the whole cell (tried first on an edge).
 _PER_CELL = 4
 
@@ -541,7 +581,9 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
     """Exact-fit points and slide segments among the ``loose`` parts of :func:`edge_cover`.
 
     A loose part is an exact fit (when shorter than 8 eps) or a slide where the closed
-    sums cover every direction around it (``ang_tol``: angular gap taken as closed).
+    sums cover every direction around it (``ang_tol``: angular gap taken as closed);
+    around a short part, the direction to the right of it (away from its own sum) is
+    tried first (:func:`_may_be_surrounded`: most are vertices of the outline).
     A part is cut at the sums' vertices lying on it; a sub-part whose right side (the
     side away from its own sum) is in no sum is outline and skipped at once. Returns
     ``(points (P, 2), segments (S, 4))``, not deduplicated: the same exact fit is found
@@ -560,7 +602,8 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
         if ln <= 8.0 * eps:
             mx = 0.5 * (ax + bx)
             my = 0.5 * (ay + by)
-            if _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs):
+            if _may_be_surrounded(mx, my, by - ay, ax - bx, starts, bb, fr, eps, ang_tol) and (
+                    _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs)):
                 pts[n_pts, 0] = mx
                 pts[n_pts, 1] = my
                 n_pts += 1
