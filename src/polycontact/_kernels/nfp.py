@@ -52,7 +52,7 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
             w = sum_into(bxy, ps, pe, i0, rxy, rstarts[rj], rstarts[rj + 1], out, w)
             k += 1
             starts[k] = w
-    return out[:w].copy(), starts
+    return out[:w], starts
 
 
 @njit(cache=True, nogil=True)
@@ -407,7 +407,7 @@ def edge_cover(xy, starts, bb, fr, eps):
                 loose[nl, 2] = ax + hi1[r] * dx
                 loose[nl, 3] = ay + hi1[r] * dy
                 nl += 1
-    return outline[:no].copy(), loose[:nl].copy()
+    return outline[:no], loose[:nl]
 
 
 @njit(cache=True, nogil=True)
@@ -707,10 +707,19 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
 
 
 @njit(cache=True, nogil=True)
+def _finite(xy):
+    """Whether every coordinate is finite (without the array of ``np.isfinite``)."""
+    for i in range(xy.shape[0]):
+        if not (np.isfinite(xy[i, 0]) and np.isfinite(xy[i, 1])):
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
 def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
-    if not np.isfinite(sums).all():
+    if not _finite(sums):
         # error code, not a crash: the caller refuses the input
         meta = np.array([1.0, -1.0, 0.0])
         return (sums, starts, sums[:0], np.zeros(1, np.int64), np.empty((0, 2)),
