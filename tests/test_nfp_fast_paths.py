@@ -191,3 +191,169 @@ def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
     want = [min(shapely.distance(shapely.Point(q), shapely.LineString(s)) for s in segs)
             for q in p]
     np.testing.assert_allclose(kn.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)
+
+
+def _former_selection(pts, pts_ok, segs, segs_ok, near):
+    """The Python steps select_contacts replaced (nfp._clean_degenerate until session 9)."""
+    slides = segs[segs_ok].reshape(-1, 2, 2)
+    on_slide = (kn.distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
+                else np.zeros(len(pts), dtype=bool))
+    fits = []
+    for p, skip, ok_p in zip(pts, on_slide.tolist(), pts_ok):
+        if skip or any(np.hypot(*(p - q)) <= near for q in fits):
+            continue
+        if ok_p:
+            fits.append(p)
+    out = np.array(fits).reshape(-1, 2)
+    return out[np.lexsort((out[:, 1], out[:, 0]))], slides
+
+
+@examples(100)
+@given(st.integers(0, 8), st.integers(0, 4), st.integers(0, 2**32 - 1))
+def test_selected_contacts_are_the_former_python_steps_bit_for_bit(n_pts, n_segs, seed):
+    # candidates on a small lattice, repeated, moved by less and more than `near`, on
+    # slides and at their ends, each verified or not at random
+    rng = np.random.default_rng(seed)
+    near = 1e-3
+    pts = rng.integers(-2, 3, (n_pts, 2)).astype(float)
+    pts += rng.choice([0.0, 0.0, 0.4 * near, 3.0 * near], (n_pts, 2))
+    segs = np.tile(rng.integers(-2, 3, (n_segs, 2)).astype(float), 2)
+    segs[:, 2:] += np.array([(1, 0), (0, 1), (1, 1), (2, -1)])[rng.integers(0, 4, n_segs)]
+    if n_pts and n_segs:
+        pts[0] = segs[0, :2] + 0.5 * near  # a fit at a slide's end
+    pts_ok = rng.random(n_pts) < 0.7
+    segs_ok = rng.random(n_segs) < 0.6
+    fits, slides = kn.select_contacts(pts, pts_ok, segs, segs_ok, near)
+    want_fits, want_slides = _former_selection(pts, pts_ok, segs, segs_ok, near)
+    assert fits.shape == want_fits.shape and slides.shape == want_slides.shape
+    np.testing.assert_array_equal(fits, want_fits)
+    np.testing.assert_array_equal(slides, want_slides)
+
+
+@pytest.mark.parametrize("b, fits, slides", [
+    (pc.Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]),  # slot
+     [], [[[1.0, 1.0], [1.0, 3.0]]]),
+    (pc.Shape([(-1, -1), (2, -1), (2, 2), (-1, 2)], [[(0, 0), (0, 1), (1, 1), (1, 0)]]),
+     [[0.0, 0.0]], []),  # socket
+    (pc.Shape([(0, 0), (4, 0), (4, 3), (3, 3), (3, 1), (1, 1), (1, 3), (0, 3)]),
+     [], []),  # loose slot: no candidate survives
+], ids=["slot", "socket", "loose slot"])
+def test_no_fit_polygon_selects_its_candidates_in_one_kernel_call(monkeypatch, b, fits, slides):
+    # the no-fit polygon verifies and selects its candidates in the kernel
+    # (touching_contacts); the same selection from the classifier's verdicts taken one
+    # by one in Python (the path inner_fit_polygon's Shapely check takes) agrees
+    nfp = pc.no_fit_polygon(SQUARE, b, "origin")
+    assert nfp.exact_fits.tolist() == fits and nfp.slides.tolist() == slides
+
+    def check(pts, segs):
+        def touches(p):
+            moved = pc.Shape(SQUARE).moved(p)
+            return pc.classify(moved, b, tolerance=16 * nfp.tolerance).state.value == "contact"
+        return [touches(p) for p in pts], [
+            touches(0.5 * (s[:2] + s[2:])) and touches(s[:2]) and touches(s[2:]) for s in segs]
+
+    calls = []
+    monkeypatch.setattr(nfp_module, "_touching", lambda *args: calls.append(1) or (
+        nfp_module._checked(check)))
+    slow = pc.no_fit_polygon(SQUARE, b, "origin")
+    assert len(calls) == (b.exterior.max() != 4 or len(b.holes) > 0)
+    np.testing.assert_array_equal(slow.exact_fits, nfp.exact_fits)
+    np.testing.assert_array_equal(slow.slides, nfp.slides)
+
+
+def _former_assembly(segs, tol):
+    """assemble_rings until session 9: every end linked by the clockwise rule
+    (_first_clockwise), also where a single start is there."""
+    seg = segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > tol]
+    n = len(seg)
+    order = np.argsort(seg[:, 0], kind="stable")
+    sx = seg[order, 0]
+    nxt = [kn._first_clockwise(seg, order, sx, np.searchsorted(sx, seg[r, 2] - tol), r, tol)
+           for r in range(n)]
+    assert min(nxt, default=0) >= 0 and len(set(nxt)) == n
+    xy, starts, seen = [], [0], set()
+    for r0 in range(n):
+        r = r0
+        while r not in seen:
+            seen.add(r)
+            xy.append(seg[r, :2])
+            r = nxt[r]
+        if len(xy) > starts[-1]:
+            starts.append(len(xy))
+    xy = np.array(xy).reshape(-1, 2)
+    return xy, kn._split_pinched(xy, np.array(starts, np.int64), tol)
+
+
+@examples(60)
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), min_size=1, max_size=12,
+                unique=True))
+def test_rings_are_linked_as_by_the_clockwise_rule_bit_for_bit(cells):
+    # unions of lattice squares: rings touching at corners (several starts at a point,
+    # where the clockwise rule decides) and plain vertices (one start, taken at once)
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy = np.concatenate([sq + c for c in cells])
+    starts = np.arange(0, 4 * len(cells) + 1, 4, dtype=np.int64)
+    outline, _ = kn.edge_cover(xy, starts, kn._bboxes(xy, starts), kn._frames(xy, starts),
+                               1e-12)
+    ok, got_xy, got_starts = kn.assemble_rings(outline, 4e-12)
+    assert ok
+    want_xy, want_starts = _former_assembly(outline, 4e-12)
+    np.testing.assert_array_equal(got_xy, want_xy)
+    np.testing.assert_array_equal(got_starts, want_starts)
+
+
+@st.composite
+def lattice_sums(draw):
+    """A few convex polygons on a small lattice (squares, triangles, hulls): shared
+    corners and edges, where the closed ones surround points on their boundaries."""
+    polys = []
+    for _ in range(draw(st.integers(1, 6))):
+        pts = draw(st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3)), min_size=3,
+                            max_size=6, unique=True))
+        hull = shapely.convex_hull(shapely.MultiPoint(pts))
+        if hull.geom_type == "Polygon":
+            polys.append(np.asarray(shapely.orient_polygons(hull).exterior.coords)[:-1])
+    if not polys:
+        polys.append(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]))
+    xy = np.concatenate(polys).astype(float)
+    starts = np.r_[0, np.cumsum([len(p) for p in polys])].astype(np.int64)
+    return xy, starts
+
+
+DIRECTIONS = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 2), (0, 0), (0.6, -0.8)]
+
+
+@examples(100)
+@given(lattice_sums(), st.integers(0, 2**32 - 1))
+def test_may_be_surrounded_is_false_only_where_not_surrounded(sums, seed):
+    # the pre-test of degenerate_contacts' short parts: at the sums' vertices, edge
+    # middles and lattice points (shared corners and edges, outline vertices), in
+    # every direction (along the edges too), never False where surrounded is True
+    xy, starts = sums
+    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
+    eps, ang = 1e-12, nfp_module.ANGLE_TOLERANCE
+    rng = np.random.default_rng(seed)
+    pts = np.vstack([xy, 0.5 * (xy + np.roll(xy, -1, axis=0)),
+                     rng.integers(0, 4, (8, 2)) + rng.choice([0.0, 0.5, 3e-13], (8, 2))])
+    rejected = 0
+    for px, py in pts:
+        around = kn.surrounded(px, py, starts, bb, fr, eps, ang)
+        for vx, vy in DIRECTIONS:
+            may = kn._may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang)
+            assert may or not around, (px, py, vx, vy)
+            rejected += not may
+    assert rejected > 0  # (outline vertices at least: the pre-test does reject)
+
+
+def test_may_be_surrounded_at_a_corner_of_four_squares_and_of_one():
+    sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    xy = np.concatenate([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
+    starts = np.arange(0, 17, 4, dtype=np.int64)
+    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
+    args = (starts, bb, fr, 1e-12, nfp_module.ANGLE_TOLERANCE)
+    for v in DIRECTIONS:  # the shared corner: every direction is entered
+        assert kn._may_be_surrounded(1.0, 1.0, *v, *args)
+    assert kn._may_be_surrounded(2.0, 1.0, -1.0, 0.0, *args)  # (surrounded says no)
+    assert not kn._may_be_surrounded(2.0, 1.0, 1.0, 0.0, *args)  # outline: out of it
+    assert not kn._may_be_surrounded(2.0, 2.0, 1.0, 1.0, *args)
+    assert not kn._may_be_surrounded(2.0, 2.0, 0.0, 0.0, *args)  # no direction: (1, 0)

@@ -440,7 +440,7 @@ def inner_fit_polygon(
         return [fits(p) for p in pts], [
             fits(0.5 * (s[:2] + s[2:])) and fits(s[:2]) and fits(s[2:]) for s in segs]
 
-    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: check)
+    fit_pts, slide_segs = _clean_degenerate(pts, segs, eps, lambda: _checked(check))
     parts = [free] if not free.is_empty else []
     parts += [shapely.Point(p) for p in fit_pts]
     parts += [shapely.LineString(s) for s in slide_segs]
@@ -682,52 +682,53 @@ def _drop_slivers(geom: Any, eps: float) -> Any:
 
 def _touching(
     a: Shape, b: Shape, a0: np.ndarray, eps: float
-) -> Callable[[np.ndarray, np.ndarray], Any]:
-    """The check of :func:`_clean_degenerate` for the no-fit polygon: A with its
-    reference at a candidate point (or at a slide's middle and both ends) touches B
-    without overlapping (the classifier, every candidate in one kernel call)."""
-    touching = _kernels().nfp.touching
+) -> Callable[[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray]]:
+    """The selection of :func:`_clean_degenerate` for the no-fit polygon: the candidates
+    where A with its reference there (at a slide's middle and both ends) touches B
+    without overlapping, verified by the classifier and selected in one kernel call."""
+    touching_contacts = _kernels().nfp.touching_contacts
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
     ax, ay = a0.tolist()
 
-    def check(pts: np.ndarray, segs: np.ndarray) -> Any:
-        return touching(np.ascontiguousarray(pts), segs, xa, sa, xb, sb, ax, ay, tol)
+    def select(pts: np.ndarray, segs: np.ndarray, near: float) -> Any:
+        return touching_contacts(np.ascontiguousarray(pts), segs, near, xa, sa, xb, sb, ax,
+                                 ay, tol)
 
-    return check
+    return select
+
+
+def _checked(
+    check: Callable[[np.ndarray, np.ndarray], tuple[Any, Any]]
+) -> Callable[[np.ndarray, np.ndarray, float], tuple[np.ndarray, np.ndarray]]:
+    """The selection of :func:`_clean_degenerate` from a predicate ``check(pts, segs)``:
+    whether each point (P, 2) and each slide (S, 4: its middle and both ends) verifies,
+    two bool sequences."""
+
+    def select(pts: np.ndarray, segs: np.ndarray, near: float) -> Any:
+        pts_ok, segs_ok = check(pts, segs)
+        return _kernels().nfp.select_contacts(
+            np.ascontiguousarray(pts), np.asarray(pts_ok, dtype=np.bool_), segs,
+            np.asarray(segs_ok, dtype=np.bool_), near)
+
+    return select
 
 
 def _clean_degenerate(
-    pts: np.ndarray, segs: np.ndarray, eps: float, make_check: Any
+    pts: np.ndarray, segs: np.ndarray, eps: float, make_select: Any
 ) -> tuple[np.ndarray, np.ndarray]:
     """The verified exact fits and slides among the candidates, duplicates merged.
 
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
     of sum edges, and the kernel has snapped them to those (within
-    ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_check()`` gives the
-    verifying predicate ``check(pts, segs)``: whether each point (P, 2) and each slide
-    (S, 4: its middle and both ends) verifies, two bool sequences, all in one call; fits
-    on a kept slide or near a kept fit are dropped.
+    ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_select()`` gives
+    ``select(pts, segs, near)``: the verified candidates with fits on a kept slide or
+    near a kept fit dropped (:func:`polycontact._kernels.nfp.select_contacts`, after
+    the no-fit polygon's check :func:`_touching` or any other, :func:`_checked`).
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
-    near = HOLE_WIDTH_FACTOR * eps
-    slides = _NO_SLIDES
-    checked, kept = make_check()(pts, segs)
-    kept = np.asarray(kept, dtype=bool)
-    if kept.any():
-        slides = segs[kept].reshape(-1, 2, 2)
-    fits: list[np.ndarray] = []
-    on_slide = (_kernels().nfp.distance_to_segments(pts, slides) <= near
-                if len(slides) and len(pts) else np.zeros(len(pts), dtype=bool))
-    for p, skip, ok_p in zip(pts, on_slide.tolist(), checked):
-        if skip or any(np.hypot(*(p - q)) <= near for q in fits):
-            continue
-        if ok_p:
-            fits.append(p)
-    if not fits:
-        return _NO_FITS, slides
-    out = np.array(fits)
-    return (out[np.lexsort((out[:, 1], out[:, 0]))] if len(out) > 1 else out), slides
+    fits, slides = make_select()(pts, segs, HOLE_WIDTH_FACTOR * eps)
+    return (fits if len(fits) else _NO_FITS), (slides if len(slides) else _NO_SLIDES)

@@ -52,7 +52,7 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
             w = sum_into(bxy, ps, pe, i0, rxy, rstarts[rj], rstarts[rj + 1], out, w)
             k += 1
             starts[k] = w
-    return out[:w].copy(), starts
+    return out[:w], starts
 
 
 @njit(cache=True, nogil=True)
@@ -225,8 +225,14 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
     (:func:`_frames`).
     """
     k = starts.shape[0] - 1
-    starts_a = np.empty(k)
-    lens = np.empty(k)
+    return _surrounded(px, py, starts, bb, fr, eps, ang_tol, np.empty((2, k)))
+
+
+@njit(cache=True, nogil=True)
+def _surrounded(px, py, starts, bb, fr, eps, ang_tol, arcs):
+    """:func:`surrounded` with a work array ``arcs`` (2, number of sums), for callers
+    asking about many points."""
+    k = starts.shape[0] - 1
     n = 0
     for p in range(k):
         if px < bb[p, 0] - eps or px > bb[p, 2] + eps or py < bb[p, 1] - eps or py > bb[p, 3] + eps:
@@ -235,23 +241,69 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
         if kind == 1:
             return True
         if kind == 2:
-            starts_a[n] = st
-            lens[n] = ln
+            # kept sorted by start (insertion: a few arcs; the order among equal starts
+            # does not change the sweep's answer)
+            i = n
+            while i > 0 and arcs[0, i - 1] > st:
+                arcs[0, i] = arcs[0, i - 1]
+                arcs[1, i] = arcs[1, i - 1]
+                i -= 1
+            arcs[0, i] = st
+            arcs[1, i] = ln
             n += 1
     if n == 0:
         return False
-    order = np.argsort(starts_a[:n])
-    first = starts_a[order[0]]
+    first = arcs[0, 0]
     reach = first
     for rep in range(2):
         for oi in range(n):
-            st = starts_a[order[oi]] + 2.0 * np.pi * rep
+            st = arcs[0, oi] + 2.0 * np.pi * rep
             if st > reach + ang_tol:
                 return False
-            reach = max(reach, st + lens[order[oi]])
+            reach = max(reach, st + arcs[1, oi])
             if reach >= first + 2.0 * np.pi - ang_tol:
                 return True
     return reach >= first + 2.0 * np.pi - ang_tol
+
+
+@njit(cache=True, nogil=True)
+def _may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang_tol):
+    """False only where :func:`surrounded` is False, at a fraction of its cost (no
+    angles): no sum near p (within its box, not outside it by more than eps) enters
+    direction v (any non-zero vector; (1, 0) when v is zero), within an angle well
+    above ``ang_tol``.
+
+    Why: surrounded(p) holds when some sum holds p inside by more than eps (it has no
+    edge within eps of p, and enters every direction), or when the arcs of entering
+    directions of the sums around p leave no gap wider than ``ang_tol``; then v is
+    within ``ang_tol`` of the arc of some sum s, the intersection of the half-turns
+    {d : cross(u, d) >= 0} of the edges u of s within eps of p, so cross(u, v) >=
+    -sin(ang_tol) for each of them (unit u and v) and s passes here, where the same
+    tests tell which sums are near and which edges within eps.
+    """
+    ln = np.hypot(vx, vy)
+    if ln > 0.0:
+        vx /= ln
+        vy /= ln
+    else:
+        vx = 1.0
+        vy = 0.0
+    # (the arcs' angles and these products are rounded: 1e-15 of a turn and a unit)
+    slack = 2.0 * ang_tol + 1e-15
+    for q in range(starts.shape[0] - 1):
+        if px < bb[q, 0] - eps or px > bb[q, 2] + eps or py < bb[q, 1] - eps or py > bb[q, 3] + eps:
+            continue
+        enters = True
+        for i in range(starts[q], starts[q + 1]):
+            if fr[i, 3] == 0.0:
+                continue
+            f = fr[i, 0] * py - fr[i, 1] * px - fr[i, 2]
+            if f < -eps or (f <= eps and fr[i, 0] * vy - fr[i, 1] * vx < -slack):
+                enters = False
+                break
+        if enters:
+            return True
+    return False
 
 
 #: Sums remembered per grid cell as containing the whole cell (tried first on an edge).
@@ -355,7 +407,7 @@ def edge_cover(xy, starts, bb, fr, eps):
                 loose[nl, 2] = ax + hi1[r] * dx
                 loose[nl, 3] = ay + hi1[r] * dy
                 nl += 1
-    return outline[:no].copy(), loose[:nl].copy()
+    return outline[:no], loose[:nl]
 
 
 @njit(cache=True, nogil=True)
@@ -374,6 +426,35 @@ def _grow(arr):
     out = np.empty((2 * arr.shape[0] + 4, arr.shape[1]))
     out[: arr.shape[0]] = arr
     return out
+
+
+@njit(cache=True, nogil=True)
+def _first_clockwise(seg, order, sx, lo, r, tol):
+    """Of the segments starting within ``tol`` of segment r's end (``order``, ``sx``:
+    the segments sorted by their start's x, from ``lo``), the one first clockwise from
+    the way back along r (see :func:`assemble_rings`)."""
+    n = seg.shape[0]
+    ex = seg[r, 2]
+    ey = seg[r, 3]
+    back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
+    best = -1
+    best_turn = np.inf
+    for oi in range(lo, n):
+        c = order[oi]
+        if sx[oi] > ex + tol:
+            break
+        if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
+            continue
+        ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
+        turn = back - ang  # clockwise angle from the way back
+        while turn <= 0.0:
+            turn += 2.0 * np.pi
+        while turn > 2.0 * np.pi:
+            turn -= 2.0 * np.pi
+        if turn < best_turn:
+            best_turn = turn
+            best = c
+    return best
 
 
 @njit(cache=True, nogil=True)
@@ -400,25 +481,20 @@ def assemble_rings(segs, tol):
     for r in range(n):
         ex = seg[r, 2]
         ey = seg[r, 3]
-        back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
         best = -1
-        best_turn = np.inf
         lo = np.searchsorted(sx, ex - tol)
+        # one start there (the common case): it, without comparing turns
+        starts_there = 0
         for oi in range(lo, n):
             c = order[oi]
             if sx[oi] > ex + tol:
                 break
             if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
                 continue
-            ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
-            turn = back - ang  # clockwise angle from the way back
-            while turn <= 0.0:
-                turn += 2.0 * np.pi
-            while turn > 2.0 * np.pi:
-                turn -= 2.0 * np.pi
-            if turn < best_turn:
-                best_turn = turn
-                best = c
+            starts_there += 1
+            best = c
+        if starts_there > 1:
+            best = _first_clockwise(seg, order, sx, lo, r, tol)
         if best < 0 or taken[best]:
             return False, np.empty((0, 2)), np.zeros(1, np.int64)
         taken[best] = True
@@ -505,14 +581,20 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
     """Exact-fit points and slide segments among the ``loose`` parts of :func:`edge_cover`.
 
     A loose part is an exact fit (when shorter than 8 eps) or a slide where the closed
-    sums cover every direction around it (``ang_tol``: angular gap taken as closed).
+    sums cover every direction around it (``ang_tol``: angular gap taken as closed);
+    around a short part, the direction to the right of it (away from its own sum) is
+    tried first (:func:`_may_be_surrounded`: most are vertices of the outline).
     A part is cut at the sums' vertices lying on it; a sub-part whose right side (the
     side away from its own sum) is in no sum is outline and skipped at once. Returns
     ``(points (P, 2), segments (S, 4))``, not deduplicated: the same exact fit is found
     on every edge through it, a slide on the edges of both sides.
     """
-    pts = []
-    slides = []
+    pts = np.empty((loose.shape[0], 2))
+    slides = np.empty((loose.shape[0], 4))
+    n_pts = 0
+    n_slides = 0
+    arcs = np.empty((2, starts.shape[0] - 1))
+    ts = np.empty(xy.shape[0] + 2)
     off = 64.0 * eps
     for r in range(loose.shape[0]):
         ax, ay, bx, by = loose[r, 0], loose[r, 1], loose[r, 2], loose[r, 3]
@@ -520,12 +602,18 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
         if ln <= 8.0 * eps:
             mx = 0.5 * (ax + bx)
             my = 0.5 * (ay + by)
-            if surrounded(mx, my, starts, bb, fr, eps, ang_tol):
-                pts.append((mx, my))
+            if _may_be_surrounded(mx, my, by - ay, ax - bx, starts, bb, fr, eps, ang_tol) and (
+                    _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs)):
+                pts[n_pts, 0] = mx
+                pts[n_pts, 1] = my
+                n_pts += 1
             continue
         ux = (bx - ax) / ln
         uy = (by - ay) / ln
-        ts = [0.0, ln]
+        # the cuts: both ends and the sums' vertices on the part, sorted (insertion)
+        ts[0] = 0.0
+        ts[1] = ln
+        nt = 2
         x0 = min(ax, bx) - eps
         x1 = max(ax, bx) + eps
         y0 = min(ay, by) - eps
@@ -541,34 +629,44 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
                 if abs(ux * dy - uy * dx) <= eps:
                     t = ux * dx + uy * dy
                     if 0.0 < t < ln:
-                        ts.append(t)
-        tarr = np.sort(np.array(ts))
+                        i = nt
+                        while i > 1 and ts[i - 1] > t:
+                            ts[i] = ts[i - 1]
+                            i -= 1
+                        ts[i] = t
+                        nt += 1
         open_at = -1.0
-        for q in range(tarr.shape[0] - 1):
-            t0 = tarr[q]
-            t1 = tarr[q + 1]
+        for q in range(nt - 1):
+            t0 = ts[q]
+            t1 = ts[q + 1]
             if t1 - t0 <= eps:
                 continue
             tm = 0.5 * (t0 + t1)
             mx = ax + tm * ux
             my = ay + tm * uy
-            inside = _in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr) and surrounded(
-                mx, my, starts, bb, fr, eps, ang_tol
+            inside = _in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr) and _surrounded(
+                mx, my, starts, bb, fr, eps, ang_tol, arcs
             )
             if inside and open_at < 0.0:
                 open_at = t0
             if not inside and open_at >= 0.0:
-                slides.append((ax + open_at * ux, ay + open_at * uy, ax + t0 * ux, ay + t0 * uy))
+                if n_slides == slides.shape[0]:
+                    slides = _grow(slides)
+                slides[n_slides, 0] = ax + open_at * ux
+                slides[n_slides, 1] = ay + open_at * uy
+                slides[n_slides, 2] = ax + t0 * ux
+                slides[n_slides, 3] = ay + t0 * uy
+                n_slides += 1
                 open_at = -1.0
         if open_at >= 0.0:
-            slides.append((ax + open_at * ux, ay + open_at * uy, bx, by))
-    p_out = np.empty((len(pts), 2))
-    for r in range(len(pts)):
-        p_out[r, 0], p_out[r, 1] = pts[r]
-    s_out = np.empty((len(slides), 4))
-    for r in range(len(slides)):
-        s_out[r, 0], s_out[r, 1], s_out[r, 2], s_out[r, 3] = slides[r]
-    return p_out, s_out
+            if n_slides == slides.shape[0]:
+                slides = _grow(slides)
+            slides[n_slides, 0] = ax + open_at * ux
+            slides[n_slides, 1] = ay + open_at * uy
+            slides[n_slides, 2] = bx
+            slides[n_slides, 3] = by
+            n_slides += 1
+    return pts[:n_pts], slides[:n_slides]
 
 
 @njit(cache=True, nogil=True)
@@ -609,10 +707,19 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
 
 
 @njit(cache=True, nogil=True)
+def _finite(xy):
+    """Whether every coordinate is finite (without the array of ``np.isfinite``)."""
+    for i in range(xy.shape[0]):
+        if not (np.isfinite(xy[i, 0]) and np.isfinite(xy[i, 1])):
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
 def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
     sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
-    if not np.isfinite(sums).all():
+    if not _finite(sums):
         # error code, not a crash: the caller refuses the input
         meta = np.array([1.0, -1.0, 0.0])
         return (sums, starts, sums[:0], np.zeros(1, np.int64), np.empty((0, 2)),
@@ -777,6 +884,70 @@ def touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol):
             and _touches_at(x0, y0, moved, xa, sa, xb, sb, a0x, a0y, tol)
             and _touches_at(x1, y1, moved, xa, sa, xb, sb, a0x, a0y, tol))
     return at_pts, at_segs
+
+
+@njit(cache=True, nogil=True)
+def select_contacts(pts, pts_ok, segs, segs_ok, near):
+    """The exact fits and slides kept among verified candidates, duplicates merged.
+
+    ``pts`` (P, 2) candidate exact fits and ``segs`` (S, 4) candidate slides, with
+    whether each verified (``pts_ok``, ``segs_ok``). The verified slides are kept; a
+    point is dropped when it lies within ``near`` of a kept slide or of a point kept
+    before it, else kept when verified. Returns ``(fits (F, 2), slides (K, 2, 2))``,
+    the fits sorted by x then y.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pts = np.array([[2.0, 0.0], [0.5, 0.0], [1.0, 3.0], [1.0, 3.0 + 1e-12]])
+    >>> segs = np.array([[0.0, 0.0, 1.0, 0.0]])
+    >>> fits, slides = select_contacts(pts, np.ones(4, np.bool_), segs,
+    ...                                np.ones(1, np.bool_), 1e-9)
+    >>> fits.tolist(), slides.shape
+    ([[1.0, 3.0], [2.0, 0.0]], (1, 2, 2))
+    """
+    ns = 0
+    slides = np.empty((segs.shape[0], 2, 2))
+    for k in range(segs.shape[0]):
+        if segs_ok[k]:
+            for e in range(2):
+                slides[ns, e, 0] = segs[k, 2 * e]
+                slides[ns, e, 1] = segs[k, 2 * e + 1]
+            ns += 1
+    slides = slides[:ns]
+    on_slide = distance_to_segments(pts, slides)
+    fits = np.empty((pts.shape[0], 2))
+    nf = 0
+    for k in range(pts.shape[0]):
+        if on_slide[k] <= near:
+            continue
+        px = pts[k, 0]
+        py = pts[k, 1]
+        dup = False
+        for f in range(nf):
+            if np.hypot(px - fits[f, 0], py - fits[f, 1]) <= near:
+                dup = True
+                break
+        if dup or not pts_ok[k]:
+            continue
+        # kept sorted by (x, y), stably (insertion: a few fits)
+        i = nf
+        while i > 0 and (fits[i - 1, 0] > px or (fits[i - 1, 0] == px and fits[i - 1, 1] > py)):
+            fits[i, 0] = fits[i - 1, 0]
+            fits[i, 1] = fits[i - 1, 1]
+            i -= 1
+        fits[i, 0] = px
+        fits[i, 1] = py
+        nf += 1
+    return fits[:nf], slides
+
+
+@njit(cache=True, nogil=True)
+def touching_contacts(points, segs, near, xa, sa, xb, sb, a0x, a0y, tol):
+    """:func:`select_contacts` of the candidates verified by :func:`touching` (A placed
+    there touches B without overlapping), in one call."""
+    pts_ok, segs_ok = touching(points, segs, xa, sa, xb, sb, a0x, a0y, tol)
+    return select_contacts(points, pts_ok, segs, segs_ok, near)
 
 
 @njit(cache=True, nogil=True)
