@@ -84,14 +84,22 @@ def test_warmup_command_reports_every_family(tmp_path):
     assert out.stdout.startswith("kernels ready in")
 
 
-def test_a_warmed_up_cache_is_warm_for_every_family(tmp_path):
+def test_a_family_warmed_up_alone_is_warm(tmp_path):
     # is_warm reads the cache index of the kernels each family lists: they must be the
-    # kernels the family's functions compile (an entry point renamed or no longer
-    # called leaves is_warm False forever: every start announced a compile)
+    # kernels the family's own functions compile (an entry point renamed or no longer
+    # called leaves is_warm False forever: every start announced a compile). Each family
+    # is warmed up alone, the last listed first, so that its check does not rest on
+    # what an earlier family compiled: "entrance block" named relate_state, which only
+    # classify's first call used to compile, and after classify stopped compiling it
+    # (it binds that kernel on the first pair too large for its scratch) neither family
+    # was ever warm.
     out = _run([sys.executable, "-c",
                 "from polycontact import compiling\n"
-                "compiling.warmup()\n"
-                "print([f for f in compiling.FAMILIES if not compiling.is_warm([f])])\n"],
+                "cold = []\n"
+                "for f in reversed(list(compiling.FAMILIES)):\n"
+                "    compiling.warmup([f])\n"
+                "    cold += [] if compiling.is_warm([f]) else [f]\n"
+                "print(cold)\n"],
                {"NUMBA_CACHE_DIR": str(tmp_path)})
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"

@@ -40,10 +40,12 @@ __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint
 
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
-    "classification": ("relation.relate_state", "relation.classify_raw"),
+    "classification": ("relation.relate_shapes_into", "relation.relate_state",
+                       "relation.classify_raw"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
-    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed"),
-    "entrance block": ("relation.relate_state",),
+    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "nfp.touching_contacts",
+                       "nfp.select_contacts"),
+    "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
 }
 
@@ -172,6 +174,10 @@ def _run(family: str) -> None:
             rs = classify(Shape(sq), Shape(sq + d))
             rs.distance, rs.features  # noqa: B018
         classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances  # noqa: B018
+        # more vertices than a thread's scratch holds: the state kernel on the arrays
+        t = np.linspace(0.0, 2.0 * np.pi, 300, endpoint=False)
+        disk = Shape(np.c_[np.cos(t), np.sin(t)])
+        classify(disk, disk.moved((0.5, 0.0)))
     elif family == "time of impact":
         from .impact import time_of_impact
         from .motion import Motion
@@ -185,7 +191,11 @@ def _run(family: str) -> None:
 
         ell = Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
         no_fit_polygon(ell, Shape(sq)).region  # noqa: B018
+        # a slot as wide as the square: a slide, whose candidates are verified apart
+        slot = Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)])
+        no_fit_polygon(Shape(sq), slot).region  # noqa: B018
         inner_fit_polygon(Shape(sq), Shape(sq * 4.0))
+        inner_fit_polygon(Shape(sq), Shape(sq))  # an exact fit
     elif family == "entrance block":
         from .entrance import entrance_block
 
