@@ -145,12 +145,15 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
 
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
     bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
-    ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap.
-    Returns ``(bound, bdx, bdy)`` when nothing nearer ends it, NaNs when the sums would
-    hold more than ``max_vertices`` vertices (none is built). The edges are clipped with
-    the grid of :func:`polycontact._kernels.nfp.sum_index` from ``grid_from`` sums on,
-    else by the scan alone (a 12-gon pair makes about 9 sums; the grid's set-up cost 83
-    of its 105 us).
+    ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap
+    (:func:`first_escape`, or :func:`box_escape`).
+    Returns ``(bound, bdx, bdy)`` when nothing nearer ends it (confirmed by the state
+    kernel; if rounding left it penetrating, the search is made again from the box's
+    escape), NaNs when the sums would hold more than ``max_vertices`` vertices (none
+    is built). The edges are clipped with the grid of
+    :func:`polycontact._kernels.nfp.sum_index` from ``grid_from`` sums on, else by the
+    scan alone (a 12-gon pair makes about 9 sums; the grid's set-up cost 83 of its 105
+    us).
 
     Cost: with P pairs of pieces whose sums' boxes meet the disk of radius ``bound`` and
     K edges of those sums nearer than the depth, O((p + q) log(p + q) + P + K log K)
@@ -158,38 +161,72 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     usually: the sum that covered the previous edge is tried first) and one state check,
     O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
     """
+    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
+                          max_vertices, grid_from)
+    if got[3] or np.isnan(got[0]) or _escapes(xa, sa, xb, sb, bdx, bdy, eps):
+        return got[0], got[1], got[2]
+    # (a normal's escape left touching within rounding, yet penetrating: the box's)
+    bound, bdx, bdy = box_escape(xa, xb)
+    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
+                          max_vertices, grid_from)
+    return got[0], got[1], got[2]
+
+
+@njit(cache=True, nogil=True)
+def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
+                    max_vertices, grid_from):
+    """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
+    when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
+    confirmed).
+
+    The origin's distance to the outline of a sum that holds it is a lower bound of the
+    depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
+    the search stops there: the depth is ``bound`` within ``eps``.
+    """
     best = bound
     pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound,
                           bstarts, rstarts, max_vertices)
     if pairs.shape[0] == 1 and pairs[0, 0] < 0:
-        return np.nan, np.nan, np.nan
+        return np.nan, np.nan, np.nan, False
     if pairs.shape[0] == 0:
-        return best, bdx, bdy
+        return best, bdx, bdy, False
     xy, starts = _pair_sums(bxy, bstarts, rxy, rstarts, pairs)
     k = starts.shape[0] - 1
     bb = _bboxes(xy, starts)
     fr = _frames(xy, starts)
     n_edges = xy.shape[0]
-    dist = np.empty(n_edges)
+    dist = np.empty(n_edges)  # squared distances of the edges from the origin
     owner = np.empty(n_edges, np.int64)
+    low = 0.0  # the lower bound
+    deepest = -1  # the sum that gives it (the first tried on an edge)
     for p in range(k):
         s = starts[p]
         e = starts[p + 1]
+        inner = np.inf
         for i in range(s, e):
             j = i + 1 if i + 1 < e else s
             owner[i] = p
             if fr[i, 3] == 0.0:
                 dist[i] = np.inf
             else:
-                dist[i] = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])[2]
-    by_dist = np.argsort(dist)
+                inner = min(inner, -fr[i, 2])  # the origin's distance inside edge i
+                fx, fy, _ = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])
+                dist[i] = fx * fx + fy * fy
+        if inner < np.inf and inner > low:
+            low = inner
+            deepest = p
+    if best - low <= eps:
+        return best, bdx, bdy, False
+    near = np.flatnonzero(dist < best * best)  # (only these are visited: sorted alone)
+    by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
     index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
-    hint = -1
-    for oi in range(n_edges):
+    hint = deepest
+    found = False
+    for oi in range(by_dist.shape[0]):
         i = by_dist[oi]
-        if dist[i] >= best:
+        if dist[i] >= best * best:
             break
         p = owner[i]
         s = starts[p]
@@ -227,8 +264,9 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
                     best = cd
                     bdx = cx
                     bdy = cy
+                    found = True
                     break
-    return best, bdx, bdy
+    return best, bdx, bdy, found
 
 
 def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
@@ -263,7 +301,7 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
 
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *box_escape(xa, xb), eps,
+    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
                             MAX_SUM_VERTICES)
     if np.isnan(got[0]):
         raise _too_large(len(xa), len(xb))
@@ -276,6 +314,80 @@ def _too_large(m: int, n: int) -> DepthTooLargeError:
         f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({m} and "
         f"{n} vertices) are too large and interlocked for this depth"
     )
+
+
+#: Up to this many vertices in both bodies, :func:`first_escape` tries the normals of
+#: every edge (O((m + n)^2)); above, only the box's axes.
+_FEW_NORMALS = 64
+
+
+@njit(cache=True, nogil=True)
+def _projected_escape(xa, xb, nx, ny, ox, oy):
+    """The shorter of the two translations of A along ±(nx, ny) (a unit vector) after
+    which the projections of A and B onto it no longer overlap: ``(length, dx, dy)``.
+    The projections are taken from the point (ox, oy) near the bodies, so that the
+    differences of nearby coordinates far from the origin lose no precision."""
+    amin = np.inf
+    amax = -np.inf
+    for k in range(xa.shape[0]):
+        d = nx * (xa[k, 0] - ox) + ny * (xa[k, 1] - oy)
+        amin = min(amin, d)
+        amax = max(amax, d)
+    bmin = np.inf
+    bmax = -np.inf
+    for k in range(xb.shape[0]):
+        d = nx * (xb[k, 0] - ox) + ny * (xb[k, 1] - oy)
+        bmin = min(bmin, d)
+        bmax = max(bmax, d)
+    if bmax - amin <= amax - bmin:
+        return bmax - amin, nx * (bmax - amin), ny * (bmax - amin)
+    return amax - bmin, -nx * (amax - bmin), -ny * (amax - bmin)
+
+
+@njit(cache=True, nogil=True)
+def first_escape(xa, xb):
+    """A short translation of A (vertices ``xa``) that ends its overlap with B
+    (vertices ``xb``): ``(length, dx, dy)``, the shortest of :func:`box_escape` and, for
+    bodies of at most :data:`_FEW_NORMALS` vertices in all, the translations along the
+    normal of each edge (consecutive vertices) of either body that separate their
+    projections on it (a separating axis: the shapes' projections touch at most).
+
+    Exact for two convex bodies; for concave ones, an upper bound of the depth that
+    limits which convex sums :func:`depth_from_pieces` builds (a median of 1.12 times
+    the depth on the benchmark's 12-gons, against 1.5 for the box). The normals'
+    escapes are touching up to the rounding of the projections: the caller confirms the
+    one it returns.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> tri = np.array([[0.5, 0.5], [2.0, 0.8], [0.8, 2.0]])
+    >>> [round(float(v), 6) for v in first_escape(tri, sq)]
+    [0.707107, 0.5, 0.5]
+    """
+    best, bdx, bdy = box_escape(xa, xb)
+    m = xa.shape[0]
+    n = xb.shape[0]
+    if m + n > _FEW_NORMALS:
+        return best, bdx, bdy
+    ox = xa[0, 0]
+    oy = xa[0, 1]
+    for i in range(m + n):
+        y = xa if i < m else xb
+        k = i if i < m else i - m
+        j = k + 1 if k + 1 < y.shape[0] else 0
+        ux = y[j, 0] - y[k, 0]
+        uy = y[j, 1] - y[k, 1]
+        ln = np.sqrt(ux * ux + uy * uy)
+        if not ln > 0.0:
+            continue
+        t, dx, dy = _projected_escape(xa, xb, uy / ln, -ux / ln, ox, oy)
+        if t < best:
+            best = t
+            bdx = dx
+            bdy = dy
+    return best, bdx, bdy
 
 
 @njit(cache=True, nogil=True)
@@ -443,7 +555,7 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
         yb = _oriented(yb, sb, fb[p])
         ra = rfirst[slot_a[k]]
         rb = bfirst[slot_b[k]]
-        bound, bdx, bdy = box_escape(ya, yb)
+        bound, bdx, bdy = first_escape(ya, yb)
         out[k, 0], out[k, 1], out[k, 2] = depth_from_pieces(
             ya, sa, yb, sb, bxy, bst[rb : rb + bcount[slot_b[k]] + 1], rxy,
             rst[ra : ra + rcount[slot_a[k]] + 1], bound, bdx, bdy, eps[k], max_vertices)
