@@ -361,10 +361,10 @@ def first_escape(xa, xb):
     Examples
     --------
     >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> tri = np.array([[0.5, 0.5], [2.0, 0.8], [0.8, 2.0]])
-    >>> [round(float(v), 6) for v in first_escape(tri, sq)]
-    [0.707107, 0.5, 0.5]
+    >>> diamond = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+    >>> sq = np.array([[0.3, 0.3], [0.5, 0.3], [0.5, 0.5], [0.3, 0.5]])
+    >>> [round(float(v), 6) for v in first_escape(sq, diamond)]  # the box's: 0.7
+    [0.282843, 0.2, 0.2]
     """
     best, bdx, bdy = box_escape(xa, xb)
     m = xa.shape[0]
