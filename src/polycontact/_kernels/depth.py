@@ -27,7 +27,7 @@ from ..errors import DepthTooLargeError
 from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
                   sum_into)
 from .decompose import ring_pieces
-from .relation import PENETRATING, _bbox, _state
+from .relation import PENETRATING, _bbox, _scratch_views, _state_in, scratch_floats
 from .relation_many import _body, _oriented
 
 
@@ -43,6 +43,19 @@ def _segment_foot(ax, ay, bx, by):
     px = ax + t * dx
     py = ay + t * dy
     return px, py, np.hypot(px, py)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _foot_sq(ax, ay, bx, by, ux, uy, c):
+    """Squared distance from the origin to segment ab, of unit direction (ux, uy) and
+    line offset c (:func:`polycontact._kernels.nfp._frames`: the origin lies at -c
+    from the line): no division."""
+    s = -(ax * ux + ay * uy)  # where the foot of the line falls, from a towards b
+    if s <= 0.0:
+        return ax * ax + ay * ay
+    if s >= (bx - ax) * ux + (by - ay) * uy:
+        return bx * bx + by * by
+    return c * c
 
 
 @njit(cache=True, nogil=True)
@@ -130,12 +143,16 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
 
 
 @njit(cache=True, nogil=True)
-def _escapes(xa, sa, xb, sb, dx, dy, eps):
-    """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict)."""
-    moved = xa.copy()
-    moved[:, 0] += dx
-    moved[:, 1] += dy
-    return _state(moved, sa, 1.0, xb, sb, 1.0, eps) != PENETRATING
+def _escapes(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
+    """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict);
+    ``moved`` (shaped like ``xa``) and ``scratch`` (``scratch_floats`` of both bodies'
+    vertices) are written, so that the checks of one pair allocate nothing."""
+    for i in range(xa.shape[0]):
+        moved[i, 0] = xa[i, 0] + dx
+        moved[i, 1] = xa[i, 1] + dy
+    box, ids, touch, rays, rord = _scratch_views(scratch, xa.shape[0] + xb.shape[0])
+    return _state_in(moved, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays,
+                     rord) != PENETRATING
 
 
 @njit(cache=True, nogil=True)
@@ -161,23 +178,25 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     usually: the sum that covered the previous edge is tried first) and one state check,
     O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
     """
+    moved = np.empty_like(xa)
+    scratch = np.empty(scratch_floats(xa.shape[0] + xb.shape[0]))
     got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from)
-    if got[3] or np.isnan(got[0]) or _escapes(xa, sa, xb, sb, bdx, bdy, eps):
+                          max_vertices, grid_from, moved, scratch)
+    if got[3] or np.isnan(got[0]) or _escapes(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return got[0], got[1], got[2]
     # (a normal's escape left touching within rounding, yet penetrating: the box's)
     bound, bdx, bdy = box_escape(xa, xb)
     got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from)
+                          max_vertices, grid_from, moved, scratch)
     return got[0], got[1], got[2]
 
 
 @njit(cache=True, nogil=True)
 def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                    max_vertices, grid_from):
+                    max_vertices, grid_from, moved, scratch):
     """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
     when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
-    confirmed).
+    confirmed); ``moved``, ``scratch``: see :func:`_escapes`.
 
     The origin's distance to the outline of a sum that holds it is a lower bound of the
     depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
@@ -210,8 +229,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
                 dist[i] = np.inf
             else:
                 inner = min(inner, -fr[i, 2])  # the origin's distance inside edge i
-                fx, fy, _ = _segment_foot(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1])
-                dist[i] = fx * fx + fy * fy
+                dist[i] = _foot_sq(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], fr[i, 0], fr[i, 1],
+                                   fr[i, 2])
         if inner < np.inf and inner > low:
             low = inner
             deepest = p
@@ -260,7 +279,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
             for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
                            (0.5 * (px0 + px1), 0.5 * (py0 + py1))):
                 cd = np.hypot(cx, cy)
-                if cd < best and _escapes(xa, sa, xb, sb, cx, cy, eps):
+                if cd < best and _escapes(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
                     best = cd
                     bdx = cx
                     bdy = cy
