@@ -7,12 +7,18 @@ depth is the distance from the origin to the complement of ``O``: to the outline
 union (the boundary of the entrance block, translated so A's reference is the origin),
 or to an exact fit or slide inside it (sum boundaries covered by no open sum).
 
-Only the part of the union inside the disk of radius ``bound`` (a known escape, e.g. out
-of B's bounding box) can hold the answer: only the pairs of pieces whose sum's box meets
-that disk's box are summed, and the sums' edges are visited in increasing distance from
-the origin, each clipped by the open sums (the one that covered the previous edge first)
-until the first uncovered part; the search stops when the next edge is farther than the
-best escape found. Uncovered parts are confirmed with the state kernel.
+Only the part of the union inside the disk of radius ``bound`` (a known escape: the
+shortest of the translations out of B's bounding box and, for small bodies, along the
+edge normals that separate the projections, :func:`first_escape`) can hold the answer:
+only the pairs of pieces whose sum's box meets that disk's box are summed. A sum that
+holds the origin at distance ``low`` from its outline proves the depth at least ``low``
+(the union holds the sum): when ``bound - low <= eps`` the bound is the depth within eps
+and the search stops there (two convex bodies, and about a fifth of the benchmark's
+concave 12-gon pairs). Else the sums' edges are visited in increasing distance from the
+origin, each clipped by the open sums (the one that covered the previous edge first,
+the deepest sum on the first edge) until the first uncovered part; the search stops
+when the next edge is farther than the best escape found. Uncovered parts, and the
+first escape when nothing nearer is found, are confirmed with the state kernel.
 
 Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
 body is decomposed once and each distinct pair computed once, in parallel.
@@ -293,10 +299,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
 
     Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). The first escape is out of B's bounding box
-    (:func:`box_escape`); then :func:`depth_from_pieces` looks for a nearer one on the
-    union of the convex sums of the pieces of B and −A (decomposed in O(n log n), cached
-    by coordinates).
+    the left of every edge). The first escape is :func:`first_escape`'s (out of B's
+    bounding box, or along an edge normal); then :func:`depth_from_pieces` looks for a
+    nearer one on the union of the convex sums of the pieces of B and −A (decomposed in
+    O(n log n), cached by coordinates).
 
     Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
     pieces whose sums reach the disk of the first escape and their K edges, plus the
