@@ -145,3 +145,25 @@ def test_depth_from_a_first_escape_that_does_not_escape_falls_back_to_the_box():
     assert got == pytest.approx((0.5, 0.0, -0.5) if got[2] else (0.5, -0.5, 0.0))
     assert pc.classify(sq + np.array(got[1:]), sq + [0.5, 0.25]).state is not \
         pc.State.PENETRATING
+
+
+_L = np.array([(0, 0), (4, 0), (4, 1), (1, 1), (1, 4), (0, 4)], float)
+
+
+def test_depth_at_the_foot_on_the_deepest_sum_and_past_it():
+    # A unit square on the L's arm: the sum of the arm's piece holds the origin 0.3 inside
+    # its top edge, and the foot there is covered by no other sum: the depth (the first
+    # escape is 1.5, out of the box). In the L's corner, that foot is inside the other
+    # arm's sum: the search goes on, to the corner (0.5, 0.5).
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    on_arm = sq + [2.5, 0.7]
+    assert kd.first_escape(on_arm, _L)[0] == pytest.approx(1.5)
+    rel = pc.classify(on_arm, _L)
+    assert -rel.distance == pytest.approx(0.3, abs=2 * rel.tolerance)
+    assert rel.escape == pytest.approx([0.0, 0.3], abs=2 * rel.tolerance)
+    in_corner = sq + [0.5, 0.5]
+    rel = pc.classify(in_corner, _L)
+    assert -rel.distance == pytest.approx(np.sqrt(0.5), abs=2 * rel.tolerance)
+    assert rel.escape == pytest.approx([0.5, 0.5], abs=2 * rel.tolerance)
+    batch = pc.classify_many([on_arm, in_corner], [_L, _L])
+    assert batch.distances == pytest.approx([-0.3, -np.sqrt(0.5)], abs=2 * batch.tolerances.max())
