@@ -38,7 +38,9 @@ def _clipper_depth(a: np.ndarray, b: np.ndarray) -> float:
     clip = pyclipper.Pyclipper()
     clip.AddPaths(pyclipper.MinkowskiSum((-ia).tolist(), ib.tolist(), True),
                   pyclipper.PT_SUBJECT, True)
+    # (the positions with A inside B, and with B inside A: the outlines do not meet there)
     clip.AddPath((ib - ia[0]).tolist(), pyclipper.PT_SUBJECT, True)
+    clip.AddPath((ib[0] - ia).tolist(), pyclipper.PT_SUBJECT, True)
     rings = clip.Execute(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
     lines = shapely.MultiLineString([np.vstack((r, r[:1])) / scale for r in map(np.asarray, rings)])
     return float(lines.distance(shapely.Point(0.0, 0.0)))
@@ -67,6 +69,27 @@ def test_depth_of_concave_pairs_equals_the_clipper_oracle(seed):
     assert -r.distance == pytest.approx(want, rel=1e-9, abs=1e-9)
     assert np.hypot(*r.escape) == pytest.approx(-r.distance)
     assert pc.classify(a + r.escape, b).state is not pc.State.PENETRATING
+
+
+def test_clipper_oracle_counts_the_positions_with_b_inside_a():
+    # The oracle's sums of the outlines miss the translations that put B wholly inside
+    # A; it took them for a hole of the region (a free position) at 0.475 from the
+    # origin, where A and B still overlap. The depth is 0.8626 (the library's answer).
+    a = np.array([[0.63835639, 0.28006268], [0.55726146, 0.42890238],
+                  [0.29801575, 0.79624266], [-0.25635551, 0.72516392],
+                  [-0.5575383, 0.44981339], [-0.90375334, 0.32056434],
+                  [-0.77081448, -0.37585173], [-0.53235807, -0.49195362],
+                  [-0.21756141, -0.69070291], [0.09461369, -0.89041219],
+                  [0.63101569, -0.59926642], [0.61637308, -0.18537699]])
+    b = np.array([[0.22361671, -0.22094979], [0.12993137, 0.11004753],
+                  [-0.30133329, 0.24132091], [-0.3897116, 0.46905561],
+                  [-0.88036593, 0.10363367], [-0.99770819, 0.03089465],
+                  [-0.92697594, -0.43431274], [-0.98858885, -0.72708059],
+                  [-0.61255538, -0.96763989], [-0.17159421, -1.02286143],
+                  [-0.04644098, -0.70121314], [0.18024037, -0.42384016]])
+    rel = pc.classify(a, b)
+    assert _clipper_depth(a, b) == pytest.approx(-rel.distance, rel=1e-9)
+    assert _clipper_depth(a, b) == pytest.approx(0.862605, abs=1e-6)  # (not 0.475)
 
 
 def test_defect7_depth_of_star_around_square_finishes_and_is_exact():
