@@ -380,24 +380,26 @@ def _too_large(m: int, n: int) -> DepthTooLargeError:
 _FEW_NORMALS = 64
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _projection(x, nx, ny, ox, oy):
+    """The range ``(min, max)`` of the points x projected onto (nx, ny) from (ox, oy)."""
+    lo = np.inf
+    hi = -np.inf
+    for k in range(x.shape[0]):
+        d = nx * (x[k, 0] - ox) + ny * (x[k, 1] - oy)
+        lo = min(lo, d)
+        hi = max(hi, d)
+    return lo, hi
+
+
 @njit(cache=True, nogil=True)
 def _projected_escape(xa, xb, nx, ny, ox, oy):
     """The shorter of the two translations of A along ±(nx, ny) (a unit vector) after
     which the projections of A and B onto it no longer overlap: ``(length, dx, dy)``.
     The projections are taken from the point (ox, oy) near the bodies, so that the
     differences of nearby coordinates far from the origin lose no precision."""
-    amin = np.inf
-    amax = -np.inf
-    for k in range(xa.shape[0]):
-        d = nx * (xa[k, 0] - ox) + ny * (xa[k, 1] - oy)
-        amin = min(amin, d)
-        amax = max(amax, d)
-    bmin = np.inf
-    bmax = -np.inf
-    for k in range(xb.shape[0]):
-        d = nx * (xb[k, 0] - ox) + ny * (xb[k, 1] - oy)
-        bmin = min(bmin, d)
-        bmax = max(bmax, d)
+    amin, amax = _projection(xa, nx, ny, ox, oy)
+    bmin, bmax = _projection(xb, nx, ny, ox, oy)
     if bmax - amin <= amax - bmin:
         return bmax - amin, nx * (bmax - amin), ny * (bmax - amin)
     return amax - bmin, -nx * (amax - bmin), -ny * (amax - bmin)
