@@ -428,23 +428,32 @@ def _grow(arr):
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _start_near(seg, order, sx, oi, ex, ey, tol):
+    """The first position from ``oi`` in ``order`` (the segments sorted by their
+    start's x, ``sx``) of a segment starting within ``tol`` of (ex, ey), or -1."""
+    while oi < order.shape[0] and sx[oi] <= ex + tol:
+        c = order[oi]
+        if abs(seg[c, 1] - ey) <= tol and np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) <= tol:
+            return oi
+        oi += 1
+    return -1
+
+
 @njit(cache=True, nogil=True)
 def _first_clockwise(seg, order, sx, lo, r, tol):
     """Of the segments starting within ``tol`` of segment r's end (``order``, ``sx``:
     the segments sorted by their start's x, from ``lo``), the one first clockwise from
     the way back along r (see :func:`assemble_rings`)."""
-    n = seg.shape[0]
     ex = seg[r, 2]
     ey = seg[r, 3]
     back = np.arctan2(seg[r, 1] - ey, seg[r, 0] - ex)
     best = -1
     best_turn = np.inf
-    for oi in range(lo, n):
+    oi = _start_near(seg, order, sx, lo, ex, ey, tol)
+    while oi >= 0:
         c = order[oi]
-        if sx[oi] > ex + tol:
-            break
-        if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
-            continue
+        oi = _start_near(seg, order, sx, oi + 1, ex, ey, tol)
         ang = np.arctan2(seg[c, 3] - seg[c, 1], seg[c, 2] - seg[c, 0])
         turn = back - ang  # clockwise angle from the way back
         while turn <= 0.0:
@@ -485,14 +494,11 @@ def assemble_rings(segs, tol):
         lo = np.searchsorted(sx, ex - tol)
         # one start there (the common case): it, without comparing turns
         starts_there = 0
-        for oi in range(lo, n):
-            c = order[oi]
-            if sx[oi] > ex + tol:
-                break
-            if abs(seg[c, 1] - ey) > tol or np.hypot(seg[c, 0] - ex, seg[c, 1] - ey) > tol:
-                continue
+        oi = _start_near(seg, order, sx, lo, ex, ey, tol)
+        while oi >= 0:
             starts_there += 1
-            best = c
+            best = order[oi]
+            oi = _start_near(seg, order, sx, oi + 1, ex, ey, tol)
         if starts_there > 1:
             best = _first_clockwise(seg, order, sx, lo, r, tol)
         if best < 0 or taken[best]:
