@@ -12,7 +12,8 @@ What is timed (medians of several repeats, peers measured in the same run):
   with their construction by ``shapely.polygons`` counted);
 - prebuilt :class:`polycontact.Shape` pairs against prebuilt Shapely polygons with
   ``shapely.relate`` (a simulation's loop), taking turns every 50 pairs, with the
-  target ratio;
+  target ratio, and under it the same call with a state kernel that does nothing (the
+  most any kernel could reach through this call);
 - signed distances of the 100 000 pairs (``classify_many(...).distances``) against the
   states alone (also with every pair made distinct: the pairs repeat 3000, and each
   distinct pair's depth is computed once), and for the separate pairs against
@@ -283,6 +284,35 @@ def prebuilt_rows(rng: np.random.Generator, repeats: int, rows) -> None:
                            50 if n < 1000 else 10)
         print(f"{n:>8} {spread(t['ours']):>24} {spread(t['relate']):>22}  "
               f"{ratio_text(chunks['relate'], chunks['ours'], target, quantiles=True)}")
+        t, chunks = call_floor(shapes, geoms, 2 * repeats + 1, 50 if n < 1000 else 10)
+        r = np.array(chunks["relate"]) / np.array(chunks["ours"])
+        print(f"{'':>8} {spread(t['ours']):>24} {spread(t['relate']):>22}   "
+              f"{np.median(r):.2f}x ({np.percentile(r, 10):.2f}-{np.percentile(r, 90):.2f})"
+              "  the call alone, its state kernel doing nothing: the ceiling of the ratio")
+
+
+def call_floor(shapes: list, geoms: list, repeats: int, chunk: int) -> tuple[dict, dict]:
+    """:func:`rounds` of classify on prebuilt Shapes with its state kernel swapped for
+    one that reads a number from each shape and returns, against shapely.relate: what
+    the call costs around the geometry (checks, unboxing, the Relation, caches emptied by
+    GEOS), so ``relate / this`` is the most any state kernel could reach in this call."""
+    from numba import njit
+
+    from polycontact import relation
+    from polycontact._dispatch import entry_point
+
+    @njit(nogil=True, _nrt=False)
+    def nothing(pa, pb, eps, scratch):  # (an answer that depends on both shapes)
+        return 1 if pa[1] < pb[3] else 0
+
+    real = relation._state_into
+    relation._state_into = entry_point(
+        nothing, (shapes[0][0]._kernel, shapes[0][1]._kernel, 1.0, np.empty(1)))
+    try:
+        return rounds({"ours": ours, "relate": shapely.relate},
+                      {"ours": shapes, "relate": geoms}, repeats, chunk)
+    finally:
+        relation._state_into = real
 
 
 def main() -> None:
