@@ -149,8 +149,8 @@ def _foot_sq(ax, ay, bx, by):
     den = dx * dx + dy * dy
     if s >= den:
         return bx * bx + by * by
-    c = ax * dy - ay * dx
-    return c * c / den
+    c = (ax * dy - ay * dx) / np.sqrt(den)  # (squared after the division: no overflow)
+    return c * c
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -184,6 +184,8 @@ def _splits(seg, n, s, tol, ts):
     dy = by - ay
     ln2 = dx * dx + dy * dy
     ln = np.sqrt(ln2)
+    if not ln > 0.0:
+        return -1
     x0 = min(ax, bx) - tol
     x1 = max(ax, bx) + tol
     y0 = min(ay, by) - tol
@@ -199,6 +201,8 @@ def _splits(seg, n, s, tol, ts):
         fx = ex - cx
         fy = ey - cy
         lf = _norm(fx, fy)
+        if not lf > 0.0:
+            return -1
         den = dx * fy - dy * fx
         t0, h0 = _project(cx, cy, ax, ay, dx, dy, ln2)
         t1, h1 = _project(ex, ey, ax, ay, dx, dy, ln2)
