@@ -14,12 +14,16 @@ property (two wedges that do not overlap are separated by a line along an edge o
 
 Along one such segment the verdict (overlap or not) can change only where another
 contact starts or ends: where another kept segment meets it. Each segment nearer than a
-known escape (``bound``) is split at every parameter where another one crosses it or
-comes within the tolerance (crossings, and the ends of the others projected onto it),
-and the verdict is constant on each open piece. A piece whose point nearest the origin
+known escape (``bound``) is split at every parameter where another one meets it, up to
+the tolerance (the crossing of their lines, when within the tolerance of both segments;
+for two nearly parallel ones that only end near each other, their ends projected), and
+the verdict is constant on each open piece. A piece whose point nearest the origin
 overlaps overlaps all along (the set of escapes is closed); the first piece point, in
 increasing distance, that the state kernel calls contact or separate is the depth. The
-segments' ends (vertex-vertex contacts) are tried as well.
+segments' ends need no test of their own: where the escapes near a vertex-vertex
+contact form a wedge, its sides run along kept segments from it, so the contact is the
+nearest point of a piece that starts there; a single escape, or a line of them, needs
+two contacts on opposite sides along parallel edges, whose segments run together (below).
 
 Where rounding could hide where two segments meet (two kept segments nearly parallel,
 within the tolerance of each other along more than the tolerance: slides, exact fits),
@@ -204,26 +208,19 @@ def _splits(seg, n, s, tol, ts):
         if not lf > 0.0:
             return -1
         den = dx * fy - dy * fx
-        t0, h0 = _project(cx, cy, ax, ay, dx, dy, ln2)
-        t1, h1 = _project(ex, ey, ax, ay, dx, dy, ln2)
         if abs(den) >= _SIN_PARALLEL * ln * lf:
             # crossing of the lines, if near both segments
             t = ((cx - ax) * fy - (cy - ay) * fx) / den
             u = ((cx - ax) * dy - (cy - ay) * dx) / den
             mt = 2.0 * tol * lf / abs(den)  # tol / (sine x length of s)
             mu = 2.0 * tol * ln / abs(den)
-            if -mu <= u <= 1.0 + mu and -mt <= t <= 1.0 + mt:
+            if -mu <= u <= 1.0 + mu and -mt <= t <= 1.0 + mt:  # (an end near s too)
                 ts[c] = t
-                c += 1
-            # the other's ends, where they come near s
-            if h0 <= tol:
-                ts[c] = t0
-                c += 1
-            if h1 <= tol:
-                ts[c] = t1
                 c += 1
             continue
         # nearly parallel: they meet (within tol) only if an end of one is near the other
+        t0, h0 = _project(cx, cy, ax, ay, dx, dy, ln2)
+        t1, h1 = _project(ex, ey, ax, ay, dx, dy, ln2)
         near = h0 <= tol or h1 <= tol
         if not near:
             for px, py in ((ax, ay), (bx, by)):
@@ -289,11 +286,11 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     seg = np.empty((2 * m * nb, 5))
     n = _add_segments(xb, sb, eb, xa, ea, nxa, 1.0, bound, eps, seg, 0)
     n = _add_segments(xa, sa, ea, xb, eb, nxb, -1.0, bound, eps, seg, n)
-    # test points: each piece's point nearest the origin, and the segments' ends
+    # test points: each piece's point nearest the origin
     cap = 8 * n + 8
     pts = np.empty((cap, 3))
     c = 0
-    ts = np.empty(3 * n + 2)
+    ts = np.empty(2 * n + 2)
     for s in range(n):
         k = _splits(seg, n, s, tol, ts)
         if k < 0:
@@ -311,23 +308,11 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
         ax, ay = seg[s, 0], seg[s, 1]
         dx = seg[s, 2] - ax
         dy = seg[s, 3] - ay
-        for q in range(k):
-            if q + 1 < k:
-                if ts[q + 1] <= ts[q]:
-                    continue
-                got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx,
-                            ay + ts[q + 1] * dy)
-            else:
-                got = (seg[s, 2], seg[s, 3], _norm(seg[s, 2], seg[s, 3]))
-            if q == 0:  # the segment's start, then the first piece's nearest point
-                if _norm(ax, ay) < bound:
-                    if c == cap:
-                        pts = _grown(pts)
-                        cap = pts.shape[0]
-                    pts[c, 0] = _norm(ax, ay)
-                    pts[c, 1] = ax
-                    pts[c, 2] = ay
-                    c += 1
+        for q in range(k - 1):
+            if ts[q + 1] <= ts[q]:
+                continue
+            got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx,
+                        ay + ts[q + 1] * dy)
             if got[2] < bound:
                 if c == cap:
                     pts = _grown(pts)
