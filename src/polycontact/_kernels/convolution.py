@@ -39,8 +39,8 @@ from numba import njit
 from .relation import PENETRATING, _scratch_views, _state_in, scratch_floats
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
-#: segments, O(K^2) tests among the K of them nearer than the first escape); above it
-#: the caller's search over convex sums.
+#: segments, O(K) tests to split each of the K near the origin); above it the caller's
+#: search over convex sums.
 FEW_VERTICES = 64
 
 #: Two kept segments closer than the tolerance whose directions make a sine below this
@@ -260,13 +260,14 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left of every
     edge, at most :data:`FEW_VERTICES` vertices in all); ``(bdx, bdy)``: a translation
     of A, of length ``bound``, that ends the overlap
-    (:func:`polycontact._kernels.depth.first_escape`). ``ok`` False (and NaNs) when
+    (:func:`polycontact._kernels.depth.box_escape`). ``ok`` False (and NaNs) when
     this kernel cannot decide exactly (nearly parallel segments that run together, the
     first escape not confirmed, bodies too large): the caller takes the search over
     convex sums.
 
-    Cost: O(m n) segments; with K of them nearer than ``bound``, O(K^2) to split them
-    and one state check, O((m + n) log(m + n)), per piece nearer than the depth.
+    Cost: O(m n) segments; with K of them nearer than ``bound``, O(K) to split each
+    one nearer than the depth, and one state check, O((m + n) log(m + n)), per piece
+    nearer than the depth.
 
     Examples
     --------
@@ -286,63 +287,95 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     seg = np.empty((2 * m * nb, 5))
     n = _add_segments(xb, sb, eb, xa, ea, nxa, 1.0, bound, eps, seg, 0)
     n = _add_segments(xa, sa, ea, xb, eb, nxb, -1.0, bound, eps, seg, n)
-    # test points: each piece's point nearest the origin
+    # Segments and pieces are taken in increasing distance (a linear scan each time:
+    # a few of each): a segment is split when it is the nearest thing left, each piece
+    # then waits for its turn, and the first piece point that escapes is the depth.
+    for s in range(n):
+        seg[s, 4] = np.sqrt(seg[s, 4])
+    todo = np.ones(n, np.bool_)
     cap = 8 * n + 8
-    pts = np.empty((cap, 3))
+    pts = np.empty((cap, 4))  # rows (distance, x, y, 1.0 once tried)
     c = 0
     ts = np.empty(2 * n + 2)
-    for s in range(n):
-        k = _splits(seg, n, s, tol, ts)
-        if k < 0:
-            return np.nan, np.nan, np.nan, False
-        ts[k] = 0.0
-        ts[k + 1] = 1.0
-        k += 2
-        for q in range(k):  # clamp to [0, 1] and sort (a few values)
-            v = min(1.0, max(0.0, ts[q]))
-            r = q
-            while r > 0 and ts[r - 1] > v:
-                ts[r] = ts[r - 1]
-                r -= 1
-            ts[r] = v
-        ax, ay = seg[s, 0], seg[s, 1]
-        dx = seg[s, 2] - ax
-        dy = seg[s, 3] - ay
-        for q in range(k - 1):
-            if ts[q + 1] <= ts[q]:
-                continue
-            got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx,
-                        ay + ts[q + 1] * dy)
-            if got[2] < bound:
-                if c == cap:
-                    pts = _grown(pts)
-                    cap = pts.shape[0]
-                pts[c, 0] = got[2]
-                pts[c, 1] = got[0]
-                pts[c, 2] = got[1]
-                c += 1
-    order = np.argsort(pts[:c, 0])
     moved = np.empty_like(xa)
     scratch = np.empty(scratch_floats(m + nb))
-    for o in range(c):
-        r = order[o]
-        # (an end shared by several segments is tried once: equal points sort together)
-        u = o - 1
-        while u >= 0 and pts[order[u], 0] == pts[r, 0]:
-            if pts[order[u], 1] == pts[r, 1] and pts[order[u], 2] == pts[r, 2]:
-                break
-            u -= 1
-        if u >= 0 and pts[order[u], 0] == pts[r, 0]:
+    while True:
+        s = -1
+        for q in range(n):
+            if todo[q] and (s < 0 or seg[q, 4] < seg[s, 4]):
+                s = q
+        r = -1
+        for q in range(c):
+            if pts[q, 3] == 0.0 and (r < 0 or pts[q, 0] < pts[r, 0]):
+                r = q
+        if s >= 0 and (r < 0 or seg[s, 4] <= pts[r, 0]):
+            todo[s] = False
+            k = _splits(seg, n, s, tol, ts)
+            if k < 0:
+                return np.nan, np.nan, np.nan, False
+            c = _pieces(seg, s, ts, k, bound, pts, c)
+            if c < 0:  # (more rows needed)
+                pts = _grown(pts)
+                c = _pieces(seg, s, ts, k, bound, pts, -c - 1)
             continue
-        if not _penetrates(xa, sa, xb, sb, pts[r, 1], pts[r, 2], eps, moved, scratch):
-            return pts[r, 0], pts[r, 1], pts[r, 2], True
+        if r < 0 or not pts[r, 0] < bound:
+            break
+        d, px, py = pts[r, 0], pts[r, 1], pts[r, 2]
+        pts[r, 3] = 1.0
+        if _tried(pts, c, r):
+            continue  # (an end shared by several pieces is tried once)
+        if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
+            return d, px, py, True
     if _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return np.nan, np.nan, np.nan, False
     return bound, bdx, bdy, True
 
 
 @njit(cache=True, nogil=True)
+def _tried(pts, c, r):
+    """Whether another row of ``pts`` holds the point of row r and was tried."""
+    for q in range(c):
+        if q != r and pts[q, 3] != 0.0 and pts[q, 1] == pts[r, 1] and pts[q, 2] == pts[r, 2]:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def _pieces(seg, s, ts, k, bound, pts, c):
+    """Append to ``pts`` (from row c) the point nearest the origin of each piece of
+    segment ``s`` between the ``k`` split parameters ``ts`` (and 0 and 1), when nearer
+    than ``bound``: the new row count, or ``-c - 1`` when ``pts`` is too small (nothing
+    written)."""
+    ts[k] = 0.0
+    ts[k + 1] = 1.0
+    k += 2
+    for q in range(k):  # clamp to [0, 1] and sort (a few values)
+        v = min(1.0, max(0.0, ts[q]))
+        r = q
+        while r > 0 and ts[r - 1] > v:
+            ts[r] = ts[r - 1]
+            r -= 1
+        ts[r] = v
+    if c + k > pts.shape[0]:
+        return -c - 1
+    ax, ay = seg[s, 0], seg[s, 1]
+    dx = seg[s, 2] - ax
+    dy = seg[s, 3] - ay
+    for q in range(k - 1):
+        if ts[q + 1] <= ts[q]:
+            continue
+        got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx, ay + ts[q + 1] * dy)
+        if got[2] < bound:
+            pts[c, 0] = got[2]
+            pts[c, 1] = got[0]
+            pts[c, 2] = got[1]
+            pts[c, 3] = 0.0
+            c += 1
+    return c
+
+
+@njit(cache=True, nogil=True)
 def _grown(pts):
-    out = np.empty((2 * pts.shape[0], 3))
+    out = np.empty((2 * pts.shape[0], pts.shape[1]))
     out[: pts.shape[0]] = pts
     return out

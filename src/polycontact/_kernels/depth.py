@@ -22,8 +22,15 @@ the deepest sum on the first edge) until the first uncovered part; the search st
 when the next edge is farther than the best escape found. Uncovered parts, and the
 first escape when nothing nearer is found, are confirmed with the state kernel.
 
+Small bodies (at most :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices
+in both) first take the vertex-edge contact segments of
+:mod:`polycontact._kernels.convolution`, with no convex pieces; this search is their
+fallback when that kernel cannot decide (segments that run together: slides, exact
+fits).
+
 Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
-body is decomposed once and each distinct pair computed once, in parallel.
+pair computed once, in parallel; for the pairs left to this search, each distinct body
+decomposed once.
 """
 
 from __future__ import annotations
@@ -321,7 +328,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
 
     Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). The first escape is :func:`first_escape`'s (out of B's
+    the left of every edge). Bodies of at most
+    :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices in all take
+    :func:`polycontact._kernels.convolution.contact_depth` (no decomposition), unless
+    it cannot decide. Otherwise the first escape is :func:`first_escape`'s (out of B's
     bounding box, or along an edge normal); then :func:`depth_from_pieces` looks for a
     nearer one on the union of the convex sums of the pieces of B and −A (decomposed in
     O(n log n), cached by coordinates).
@@ -346,14 +356,13 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """
     from ..nfp import _pieces_packed
 
-    bound, bdx, bdy = first_escape(xa, xb)
     if len(xa) + len(xb) <= FEW_VERTICES:
-        fast = contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps)
+        fast = contact_depth(xa, sa, xb, sb, *box_escape(xa, xb), eps)
         if fast[3]:
             return fast[0], fast[1], fast[2]
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, bound, bdx, bdy, eps,
+    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
                             MAX_SUM_VERTICES)
     if np.isnan(got[0]):
         raise _too_large(len(xa), len(xb))
@@ -619,8 +628,8 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
 @njit(cache=True, nogil=True, parallel=True)
 def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
     """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches by
-    :func:`polycontact._kernels.convolution.contact_depth` from :func:`first_escape`, in
-    parallel; a row of NaNs where that kernel does not decide (the caller takes
+    :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
+    segments are split lazily: a nearer start saves less than it costs), in parallel; a row of NaNs where that kernel does not decide (the caller takes
     :func:`depths_of_pairs`); ``eps`` per pair."""
     n = pairs.shape[0]
     out = np.full((n, 3), np.nan)
@@ -633,7 +642,7 @@ def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
         yb, sb = _body(xb, lsb, bsb, p)
         ya = _oriented(ya, sa, fa[p])
         yb = _oriented(yb, sb, fb[p])
-        bound, bdx, bdy = first_escape(ya, yb)
+        bound, bdx, bdy = box_escape(ya, yb)
         got = contact_depth(ya, sa, yb, sb, bound, bdx, bdy, eps[k])
         if got[3]:
             out[k, 0], out[k, 1], out[k, 2] = got[0], got[1], got[2]
@@ -687,8 +696,9 @@ def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarra
     :mod:`polycontact._kernels.relation_many`), in parallel: ``(P, 3)`` rows ``(depth,
     dx, dy)``, each equal to :func:`penetration` of the pair; ``eps`` per pair.
 
-    Each distinct body (bodies repeat in a batch) is decomposed once, in parallel, and
-    each distinct pair (the same two bodies and tolerance) computed once.
+    Each distinct pair (the same two bodies and tolerance) is computed once: by
+    :func:`contact_depths`, then the pairs it leaves by :func:`depths_of_pairs`, each
+    distinct body among those decomposed once, in parallel.
 
     Examples
     --------
