@@ -271,11 +271,16 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
 
     Examples
     --------
+    A triangle in the corner of an L: the shortest escape puts one of its vertices on
+    each arm's inner edge (two squares would be refused: their sides slide).
+
     >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> st = np.array([0, 4])
-    >>> [float(v) for v in contact_depth(sq, st, sq + 0.75, st, 1.0, 1.0, 0.0, 1e-12)]
-    [0.25, -0.25, 0.0, 1.0]
+    >>> ell = np.array([(0, 0), (4, 0), (4, 1), (1, 1), (1, 4), (0, 4)], float)
+    >>> tri = np.array([(1.2, 0.5), (1.7, 1.5), (0.7, 1.0)])
+    >>> got = contact_depth(tri, np.array([0, 3]), ell, np.array([0, 6]), 1.5, 0.0, -1.5,
+    ...                     1e-12)
+    >>> [round(float(v), 6) for v in got]
+    [0.583095, 0.3, 0.5, 1.0]
     """
     m = xa.shape[0]
     nb = xb.shape[0]
