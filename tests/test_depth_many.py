@@ -131,7 +131,9 @@ def test_distinct_bodies_tells_apart_bodies_of_equal_key():
 
 def test_batch_depth_beyond_its_memory_budget_is_refused(monkeypatch):
     monkeypatch.setattr(kd, "MAX_SUM_VERTICES", 3)
-    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    batch = pc.classify_many(np.stack([sq, sq]), np.stack([sq + 0.5, sq + 3.0]))
+    # (40-gons: two small bodies take the contact segments, which build no sums)
+    t = 2.0 * np.pi * np.arange(40) / 40
+    disk = np.column_stack((np.cos(t), np.sin(t)))
+    batch = pc.classify_many(np.stack([disk, disk]), np.stack([disk + 0.5, disk + 3.0]))
     with pytest.raises(kd.DepthTooLargeError, match="too large and interlocked"):
         batch.distances  # noqa: B018

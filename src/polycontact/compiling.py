@@ -41,7 +41,7 @@ __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
     "classification": ("relation.relate_shapes_into", "relation.relate_state",
-                       "relation.classify_raw"),
+                       "relation.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
     "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "nfp.touching_contacts",
                        "nfp.select_contacts"),
@@ -177,7 +177,9 @@ def _run(family: str) -> None:
         # more vertices than a thread's scratch holds: the state kernel on the arrays
         t = np.linspace(0.0, 2.0 * np.pi, 300, endpoint=False)
         disk = Shape(np.c_[np.cos(t), np.sin(t)])
-        classify(disk, disk.moved((0.5, 0.0)))
+        # (and the depth of bodies too large for the contact segments: the convex sums)
+        classify(disk, disk.moved((0.5, 0.0))).distance  # noqa: B018
+        classify_many([disk], [disk.moved((0.5, 0.0))]).distances  # noqa: B018
     elif family == "time of impact":
         from .impact import time_of_impact
         from .motion import Motion

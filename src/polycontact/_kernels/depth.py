@@ -22,8 +22,15 @@ the deepest sum on the first edge) until the first uncovered part; the search st
 when the next edge is farther than the best escape found. Uncovered parts, and the
 first escape when nothing nearer is found, are confirmed with the state kernel.
 
+Small bodies (at most :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices
+in both) first take the vertex-edge contact segments of
+:mod:`polycontact._kernels.convolution`, with no convex pieces; this search is their
+fallback when that kernel cannot decide (segments that run together: slides, exact
+fits).
+
 Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
-body is decomposed once and each distinct pair computed once, in parallel.
+pair computed once, in parallel; for the pairs left to this search, each distinct body
+decomposed once.
 """
 
 from __future__ import annotations
@@ -34,8 +41,9 @@ from numba import njit, prange
 from ..errors import DepthTooLargeError
 from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
                   sum_into)
+from .convolution import FEW_VERTICES, _penetrates, contact_depth
 from .decompose import ring_pieces
-from .relation import PENETRATING, _bbox, _scratch_views, _state_in, scratch_floats
+from .relation import _bbox, scratch_floats
 from .relation_many import _body, _oriented
 
 
@@ -151,19 +159,6 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
 
 
 @njit(cache=True, nogil=True)
-def _escapes(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
-    """Whether A moved by (dx, dy) no longer penetrates B (the classifier's verdict);
-    ``moved`` (shaped like ``xa``) and ``scratch`` (``scratch_floats`` of both bodies'
-    vertices) are written, so that the checks of one pair allocate nothing."""
-    for i in range(xa.shape[0]):
-        moved[i, 0] = xa[i, 0] + dx
-        moved[i, 1] = xa[i, 1] + dy
-    box, ids, touch, rays, rord = _scratch_views(scratch, xa.shape[0] + xb.shape[0])
-    return _state_in(moved, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays,
-                     rord) != PENETRATING
-
-
-@njit(cache=True, nogil=True)
 def _covered(px, py, starts, bb, fr, skip, eps):
     """Whether p lies inside a convex sum other than ``skip`` by more than eps (edge
     frames ``fr``, boxes ``bb``: :mod:`polycontact._kernels.nfp`)."""
@@ -208,7 +203,7 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     scratch = np.empty(scratch_floats(xa.shape[0] + xb.shape[0]))
     got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
                           max_vertices, grid_from, moved, scratch)
-    if got[3] or np.isnan(got[0]) or _escapes(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    if got[3] or np.isnan(got[0]) or not _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return got[0], got[1], got[2]
     # (a normal's escape left touching within rounding, yet penetrating: the box's)
     bound, bdx, bdy = box_escape(xa, xb)
@@ -222,7 +217,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
                     max_vertices, grid_from, moved, scratch):
     """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
     when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
-    confirmed); ``moved``, ``scratch``: see :func:`_escapes`.
+    confirmed); ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution._penetrates`.
 
     The origin's distance to the outline of a sum that holds it is a lower bound of the
     depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
@@ -274,7 +269,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
         fx = low * fr[side, 1]
         fy = -low * fr[side, 0]
         if (not _covered(fx, fy, starts, bb, fr, deepest, eps)
-                and _escapes(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
+                and not _penetrates(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
             return low, fx, fy, True
     near = np.flatnonzero(dist < best * best)  # (only these are visited: sorted alone)
     by_dist = near[np.argsort(dist[near])]
@@ -319,7 +314,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
             for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
                            (0.5 * (px0 + px1), 0.5 * (py0 + py1))):
                 cd = np.hypot(cx, cy)
-                if cd < best and _escapes(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
+                if cd < best and not _penetrates(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
                     best = cd
                     bdx = cx
                     bdy = cy
@@ -333,7 +328,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
 
     Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). The first escape is :func:`first_escape`'s (out of B's
+    the left of every edge). Bodies of at most
+    :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices in all take
+    :func:`polycontact._kernels.convolution.contact_depth` (no decomposition), unless
+    it cannot decide. Otherwise the first escape is :func:`first_escape`'s (out of B's
     bounding box, or along an edge normal); then :func:`depth_from_pieces` looks for a
     nearer one on the union of the convex sums of the pieces of B and −A (decomposed in
     O(n log n), cached by coordinates).
@@ -358,6 +356,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     """
     from ..nfp import _pieces_packed
 
+    if len(xa) + len(xb) <= FEW_VERTICES:
+        fast = contact_depth(xa, sa, xb, sb, *box_escape(xa, xb), eps)
+        if fast[3]:
+            return fast[0], fast[1], fast[2]
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
     got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
@@ -623,6 +625,30 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
     return out
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
+    """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches by
+    :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
+    segments are split lazily: a nearer start saves less than it costs), in parallel; a row of NaNs where that kernel does not decide (the caller takes
+    :func:`depths_of_pairs`); ``eps`` per pair."""
+    n = pairs.shape[0]
+    out = np.full((n, 3), np.nan)
+    for k in prange(n):
+        p = pairs[k]
+        if (lsa[bsa[p + 1] - 1] - lsa[bsa[p]] + lsb[bsb[p + 1] - 1] - lsb[bsb[p]]
+                > FEW_VERTICES):
+            continue
+        ya, sa = _body(xa, lsa, bsa, p)
+        yb, sb = _body(xb, lsb, bsb, p)
+        ya = _oriented(ya, sa, fa[p])
+        yb = _oriented(yb, sb, fb[p])
+        bound, bdx, bdy = box_escape(ya, yb)
+        got = contact_depth(ya, sa, yb, sb, bound, bdx, bdy, eps[k])
+        if got[3]:
+            out[k, 0], out[k, 1], out[k, 2] = got[0], got[1], got[2]
+    return out
+
+
 def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
                   ids: np.ndarray, negate: bool) -> tuple[np.ndarray, ...]:
     """:func:`pieces_of_bodies`, with the bodies it leaves decomposed by
@@ -650,6 +676,19 @@ def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
     return np.concatenate(more_xy), np.concatenate(more_st), first, count
 
 
+def _depths_by_pieces(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
+                      xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
+                      pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
+    """:func:`depths_of_pairs` of the pairs ``pairs``, each distinct body decomposed once
+    (NaN rows as there)."""
+    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
+    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
+    ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
+    rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
+    return depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, *ra,
+                           slot_b, *rb, MAX_SUM_VERTICES)
+
+
 def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
                  xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
                  pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
@@ -657,8 +696,9 @@ def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarra
     :mod:`polycontact._kernels.relation_many`), in parallel: ``(P, 3)`` rows ``(depth,
     dx, dy)``, each equal to :func:`penetration` of the pair; ``eps`` per pair.
 
-    Each distinct body (bodies repeat in a batch) is decomposed once, in parallel, and
-    each distinct pair (the same two bodies and tolerance) computed once.
+    Each distinct pair (the same two bodies and tolerance) is computed once: by
+    :func:`contact_depths`, then the pairs it leaves by :func:`depths_of_pairs`, each
+    distinct body among those decomposed once, in parallel.
 
     Examples
     --------
@@ -679,10 +719,11 @@ def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarra
     one = order[new]  # the first of each group of equal pairs
     group = np.empty(len(pairs), np.int64)
     group[order] = np.cumsum(new) - 1
-    ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
-    rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    out = depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one],
-                          slot_a[one], *ra, slot_b[one], *rb, MAX_SUM_VERTICES)
+    out = contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one])
+    rest = np.flatnonzero(np.isnan(out[:, 0]))  # (large bodies, or undecided)
+    if rest.size:
+        out[rest] = _depths_by_pieces(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one[rest]],
+                                      eps[one[rest]])
     bad = np.flatnonzero(np.isnan(out[:, 0]))
     if bad.size:
         p = pairs[one[bad[0]]]
