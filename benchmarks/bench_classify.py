@@ -242,7 +242,7 @@ def distance_rows(arr_a: np.ndarray, arr_b: np.ndarray, repeats: int) -> None:
     print(f"    distances / states (per run):        "
           f"{ratio_text(uni_dist, uni_states, 3.0, True)}")
     n_pen = int(np.sum(b_uni.states == 2))
-    print(f"    distances per penetrating pair (the depths, with their convex pieces, "
+    print(f"    distances per penetrating pair (wall time on all threads; the depths "
           f"dominate): {1e6 * statistics.median(uni_dist) / max(n_pen, 1):.1f} us")
     sep = batch.states == 0
     sep_a, sep_b = np.ascontiguousarray(arr_a[sep]), np.ascontiguousarray(arr_b[sep])
