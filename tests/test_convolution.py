@@ -14,21 +14,16 @@ from hypothesis import given
 from hypothesis import strategies as st
 from profiles import examples
 from test_depth import _clipper_depth, _convex_sum_depth
-from test_depth_fast import _pairs, _star, _transformed
+from test_depth_fast import _from_box, _pairs, _star, _transformed
 
 import polycontact as pc
 from polycontact._kernels import convolution as kc
 from polycontact._kernels import depth as kd
-from polycontact.nfp import _pieces_packed
 
 
 def _search(a: pc.Shape, b: pc.Shape, eps: float) -> tuple[float, float, float]:
-    """The search over the convex sums from the same first escape."""
-    (xa, sa), (xb, sb) = a.packed, b.packed
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    return kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *kd.first_escape(xa, xb),
-                                eps, kd.MAX_SUM_VERTICES)
+    """The search over the convex sums from the first escape."""
+    return _from_box(a, b, eps, kd.first_escape)
 
 
 def _contact(a: pc.Shape, b: pc.Shape, eps: float,

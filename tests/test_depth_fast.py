@@ -9,6 +9,9 @@ search started from the box's escape alone (the path before the shortcuts).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -43,12 +46,14 @@ def _hole(rng: np.random.Generator, centre) -> np.ndarray:
     return np.column_stack((centre[0] + r * np.cos(-t), centre[1] + r * np.sin(-t)))
 
 
-def _from_box(a: pc.Shape, b: pc.Shape, eps: float) -> tuple[float, float, float]:
-    """The depth searched from the box's escape only (the path before the shortcuts)."""
+def _from_box(a: pc.Shape, b: pc.Shape, eps: float,
+              escape: Callable[..., Any] = kd.box_escape) -> tuple[float, float, float]:
+    """The depth searched over the convex sums from the ``escape`` (by default the box's
+    escape only: the path before the shortcuts)."""
     (xa, sa), (xb, sb) = a.packed, b.packed
     bxy, bst = _pieces_packed(xb, sb)
     axy, ast = _pieces_packed(xa, sa)
-    return kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *kd.box_escape(xa, xb),
+    return kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *escape(xa, xb),
                                 eps, kd.MAX_SUM_VERTICES)
 
 

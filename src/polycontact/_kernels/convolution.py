@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import PENETRATING, _scratch_views, _state_in, scratch_floats
+from .relation import PENETRATING, _bbox, _scratch_views, _state_in, scratch_floats
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
 #: segments, O(K) tests to split each of the K near the origin); above it the caller's
@@ -101,15 +101,7 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
     """
     b2 = bound * bound
     # (the segments of vertex i lie in the box of v_i - (the other body's box))
-    ex0 = np.inf
-    ex1 = -np.inf
-    ey0 = np.inf
-    ey1 = -np.inf
-    for j in range(xe.shape[0]):
-        ex0 = min(ex0, xe[j, 0])
-        ex1 = max(ex1, xe[j, 0])
-        ey0 = min(ey0, xe[j, 1])
-        ey1 = max(ey1, xe[j, 1])
+    ex0, ex1, ey0, ey1 = _bbox(xe, xe.shape[0])
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
             gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])

@@ -41,24 +41,10 @@ from numba import njit, prange
 from ..errors import DepthTooLargeError
 from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
                   sum_into)
-from .convolution import FEW_VERTICES, _penetrates, contact_depth
+from .convolution import FEW_VERTICES, _foot, _penetrates, contact_depth
 from .decompose import ring_pieces
 from .relation import _bbox, scratch_floats
 from .relation_many import _body, _oriented
-
-
-@njit(cache=True, nogil=True)
-def _segment_foot(ax, ay, bx, by):
-    """Point of segment ab nearest to the origin, and its distance."""
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    t = 0.0
-    if den > 0.0:
-        t = min(1.0, max(0.0, -(ax * dx + ay * dy) / den))
-    px = ax + t * dx
-    py = ay + t * dy
-    return px, py, np.hypot(px, py)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -308,7 +294,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
             py0 = ay + lo * dy
             px1 = ax + hi * dx
             py1 = ay + hi * dy
-            fx, fy, fd = _segment_foot(px0, py0, px1, py1)
+            fx, fy, fd = _foot(px0, py0, px1, py1)
             if fd >= best:
                 continue
             for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
