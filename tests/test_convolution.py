@@ -138,3 +138,26 @@ def test_contact_depth_at_a_crossing_of_two_segments():
         assert got[0] == pytest.approx(np.hypot(0.3, 0.5))
         assert got[1:3] == pytest.approx((0.3, 0.5))
     assert -pc.classify(tri, ell).distance == pytest.approx(np.hypot(0.3, 0.5))
+
+
+@pytest.mark.parametrize("scale, offset", [(1.0, 0.0), (1e-9, 0.0), (1e9, 0.0), (1.0, 1e6)])
+def test_contact_depth_of_a_triangle_held_by_three_spikes(scale, offset):
+    # The hole's three inward corners (blunt spikes of B) touch the triangle's three
+    # vertices tip to tip: there A can go nowhere (a single escape, no parallel sides,
+    # every contact vertex-vertex, so every segment through it ends there). Moved off it
+    # by d, the depth is |d|, found at the ends of the segments.
+    ang = np.deg2rad([90, 150, 210, 270, 330, 30])
+    hole = np.column_stack((np.cos(ang), np.sin(ang))) * np.array([3.0, 1.0] * 3)[:, None]
+    tri = np.column_stack((np.cos(ang[[5, 1, 3]]), np.sin(ang[[5, 1, 3]])))
+    frame = np.array([(-5, -5), (5, -5), (5, 5), (-5, 5)], float)
+    rng = np.random.default_rng(3)
+    for _ in range(6):
+        d = rng.normal(size=2) * rng.choice([1e-3, 0.05])
+        a = pc.Shape((tri + d) * scale + offset)
+        b = pc.Shape(frame * scale + offset, [hole[::-1] * scale + offset])
+        rel = pc.classify(a, b)
+        assert rel.state is pc.State.PENETRATING
+        got = _contact(a, b, rel.tolerance, kd.box_escape(*(a.packed[0], b.packed[0])))
+        assert got[3]
+        assert got[0] == pytest.approx(np.hypot(*d) * scale, abs=2 * rel.tolerance)
+        assert -rel.distance == got[0]

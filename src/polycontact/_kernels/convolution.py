@@ -22,8 +22,11 @@ overlaps overlaps all along (the set of escapes is closed); the first piece poin
 increasing distance, that the state kernel calls contact or separate is the depth. The
 segments' ends need no test of their own: where the escapes near a vertex-vertex
 contact form a wedge, its sides run along kept segments from it, so the contact is the
-nearest point of a piece that starts there; a single escape, or a line of them, needs
-two contacts on opposite sides along parallel edges, whose segments run together (below).
+nearest point of a piece that starts there; where it is a single escape (a triangle
+held by three spikes, tip to tip) the overlapping directions are the union of one
+convex cone per contact, bounded by kept segments, and these cones cover every
+direction only if their sides do not all lie in one open half-plane, so one side leaves
+the contact away from the origin and the contact is its piece's nearest point.
 
 Where rounding could hide where two segments meet (two kept segments nearly parallel,
 within the tolerance of each other along more than the tolerance: slides, exact fits),
