@@ -39,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import PENETRATING, _bbox, _scratch_views, _state_in, scratch_floats
+from .relation import PENETRATING, _bbox, _norm, _scratch_views, _state_in, scratch_floats
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
 #: segments, O(K) tests to split each of the K near the origin); above it the caller's
@@ -54,13 +54,6 @@ _SIN_PARALLEL = 1.0 / 64.0
 #: Generous slack (a sine) in the kept-segment test: a near-tie is kept (a segment
 #: kept in excess only costs time).
 _SIN_SLACK = 1e-6
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _norm(x, y):
-    """Length of (x, y) (no overflow within the coordinate limits: squares of up to
-    2e100)."""
-    return np.sqrt(x * x + y * y)
 
 
 @njit(cache=True, nogil=True, inline="always")
