@@ -11,7 +11,8 @@ What is timed (medians of several repeats, peers measured in the same run):
   ``shapely.relate`` / ``shapely.intersects`` vectorised on prebuilt polygon arrays (and
   with their construction by ``shapely.polygons`` counted);
 - prebuilt :class:`polycontact.Shape` pairs against prebuilt Shapely polygons with
-  ``shapely.relate`` (a simulation's loop), taking turns every 50 pairs, with the
+  ``shapely.relate`` (a simulation's loop), each called directly (no wrapper function on
+  either side: each returns its result object), taking turns every 50 pairs, with the
   target ratio, and under it the same call with a state kernel that does nothing (the
   most any kernel could reach through this call);
 - signed distances of the 100 000 pairs (``classify_many(...).distances``) against the
@@ -279,7 +280,7 @@ def prebuilt_rows(rng: np.random.Generator, repeats: int, rows) -> None:
         pairs = make_pairs(rng, n, 600 if n < 1000 else 100)
         shapes = [(pc.Shape(a), pc.Shape(b)) for a, b in pairs]
         geoms = [(shapely.Polygon(a), shapely.Polygon(b)) for a, b in pairs]
-        t, chunks = rounds({"ours": ours, "relate": shapely.relate},
+        t, chunks = rounds({"ours": pc.classify, "relate": shapely.relate},
                            {"ours": shapes, "relate": geoms}, 2 * repeats + 1,
                            50 if n < 1000 else 10)
         print(f"{n:>8} {spread(t['ours']):>24} {spread(t['relate']):>22}  "
@@ -309,7 +310,7 @@ def call_floor(shapes: list, geoms: list, repeats: int, chunk: int) -> tuple[dic
     relation._state_into = entry_point(
         nothing, (shapes[0][0]._kernel, shapes[0][1]._kernel, 1.0, np.empty(1)))
     try:
-        return rounds({"ours": ours, "relate": shapely.relate},
+        return rounds({"ours": pc.classify, "relate": shapely.relate},
                       {"ours": shapes, "relate": geoms}, repeats, chunk)
     finally:
         relation._state_into = real
