@@ -138,7 +138,7 @@ def test_early_exit_never_fires_for_a_body_in_a_hole():
 
 
 @examples(100)
-@given(pairs(holes=None))
+@given(pairs(holes=None, n_max=40))
 def test_state_with_passed_scratch_is_the_allocating_state(pair):
     """relate_shapes_into (the shapes' kernel packs and the scratch passed in, no
     allocation) gives relate_state's answer; a buffer too small for a pair that needs
