@@ -303,12 +303,12 @@ def call_floor(shapes: list, geoms: list, repeats: int, chunk: int) -> tuple[dic
     from polycontact._dispatch import entry_point
 
     @njit(nogil=True, _nrt=False)
-    def nothing(pa, pb, eps, scratch):  # (an answer that depends on both shapes)
+    def nothing(pa, pb, eps):  # (an answer that depends on both shapes)
         return 1 if pa[1] < pb[3] else 0
 
     real = relation._state_into
     relation._state_into = entry_point(
-        nothing, (shapes[0][0]._kernel, shapes[0][1]._kernel, 1.0, np.empty(1)))
+        nothing, (shapes[0][0]._kernel, shapes[0][1]._kernel, 1.0))
     try:
         return rounds({"ours": pc.classify, "relate": shapely.relate},
                       {"ours": shapes, "relate": geoms}, repeats, chunk)

@@ -6,7 +6,7 @@ full test must say separate for the same pair and tolerance. The pairs are place
 the line of their bounding boxes' centres (the line ``_apart`` projects on) at a gap of
 about eps, just above it and just below it, at scales 1e-9..1e9 and offsets up to 1e9,
 so both the early exit and the fall-through are taken. Also: the state kernel with its
-scratch passed in (``relate_shapes_into``, what ``classify`` calls on Shapes).
+scratch on its stack (``relate_shapes_into``, what ``classify`` calls on Shapes).
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from hypothesis import event, given
 from hypothesis import strategies as st
 from profiles import examples
 
+import polycontact as pc
 from polycontact import Shape
 from polycontact._kernels import relation as kr
 from polycontact.tolerances import default_tolerance
@@ -139,19 +140,29 @@ def test_early_exit_never_fires_for_a_body_in_a_hole():
 
 @examples(100)
 @given(pairs(holes=None, n_max=40))
-def test_state_with_passed_scratch_is_the_allocating_state(pair):
-    """relate_shapes_into (the shapes' kernel packs and the scratch passed in, no
-    allocation) gives relate_state's answer; a buffer too small for a pair that needs
-    it gives -1, never a wrong state."""
+def test_state_with_stack_scratch_is_the_allocating_state(pair):
+    """relate_shapes_into (the shapes' kernel packs, its scratch on the stack, no
+    allocation) gives relate_state's answer, also when called again (the stack holds
+    the last call's values)."""
     a, b, _ = pair
     eps = default_tolerance(a.packed[0], b.packed[0])
     want = kr.relate_state(*a.packed, *b.packed, eps)
-    size = a.n_vertices + b.n_vertices
-    buf = np.full(kr.scratch_floats(size) + 3, np.nan)
-    assert kr.relate_shapes_into(a._kernel, b._kernel, eps, buf) == want
-    assert kr.relate_shapes_into(a._kernel, b._kernel, eps, buf) == want  # reused
-    small = kr.relate_shapes_into(a._kernel, b._kernel, eps, buf[: kr.scratch_floats(size) - 1])
-    assert small in (-1, want) and (small == -1 or want == kr.SEPARATE)
+    assert kr.relate_shapes_into(a._kernel, b._kernel, eps) == want
+    assert kr.relate_shapes_into(a._kernel, b._kernel, eps) == want  # reused
+
+
+def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
+    """A pair of more than STACK_VERTICES vertices gets -1 (classify then calls
+    relate_state), never a state computed in a scratch too small; pairs whose boxes are
+    apart need no scratch and are separate at once."""
+    t = np.linspace(0.0, 2.0 * np.pi, kr.STACK_VERTICES // 2 + 1, endpoint=False)
+    big = Shape(np.c_[np.cos(t), np.sin(t)])
+    assert kr.relate_shapes_into(big._kernel, big._kernel, 1e-12) == -1
+    assert kr.relate_shapes_into(big._kernel, big.moved((3, 0))._kernel, 1e-12) == kr.SEPARATE
+    fits = Shape(np.c_[np.cos(t[:-1]), np.sin(t[:-1])])
+    assert fits.n_vertices * 2 == kr.STACK_VERTICES
+    assert kr.relate_shapes_into(fits._kernel, fits._kernel, 1e-12) == kr.PENETRATING
+    assert pc.classify(big, big).state is pc.State.PENETRATING
 
 
 @examples(50)

@@ -29,7 +29,7 @@ from polycontact._kernels import relation as kr
 a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 b = a.moved((1.0, 0.5))
 # the scratch-passing kernel first: its helpers are compiled from it
-print(kr.relate_shapes_into(a._kernel, b._kernel, 1e-12, np.empty(kr.scratch_floats(8))))
+print(kr.relate_shapes_into(a._kernel, b._kernel, 1e-12))
 views = kr._scratch(8)
 print([v.base.refcount for v in views])  # one reference per view
 got = [kr.relate_state(*a.packed, *a.moved(d).packed, 1e-12)

@@ -355,17 +355,18 @@ def test_batch_gaps_of_separate_pairs_with_holes_and_long_rings():
 
 
 def test_prebuilt_shapes_in_threads_and_above_the_scratch():
-    # classify on Shapes uses one scratch buffer per thread (the kernel runs without the
-    # GIL): threads classifying at once get the answers of one thread; pairs with more
-    # vertices than the buffer holds take the allocating kernel, with the same answer
+    # classify on Shapes keeps its scratch on the kernel's stack (the kernel runs without
+    # the GIL): threads classifying at once get the answers of one thread; pairs with
+    # more vertices than the stack scratch holds take the allocating kernel, with the
+    # same answer
     from concurrent.futures import ThreadPoolExecutor
 
-    from polycontact import relation as rel
+    from polycontact._kernels import relation as kr
 
     t = np.linspace(0.0, 2.0 * np.pi, 300, endpoint=False)
     ring = np.c_[np.cos(t), np.sin(t)] * (1.0 + 0.2 * np.sin(7 * t))[:, None]
     big = Shape(ring)
-    assert 2 * big.n_vertices > rel._SCRATCH_VERTICES
+    assert 2 * big.n_vertices > kr.STACK_VERTICES
     shapes = [Shape(ring[::20] + [0.5 * k, 0.0]) for k in range(8)] + [big, big.moved((1.9, 0))]
     jobs = [(a, b) for a in shapes for b in shapes]
     want = [classify(a.packed[0], b.packed[0]).state for a, b in jobs]

@@ -174,7 +174,7 @@ def _run(family: str) -> None:
             rs = classify(Shape(sq), Shape(sq + d))
             rs.distance, rs.features  # noqa: B018
         classify_many(np.stack([sq, sq]), np.stack([sq + 2.0, sq + 0.5])).distances  # noqa: B018
-        # more vertices than a thread's scratch holds: the state kernel on the arrays
+        # more vertices than the state kernel's stack scratch holds: the kernel on the arrays
         t = np.linspace(0.0, 2.0 * np.pi, 300, endpoint=False)
         disk = Shape(np.c_[np.cos(t), np.sin(t)])
         # (and the depth of bodies too large for the contact segments: the convex sums)

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import enum
 import os
-import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -388,7 +387,7 @@ _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 _new = object.__new__
 
 
-def _bind_state_into(pa: np.ndarray, pb: np.ndarray, eps: float, scratch: np.ndarray) -> int:
+def _bind_state_into(pa: np.ndarray, pb: np.ndarray, eps: float) -> int:
     """The first call of :func:`classify` on two Shapes: binds ``relate_shapes_into``'s
     entry point (see polycontact._dispatch) to ``_state_into``, then classifies.
 
@@ -396,8 +395,8 @@ def _bind_state_into(pa: np.ndarray, pb: np.ndarray, eps: float, scratch: np.nda
     binding at once bind the same entry point).
     """
     global _state_into
-    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, 1.0, np.empty(0)))
-    return int(_state_into(pa, pb, eps, scratch))
+    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, 1.0))
+    return int(_state_into(pa, pb, eps))
 
 
 def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
@@ -409,24 +408,11 @@ def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndar
 
 
 #: The state kernels for two Shapes: ``relate_shapes_into`` on the shapes' kernel packs,
-#: and ``relate_state`` on their arrays for pairs with more vertices than the thread's
-#: scratch holds; each bound on its first call.
-_state_into: Callable[[np.ndarray, np.ndarray, float, np.ndarray], int] = _bind_state_into
+#: and ``relate_state`` on their arrays for pairs with more vertices than the former's
+#: scratch on the stack holds; each bound on its first call.
+_state_into: Callable[[np.ndarray, np.ndarray, float], int] = _bind_state_into
 _state_full: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], int] = (
     _bind_state_full)
-
-#: Vertices (both bodies together) that each thread's scratch buffer for :func:`classify`
-#: holds (~90 kB); larger pairs allocate their own, which costs little beside their test.
-_SCRATCH_VERTICES = 512
-_LOCAL = threading.local()
-
-
-def _thread_scratch() -> np.ndarray:
-    """This thread's scratch buffer for the state kernel, made on its first use."""
-    buf: np.ndarray = np.empty(_kr().scratch_floats(_SCRATCH_VERTICES))
-    _LOCAL.scratch = buf
-    return buf
-
 
 def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
@@ -470,17 +456,13 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
         # cached on each shape, the state kernel is called without the dispatcher's type
         # resolution (the shapes' read-only arrays have fixed types: see
         # polycontact._dispatch) with one array per shape (its kernel pack, which holds
-        # its bounding box too) and this thread's scratch (nothing allocated).
+        # its bounding box too); its scratch is on its stack (nothing allocated).
         if tolerance is None:
             eps = a._tolerance if a._tolerance > b._tolerance else b._tolerance
         else:
             eps = _check_tolerance(tolerance)
-        try:
-            buf = _LOCAL.scratch
-        except AttributeError:
-            buf = _thread_scratch()
-        code = _state_into(a._kernel, b._kernel, eps, buf)
-        if code < 0:  # more vertices than the buffer holds
+        code = _state_into(a._kernel, b._kernel, eps)
+        if code < 0:  # more vertices than the stack scratch holds
             code = _state_full(a._xy, a._starts, b._xy, b._starts, eps)
         obj = _new(Relation)
         d = obj.__dict__

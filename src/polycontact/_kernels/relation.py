@@ -24,6 +24,7 @@ from numba import njit
 
 from .tolerance import box_extent_magnitude, tolerance_for
 from .validate import _orient, _point_segment_distance, closest_on_segment, segment_meet
+from .views import stack_floats, vector, view
 
 SEPARATE = 0
 CONTACT = 1
@@ -436,13 +437,12 @@ def _scratch_views(buf, size):
     ``scratch_floats(size)`` floats): edge boxes (r, 4), edge ids (r, 4) int64, touch
     flags, rays (2 r, 6), ray order (2 r) int64, with r = size + 1."""
     r = size + 1
-    ints = buf[16 * r : 22 * r].view(np.int64)
     return (
-        buf[: 4 * r].reshape(r, 4),
-        ints[: 4 * r].reshape(r, 4),
-        buf[22 * r : scratch_floats(size)].view(np.bool_),
-        buf[4 * r : 16 * r].reshape(2 * r, 6),
-        ints[4 * r :],
+        view(buf, 0, r, 4, np.float64),
+        view(buf, 16 * r, r, 4, np.int64),
+        vector(buf, 22 * r, 8 * (scratch_floats(size) - 22 * r), np.bool_),
+        view(buf, 4 * r, 2 * r, 6, np.float64),
+        vector(buf, 20 * r, 2 * r, np.int64),
     )
 
 
@@ -652,26 +652,32 @@ def _unpack(pack):
     """``(xy, starts, box)`` of a shape's kernel pack (views: nothing is allocated), the
     box as ``(xmin, xmax, ymin, ymax)``."""
     nl = int(pack[0])
-    starts = pack[PACK_HEAD : PACK_HEAD + nl + 1].view(np.int64)
+    starts = vector(pack, PACK_HEAD, nl + 1, np.int64)
     n = starts[nl]
-    head = PACK_HEAD + nl + 1
-    xy = pack[head : head + 2 * n].reshape(n, 2)
+    xy = view(pack, PACK_HEAD + nl + 1, n, 2, np.float64)
     return xy, starts, (pack[1], pack[3], pack[2], pack[4])
+
+
+#: Vertices (both bodies together) of the pairs :func:`relate_shapes_into` classifies with
+#: its scratch on the stack (45 kB); larger pairs take :func:`relate_state`, whose
+#: allocation costs little beside their test.
+STACK_VERTICES = 256
+_STACK_FLOATS = 22 * (STACK_VERTICES + 1) + (STACK_VERTICES + 8) // 8  # scratch_floats
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
 # arrays it is called with and passes on cost ~0.1 us per call, as much as the test of a
-# small separate pair. Nothing in it may allocate: the scratch is passed in. It takes one
-# array per shape (each array a call unboxes costs 35-120 ns, more when other code has
-# evicted the caches) and reads the bounding boxes cached in them.
+# small separate pair. Nothing in it allocates: the scratch is on its stack (a buffer
+# passed in cost a thread-local look-up and one more array to unbox per call, about
+# 0.05 us). It takes one array per shape (each array a call unboxes costs 35-120 ns, more
+# when other code has evicted the caches) and reads the bounding boxes cached in them.
 @njit(cache=True, nogil=True, _nrt=False)
-def relate_shapes_into(pa, pb, eps, scratch):
+def relate_shapes_into(pa, pb, eps):
     """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),
-    with its scratch passed in, allocating nothing.
+    allocating nothing (its scratch is on the stack).
 
-    ``scratch`` is a float64 buffer of at least :func:`scratch_floats` (vertices of
-    both bodies) entries, used by one call at a time (one per thread); returns -1 (and
-    computes nothing) when a pair that needs it finds it too small.
+    Returns -1 (and computes nothing) for a pair that needs the scratch and has more than
+    :data:`STACK_VERTICES` vertices in all.
 
     The boxes are those of the packs; they equal :func:`_bbox` of the coordinates (a
     minimum or maximum is exact) up to the sign of a zero, which no use of a box sees:
@@ -682,11 +688,12 @@ def relate_shapes_into(pa, pb, eps, scratch):
     --------
     >>> from polycontact import Shape
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> buf = np.empty(scratch_floats(8))
-    >>> [relate_shapes_into(sq._kernel, sq.moved(d)._kernel, 1e-12, buf)
+    >>> [relate_shapes_into(sq._kernel, sq.moved(d)._kernel, 1e-12)
     ...  for d in ([2, 0], [1, 0], [0.5, 0.5])]
     [0, 1, 2]
-    >>> relate_shapes_into(sq._kernel, sq._kernel, 1e-12, buf[:10])
+    >>> t = np.linspace(0.0, 2.0 * np.pi, 130, endpoint=False)
+    >>> big = Shape(np.c_[np.cos(t), np.sin(t)])
+    >>> relate_shapes_into(big._kernel, big._kernel, 1e-12)
     -1
     """
     xa, sa, ba = _unpack(pa)
@@ -695,9 +702,9 @@ def relate_shapes_into(pa, pb, eps, scratch):
     nb = sb[sb.shape[0] - 1]
     if _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps):
         return SEPARATE
-    if scratch.shape[0] < scratch_floats(na + nb):
+    if na + nb > STACK_VERTICES:
         return -1
-    box, ids, touch, rays, rord = _scratch_views(scratch, na + nb)
+    box, ids, touch, rays, rord = _scratch_views(stack_floats(_STACK_FLOATS), na + nb)
     return _overlap_state_inlined(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, box, ids, touch, rays,
                                   rord)
 
