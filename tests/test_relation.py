@@ -19,7 +19,7 @@ from hypothesis import given, note
 from hypothesis import strategies as st
 from profiles import examples
 
-from polycontact import Shape, State, classify, classify_many
+from polycontact import Relation, Shape, State, classify, classify_many
 from polycontact.tolerances import default_tolerance
 
 
@@ -375,3 +375,22 @@ def test_prebuilt_shapes_in_threads_and_above_the_scratch():
             got = list(pool.map(lambda ab: classify(*ab).state, jobs))
             assert got == want
     assert {State.SEPARATE, State.PENETRATING} <= set(want)
+
+
+def test_a_relation_cannot_be_changed():
+    """A Relation (slots, no instance dict) is read-only: its decided parts, its lazy
+    parts and new attributes alike; a lazy part is computed once and then kept."""
+    sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    for r in (classify(sq, sq.moved((0.5, 0.25))), classify(sq.packed[0], sq.packed[0] + 0.5)):
+        assert r.state is State.PENETRATING
+        point = r.point
+        assert r.point is point and r.escape is r.escape
+        for name in ("state", "tolerance", "distance", "point", "features", "anything"):
+            with pytest.raises(AttributeError):
+                setattr(r, name, None)
+        with pytest.raises(AttributeError):
+            del r.state
+        assert not hasattr(r, "__dict__")
+        assert r.state is State.PENETRATING and r.point is point
+    with pytest.raises(TypeError, match="classify"):
+        Relation(State.CONTACT, 1e-12, sq, sq)
