@@ -29,6 +29,7 @@ from .advance import STACK_SIZE, _line_time, edge_table, outward_normal, pair_st
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
 from .relation import _scratch_views, _state_in, scratch_floats
 from .validate import closest_on_segment
+from .views import vector, view
 
 NO_HIT = 0
 HIT = 1
@@ -293,20 +294,19 @@ def _work_views(work, na, nb):
     if work.shape[0] < work_floats(size):
         raise ValueError("time of impact: the scratch buffer is too short for the bodies")
     k = 2 * MAX_INTERVALS
-    iv = work[:k].reshape(MAX_INTERVALS, 2)
+    iv = view(work, 0, MAX_INTERVALS, 2, np.float64)
     bw = work[k:k + BROAD_PHASE_FLOATS]
     k += BROAD_PHASE_FLOATS
     pa = work[k:k + 2]
     pb = work[k + 2:k + 4]
-    ints = work[k + 4:k + 8 + 2 * STACK_SIZE].view(np.int64)  # (4: crit, with a spare)
-    crit = ints[:3]
+    crit = vector(work, k + 4, 3, np.int64)  # (4 floats: crit, with a spare)
     crit[:] = -1
-    stack = ints[4:].reshape(STACK_SIZE, 2)
+    stack = view(work, k + 8, STACK_SIZE, 2, np.int64)
     k += 8 + 2 * STACK_SIZE
     stau = work[k:k + STACK_SIZE]
     k += STACK_SIZE
-    xa = work[k:k + 2 * na].reshape(na, 2)
-    xb = work[k + 2 * na:k + 2 * size].reshape(nb, 2)
+    xa = view(work, k, na, 2, np.float64)
+    xb = view(work, k + 2 * na, nb, 2, np.float64)
     k += 2 * size
     return (iv, bw, pa, pb, crit, stack, stau, xa, xb,
             _scratch_views(work[k:k + scratch_floats(size)], size))
@@ -633,10 +633,9 @@ def _unpack_body(f, i):
     n = i[0]
     k = i[1]
     m = i[2]
-    table = (i[3 + k:3 + k + n], i[3 + k + n:3 + k + n + 3 * m].reshape(m, 3),
-             f[3 + 2 * n:3 + 2 * n + 4 * m].reshape(m, 4),
-             f[3 + 2 * n + 4 * m:3 + 3 * n + 4 * m])
-    return f[3:3 + 2 * n].reshape(n, 2), i[3:3 + k], f[:2], f[2], table
+    table = (i[3 + k:3 + k + n], view(i, 3 + k + n, m, 3, np.int64),
+             view(f, 3 + 2 * n, m, 4, np.float64), f[3 + 2 * n + 4 * m:3 + 3 * n + 4 * m])
+    return view(f, 3, n, 2, np.float64), i[3:3 + k], f[:2], f[2], table
 
 
 @njit(cache=True, nogil=True)
