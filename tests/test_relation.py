@@ -379,7 +379,10 @@ def test_prebuilt_shapes_in_threads_and_above_the_scratch():
 
 def test_a_relation_cannot_be_changed():
     """A Relation (slots, no instance dict) is read-only: its decided parts, its lazy
-    parts and new attributes alike; a lazy part is computed once and then kept."""
+    parts and new attributes alike; a lazy part is computed once and then kept; it
+    survives pickling (for process pools) with what it had computed."""
+    import pickle
+
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     for r in (classify(sq, sq.moved((0.5, 0.25))), classify(sq.packed[0], sq.packed[0] + 0.5)):
         assert r.state is State.PENETRATING
@@ -392,5 +395,8 @@ def test_a_relation_cannot_be_changed():
             del r.state
         assert not hasattr(r, "__dict__")
         assert r.state is State.PENETRATING and r.point is point
+        back = pickle.loads(pickle.dumps(r))
+        assert (back.state, back.tolerance, back.distance) == (r.state, r.tolerance, r.distance)
+        assert back.features == r.features and np.array_equal(back.point, point)
     with pytest.raises(TypeError, match="classify"):
         Relation(State.CONTACT, 1e-12, sq, sq)
