@@ -155,6 +155,7 @@ def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
     """A pair of more than STACK_VERTICES vertices gets -1 (classify then calls
     relate_state), never a state computed in a scratch too small; pairs whose boxes are
     apart need no scratch and are separate at once."""
+    assert kr._STACK_FLOATS == kr.scratch_floats(kr.STACK_VERTICES)  # the stack's size
     t = np.linspace(0.0, 2.0 * np.pi, kr.STACK_VERTICES // 2 + 1, endpoint=False)
     big = Shape(np.c_[np.cos(t), np.sin(t)])
     assert kr.relate_shapes_into(big._kernel, big._kernel, 1e-12) == -1
