@@ -175,7 +175,8 @@ def test_kernel_pack_is_the_shape(pair):
         xy, starts, box = kr._unpack(shape._kernel)
         assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
         assert box == kr._bbox(shape.packed[0], shape.n_vertices)
-        assert not shape._kernel.flags.writeable
+        assert type(shape._kernel) is bytes  # immutable by its type
+        assert not xy.flags.writeable and not starts.flags.writeable
 
 
 def test_scratch_views_do_not_overlap():

@@ -456,7 +456,7 @@ _RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 _new = object.__new__
 
 
-def _bind_state_into(pa: np.ndarray, pb: np.ndarray, eps: float) -> int:
+def _bind_state_into(pa: bytes, pb: bytes, eps: float) -> int:
     """The first call of :func:`classify` on two Shapes: binds ``relate_shapes_into``'s
     entry point (see polycontact._dispatch) to ``_state_into``, then classifies.
 
@@ -479,7 +479,7 @@ def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndar
 #: The state kernels for two Shapes: ``relate_shapes_into`` on the shapes' kernel packs,
 #: and ``relate_state`` on their arrays for pairs with more vertices than the former's
 #: scratch on the stack holds; each bound on its first call.
-_state_into: Callable[[np.ndarray, np.ndarray, float], int] = _bind_state_into
+_state_into: Callable[[bytes, bytes, float], int] = _bind_state_into
 _state_full: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], int] = (
     _bind_state_full)
 

@@ -44,7 +44,8 @@ def _dtype_of(dtype):
 
 
 def _flat_c(buf):
-    return isinstance(buf, types.Array) and buf.ndim == 1 and buf.layout == "C"
+    """A flat C-contiguous array or buffer (``bytes`` too: a kernel pack is one)."""
+    return isinstance(buf, types.Buffer) and buf.ndim == 1 and buf.layout == "C"
 
 
 def _lower_view(ndim):
@@ -106,15 +107,21 @@ def _stack_floats(typingctx, size):
     return out(size), codegen
 
 
+def _flat_py(buf):
+    """``buf`` as a NumPy array (``bytes`` as read-only uint8)."""
+    return buf if isinstance(buf, np.ndarray) else np.frombuffer(buf, dtype=np.uint8)
+
+
 def _view_py(buf, start, n, k, dtype):
-    """``buf[start:]`` (a flat C-contiguous array) read as a C-contiguous (n, k) array of
-    ``dtype``, writable if ``buf`` is."""
-    return buf[start:].view(dtype)[: n * k].reshape(n, k)
+    """``buf[start:]`` (a flat C-contiguous array, or ``bytes``) read as a C-contiguous
+    (n, k) array of ``dtype``, writable if ``buf`` is; ``start`` counts elements of
+    ``buf``."""
+    return _flat_py(buf)[start:].view(dtype)[: n * k].reshape(n, k)
 
 
 def _vector_py(buf, start, n, dtype):
     """``buf[start:]`` read as a vector of n elements of ``dtype``."""
-    return buf[start:].view(dtype)[:n]
+    return _flat_py(buf)[start:].view(dtype)[:n]
 
 
 def _stack_floats_py(size):
