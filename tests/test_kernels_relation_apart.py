@@ -143,12 +143,18 @@ def test_early_exit_never_fires_for_a_body_in_a_hole():
 def test_state_with_stack_scratch_is_the_allocating_state(pair):
     """relate_shapes_into (the shapes' kernel packs, its scratch on the stack, no
     allocation) gives relate_state's answer, also when called again (the stack holds
-    the last call's values)."""
+    the last call's values); a tolerance below 0 is the pair's default, taken from the
+    packs."""
     a, b, _ = pair
     eps = default_tolerance(a.packed[0], b.packed[0])
+    assert max(a._tolerance, b._tolerance) == eps
     want = kr.relate_state(*a.packed, *b.packed, eps)
     assert kr.relate_shapes_into(a._kernel, b._kernel, eps) == want
     assert kr.relate_shapes_into(a._kernel, b._kernel, eps) == want  # reused
+    assert kr.relate_shapes_into(a._kernel, b._kernel, -1.0) == want
+    r = pc.classify(a, b)
+    assert r.state.value == ("separate", "contact", "penetrating")[want]
+    assert r.tolerance == eps
 
 
 def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
@@ -163,7 +169,8 @@ def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
     fits = Shape(np.c_[np.cos(t[:-1]), np.sin(t[:-1])])
     assert fits.n_vertices * 2 == kr.STACK_VERTICES
     assert kr.relate_shapes_into(fits._kernel, fits._kernel, 1e-12) == kr.PENETRATING
-    assert pc.classify(big, big).state is pc.State.PENETRATING
+    r = pc.classify(big, big)  # the default tolerance on the allocating path
+    assert r.state is pc.State.PENETRATING and r.tolerance == big._tolerance
 
 
 @examples(50)
@@ -172,9 +179,10 @@ def test_kernel_pack_is_the_shape(pair):
     """A shape's kernel pack unpacks to its packed arrays and its bounding box (what
     relate_shapes_into reads instead of computing it), and cannot be written."""
     for shape in pair[:2]:
-        xy, starts, box = kr._unpack(shape._kernel)
+        xy, starts, box, tol = kr._unpack(shape._kernel)
         assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
         assert box == kr._bbox(shape.packed[0], shape.n_vertices)
+        assert tol == shape._tolerance
         assert type(shape._kernel) is bytes  # immutable by its type
         assert not xy.flags.writeable and not starts.flags.writeable
 

@@ -229,7 +229,6 @@ class Shape:
         starts.flags.writeable = False
         self._xy = xy
         self._starts = starts
-        self._kernel = _kernel_pack(xy, starts, lo, hi)
         # body-frame tables of the time-of-impact search
         self._frame: tuple[Any, ...] | None = None
         self._loops = tuple(xy[starts[k] : starts[k + 1]] for k in range(len(loops)))
@@ -259,6 +258,7 @@ class Shape:
         # default_tolerance of this shape alone; of a pair, the larger of the two (the
         # rule is a max of terms that grow with the extent and the magnitude)
         self._tolerance = tolerance_for(extent, magnitude)
+        self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
@@ -639,15 +639,17 @@ def _fmt(v: float) -> str:
     return f"{v:.12g}"
 
 
-def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bytes:
+def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                 tolerance: float) -> bytes:
     """The shape as the bytes of one float64 array, the layout of
     :data:`polycontact._kernels.relation.PACK_HEAD`: loop count, bounding box ``(xmin,
-    ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the loop
-    ``starts`` as int64 bit patterns, then ``xy`` row by row. :func:`polycontact.classify`
-    passes it to the state kernel: one object to unbox per shape, immutable and holding
-    its data in itself (about 2 us per shape)."""
+    ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the shape's
+    default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
+    patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
+    state kernel: one object to unbox per shape, immutable and holding its data in
+    itself (about 2 us per shape)."""
     return np.concatenate(
-        ((len(starts) - 1.0,), lo, hi, starts.view(np.float64), xy.reshape(-1))
+        ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
     ).tobytes()
 
 

@@ -642,24 +642,27 @@ def relate_state(xa, sa, xb, sb, eps):
 
 #: Layout of a shape's kernel pack (``Shape._kernel``, built once per shape by
 #: :func:`polycontact.shape._kernel_pack`): one ``bytes`` object holding, as float64,
-#: the loop count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the loop starts
-#: (int64 bit patterns, L + 1 of them) and then the packed coordinates row by row. A
+#: the loop count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the shape's
+#: default-tolerance term (``Shape._tolerance``: the kernel takes the larger of the two
+#: shapes', so the caller reads no float object), the loop starts (int64 bit patterns,
+#: L + 1 of them) and then the packed coordinates row by row. A
 #: ``bytes`` object holds its data in itself: unboxing it reads one object, where an
 #: ndarray's header, shape and data are three allocations (0.26 against 0.43-0.52 us per
 #: call of two packs when other code has evicted the caches; the same when warm).
-PACK_HEAD = 5
+PACK_HEAD = 6
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _unpack(pack):
-    """``(xy, starts, box)`` of a shape's kernel pack (views: nothing is allocated), the
-    box as ``(xmin, xmax, ymin, ymax)``."""
+    """``(xy, starts, box, tolerance)`` of a shape's kernel pack (views: nothing is
+    allocated), the box as ``(xmin, xmax, ymin, ymax)``, the shape's default-tolerance
+    term."""
     pack = vector(pack, 0, len(pack) // 8, np.float64)
     nl = int(pack[0])
     starts = vector(pack, PACK_HEAD, nl + 1, np.int64)
     n = starts[nl]
     xy = view(pack, PACK_HEAD + nl + 1, n, 2, np.float64)
-    return xy, starts, (pack[1], pack[3], pack[2], pack[4])
+    return xy, starts, (pack[1], pack[3], pack[2], pack[4]), pack[5]
 
 
 #: Vertices (both bodies together) of the pairs :func:`relate_shapes_into` classifies with
@@ -680,7 +683,10 @@ def relate_shapes_into(pa, pb, eps):
     """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),
     allocating nothing (its scratch is on the stack).
 
-    Returns -1 (and computes nothing) for a pair that needs the scratch and has more than
+    ``eps`` below 0 means the default tolerance of the pair: the larger of the two
+    shapes' terms held in their packs (``Shape._tolerance``, hence
+    :func:`polycontact.default_tolerance` of the pair). Returns -1 (and computes
+    nothing) for a pair that needs the scratch and has more than
     :data:`STACK_VERTICES` vertices in all.
 
     The boxes are those of the packs; they equal :func:`_bbox` of the coordinates (a
@@ -692,7 +698,7 @@ def relate_shapes_into(pa, pb, eps):
     --------
     >>> from polycontact import Shape
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> [relate_shapes_into(sq._kernel, sq.moved(d)._kernel, 1e-12)
+    >>> [relate_shapes_into(sq._kernel, sq.moved(d)._kernel, -1.0)
     ...  for d in ([2, 0], [1, 0], [0.5, 0.5])]
     [0, 1, 2]
     >>> t = np.linspace(0.0, 2.0 * np.pi, 130, endpoint=False)
@@ -700,8 +706,10 @@ def relate_shapes_into(pa, pb, eps):
     >>> relate_shapes_into(big._kernel, big._kernel, 1e-12)
     -1
     """
-    xa, sa, ba = _unpack(pa)
-    xb, sb, bb = _unpack(pb)
+    xa, sa, ba, ta = _unpack(pa)
+    xb, sb, bb, tb = _unpack(pb)
+    if eps < 0.0:
+        eps = max(ta, tb)
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
     if _boxes_apart(ba, bb, eps) or _apart(xa, na, xb, nb, ba, bb, eps):
