@@ -176,14 +176,17 @@ def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
 @examples(50)
 @given(pairs(holes=None))
 def test_kernel_pack_is_the_shape(pair):
-    """A shape's kernel pack unpacks to its packed arrays and its bounding box (what
-    relate_shapes_into reads instead of computing it), and cannot be written."""
+    """A shape's kernel pack unpacks to its packed arrays, its bounding box and its
+    tolerance term (what relate_shapes_into reads instead of computing them), cannot be
+    written, and its numbers are aligned."""
     for shape in pair[:2]:
         xy, starts, box, tol = kr._unpack(shape._kernel)
         assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
         assert box == kr._bbox(shape.packed[0], shape.n_vertices)
         assert tol == shape._tolerance
         assert type(shape._kernel) is bytes  # immutable by its type
+        # the kernel reads float64 and int64 from the bytes' own storage: 8-byte aligned
+        assert np.frombuffer(shape._kernel, np.uint8).ctypes.data % 8 == 0
         assert not xy.flags.writeable and not starts.flags.writeable
 
 

@@ -669,15 +669,15 @@ def _unpack(pack):
 #: its scratch on the stack (45 kB); larger pairs take :func:`relate_state`, whose
 #: allocation costs little beside their test.
 STACK_VERTICES = 256
-_STACK_FLOATS = 22 * (STACK_VERTICES + 1) + (STACK_VERTICES + 8) // 8  # scratch_floats
+_STACK_FLOATS = getattr(scratch_floats, "py_func", scratch_floats)(STACK_VERTICES)
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
 # arrays it is called with and passes on cost ~0.1 us per call, as much as the test of a
 # small separate pair. Nothing in it allocates: the scratch is on its stack (a buffer
 # passed in cost a thread-local look-up and one more array to unbox per call, about
-# 0.05 us). It takes one array per shape (each array a call unboxes costs 35-120 ns, more
-# when other code has evicted the caches) and reads the bounding boxes cached in them.
+# 0.05 us). It takes one bytes object per shape (see PACK_HEAD) and reads the bounding
+# boxes and tolerance terms cached in them.
 @njit(cache=True, nogil=True, _nrt=False)
 def relate_shapes_into(pa, pb, eps):
     """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),
