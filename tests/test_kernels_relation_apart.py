@@ -204,3 +204,18 @@ def test_scratch_views_do_not_overlap():
     touch[:] = True
     assert (box == 1.0).all() and (rays == 2.0).all() and (ids == 3).all()
     assert (rord == 4).all() and touch.all()
+
+
+def test_default_tolerance_of_two_shapes_is_the_larger_term():
+    """A small triangle 1e-7 above the top of a 1e6 square: the pair's default tolerance
+    is the square's term (1e-6), so they touch; the triangle's own term (1.4e-8, the
+    float spacing of its coordinates) would call them apart. Both orders, through the
+    kernel's default (-1.0) and through classify."""
+    square = Shape([(0, 0), (1e6, 0), (1e6, 1e6), (0, 1e6)])
+    tri = Shape([(5e5, 1e6 + 1e-7), (5e5 + 1, 1e6 + 1e-7), (5e5, 1e6 + 1)])
+    assert tri._tolerance < 1e-7 < square._tolerance
+    for a, b in ((square, tri), (tri, square)):
+        assert kr.relate_shapes_into(a._kernel, b._kernel, -1.0) == kr.CONTACT
+        assert kr.relate_shapes_into(a._kernel, b._kernel, tri._tolerance) == kr.SEPARATE
+        r = pc.classify(a, b)
+        assert r.state is pc.State.CONTACT and r.tolerance == square._tolerance
