@@ -88,3 +88,42 @@ def point(value: Any, what: str, *, error: type[ValueError] = ValueError) -> np.
     if arr.shape != (2,) or not np.isfinite(arr).all():
         raise error(f"{what}: expected two finite numbers (x, y), got {value!r}")
     return arr
+
+
+def real_array(value: Any, what: str, shape: tuple[int, ...]) -> np.ndarray:
+    """``value`` as a new float64 array of ``shape`` with finite entries, else an error
+    naming ``what`` and, for a bad entry, its index; ``TypeError`` if the entries are
+    not real numbers (strings, booleans, complex numbers, objects).
+
+    >>> real_array([[0, 1], [2.5, 3]], "positions", (2, 2)).tolist()
+    [[0.0, 1.0], [2.5, 3.0]]
+    >>> real_array([0.0, float("nan")], "angles", (2,))
+    Traceback (most recent call last):
+    ...
+    ValueError: angles[1]: expected a finite number, got nan
+    """
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: expected an array of shape {shape}, got "
+                         f"{type(value).__name__}") from None
+    if raw.dtype.kind == "O":
+        for index, x in np.ndenumerate(raw):
+            if not is_real(x):
+                where = "".join(f"[{i}]" for i in index)
+                raise TypeError(f"{what}{where}: expected a real number, got "
+                                f"{type(x).__name__} {x!r}")
+    elif raw.dtype.kind not in "fiu":
+        raise TypeError(f"{what}: expected real numbers, got an array of {raw.dtype}")
+    if raw.shape != shape:
+        raise ValueError(f"{what}: expected an array of shape {shape}, got shape {raw.shape}")
+    try:
+        arr = np.array(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{what}: expected finite numbers") from None
+    finite = np.isfinite(arr)
+    if not finite.all():
+        index = tuple(int(i) for i in np.argwhere(~finite)[0])
+        where = "".join(f"[{i}]" for i in index[:1]) if arr.ndim else ""
+        raise ValueError(f"{what}{where}: expected a finite number, got {float(arr[index])!r}")
+    return arr

@@ -665,8 +665,11 @@ def _classify_arrays(
     )
 
 
-def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, ...]:
-    """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel."""
+def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
+                   objects: list[Shape | None] | None = None) -> tuple[Any, ...]:
+    """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel.
+    ``objects``, when given, receives each body's Shape, or None for a raw ring packed
+    as given."""
     from ._kernels import relation_many as km
 
     bodies: list[Any] = []
@@ -709,11 +712,13 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, .
             ls.extend((row, row + len(body)))
         row += len(chunks[-1])
         bs.append(len(ls))
+    if objects is not None:
+        objects.extend(b if isinstance(b, Shape) else None for b in bodies)
     xy = np.ascontiguousarray(np.concatenate(chunks)) if chunks else np.empty((0, 2))
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def _pack(items: Any, what: str) -> tuple[Any, ...]:
+def _pack(items: Any, what: str, objects: list[Shape | None] | None = None) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
@@ -721,7 +726,7 @@ def _pack(items: Any, what: str) -> tuple[Any, ...]:
             f"{what}: expected a sequence of bodies or an array of shape (P, N, 2), "
             f"got {type(items).__name__}"
         )
-    return _pack_sequence(items, what)
+    return _pack_sequence(items, what, objects)
 
 
 def classify_many(

@@ -72,6 +72,13 @@ def _edges(x, st):
     i to the next of its loop) and each vertex's successor."""
     e = np.empty((x.shape[0], 3))
     nxt = np.empty(x.shape[0], np.int64)
+    _edges_into(x, st, e, nxt)
+    return e, nxt
+
+
+@njit(cache=True, nogil=True)
+def _edges_into(x, st, e, nxt):
+    """:func:`_edges` written into ``e`` and ``nxt``."""
     for k in range(st.shape[0] - 1):
         for i in range(st[k], st[k + 1]):
             j = _next(i, st, k)
@@ -79,7 +86,6 @@ def _edges(x, st):
             e[i, 0] = x[j, 0] - x[i, 0]
             e[i, 1] = x[j, 1] - x[i, 1]
             e[i, 2] = np.sqrt(e[i, 0] * e[i, 0] + e[i, 1] * e[i, 1])
-    return e, nxt
 
 
 @njit(cache=True, nogil=True)
@@ -87,8 +93,8 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
     """Append the kept segments of the vertices of one body (``xv``, loop starts ``sv``,
     edges ``ev`` of :func:`_edges`) against the edges of the other (``xe``, edges
     ``ee``, successors ``ne``) nearer than ``bound``: rows ``(x0, y0, x1, y1, squared
-    distance)`` of translations of A; ``sign`` +1 when the vertices are B's (``v − e``),
-    −1 when they are A's (``e − w``).
+    distance, side, vertex, edge)`` of translations of A; ``sign`` +1 when the vertices
+    are B's (``v − e``, side 1), −1 when they are A's (``e − w``, side 0).
 
     Kept: a vertex that may touch the edge (the other body's interior on its left)
     without overlap: convex, and both of its edges on the outer (right) side of the
@@ -126,6 +132,9 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
                     seg[n, 2] = x1
                     seg[n, 3] = y1
                     seg[n, 4] = d
+                    seg[n, 5] = 0.5 + 0.5 * sign
+                    seg[n, 6] = i
+                    seg[n, 7] = j
                     n += 1
     return n
 
@@ -274,38 +283,59 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     nb = xb.shape[0]
     if m + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, False
+    got = contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, depth_buffers(m, nb))
+    return got[0], got[1], got[2], got[3]
+
+
+@njit(cache=True, nogil=True)
+def depth_buffers(m, n):
+    """Scratch of :func:`contact_depth_into` for bodies of up to ``m`` and ``n``
+    vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb)``."""
+    k = 2 * m * n
+    return (np.empty((k, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
+            np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 3)),
+            np.empty(m, np.int64), np.empty((n, 3)), np.empty(n, np.int64))
+
+
+@njit(cache=True, nogil=True)
+def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
+    """:func:`contact_depth` with its scratch (:func:`depth_buffers`, for at least the
+    bodies' vertex counts) passed in, so that a loop over pairs allocates nothing.
+    Returns ``(depth, dx, dy, ok, side, vertex, edge)``: with the depth, the contact
+    segment it lies on, the vertex of one body brought onto the edge of the other (side
+    0: a vertex of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows
+    of each body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
+    seg, pts, ts, moved, scratch, ea, nxa, eb, nxb = buffers
+    m = xa.shape[0]
+    nb = xb.shape[0]
     tol = 4.0 * eps
-    ea, nxa = _edges(xa, sa)
-    eb, nxb = _edges(xb, sb)
-    seg = np.empty((2 * m * nb, 5))
+    _edges_into(xa, sa, ea[:m], nxa[:m])
+    _edges_into(xb, sb, eb[:nb], nxb[:nb])
     n = _add_segments(xb, sb, eb, xa, ea, nxa, 1.0, bound, eps, seg, 0)
     n = _add_segments(xa, sa, ea, xb, eb, nxb, -1.0, bound, eps, seg, n)
+    moved = moved[:m]
     # Segments and pieces are taken in increasing distance (a linear scan each time:
     # a few of each): a segment is split when it is the nearest thing left, each piece
     # then waits for its turn, and the first piece point that escapes is the depth.
     for s in range(n):
         seg[s, 4] = np.sqrt(seg[s, 4])
-    todo = np.ones(n, np.bool_)
-    cap = 8 * n + 8
-    pts = np.empty((cap, 4))  # rows (distance, x, y, 1.0 once tried)
+    # (pieces' "tried" flags: column 3; the segment index: column 4; a segment is done
+    # once its distance is set negative)
     c = 0
-    ts = np.empty(2 * n + 2)
-    moved = np.empty_like(xa)
-    scratch = np.empty(scratch_floats(m + nb))
     while True:
         s = -1
         for q in range(n):
-            if todo[q] and (s < 0 or seg[q, 4] < seg[s, 4]):
+            if seg[q, 4] >= 0.0 and (s < 0 or seg[q, 4] < seg[s, 4]):
                 s = q
         r = -1
         for q in range(c):
             if pts[q, 3] == 0.0 and (r < 0 or pts[q, 0] < pts[r, 0]):
                 r = q
         if s >= 0 and (r < 0 or seg[s, 4] <= pts[r, 0]):
-            todo[s] = False
             k = _splits(seg, n, s, tol, ts)
+            seg[s, 4] = -1.0 - seg[s, 4]
             if k < 0:
-                return np.nan, np.nan, np.nan, False
+                return np.nan, np.nan, np.nan, False, -1, -1, -1
             c = _pieces(seg, s, ts, k, bound, pts, c)
             if c < 0:  # (more rows needed)
                 pts = _grown(pts)
@@ -318,10 +348,11 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
         if _tried(pts, c, r):
             continue  # (an end shared by several pieces is tried once)
         if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
-            return d, px, py, True
+            q = int(pts[r, 4])
+            return d, px, py, True, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
     if _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
-        return np.nan, np.nan, np.nan, False
-    return bound, bdx, bdy, True
+        return np.nan, np.nan, np.nan, False, -1, -1, -1
+    return bound, bdx, bdy, True, -1, -1, -1
 
 
 @njit(cache=True, nogil=True)
@@ -337,8 +368,8 @@ def _tried(pts, c, r):
 def _pieces(seg, s, ts, k, bound, pts, c):
     """Append to ``pts`` (from row c) the point nearest the origin of each piece of
     segment ``s`` between the ``k`` split parameters ``ts`` (and 0 and 1), when nearer
-    than ``bound``: the new row count, or ``-c - 1`` when ``pts`` is too small (nothing
-    written)."""
+    than ``bound``, as rows ``(distance, x, y, 0.0, s)``: the new row count, or
+    ``-c - 1`` when ``pts`` is too small (nothing written)."""
     ts[k] = 0.0
     ts[k + 1] = 1.0
     k += 2
@@ -363,6 +394,7 @@ def _pieces(seg, s, ts, k, bound, pts, c):
             pts[c, 1] = got[0]
             pts[c, 2] = got[1]
             pts[c, 3] = 0.0
+            pts[c, 4] = s
             c += 1
     return c
 

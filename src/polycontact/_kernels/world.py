@@ -199,9 +199,9 @@ def _meet(box, b, q0, q1, q2, q3):
 
 @njit(cache=True, nogil=True)
 def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps, tol, alive,
-                    n_ids):
-    """Pairs (i, j) of live bodies whose boxes come within their tolerance: i < j on a
-    shared level, else i on the lower level. Returns (pi, pj)."""
+                    n_ids, margin):
+    """Pairs (i, j) of live bodies whose boxes come within their tolerance plus
+    ``margin``: i < j on a shared level, else i on the lower level. Returns (pi, pj)."""
     cap = 4 * alive.shape[0] + 16
     pi = np.empty(cap, np.int64)
     pj = np.empty(cap, np.int64)
@@ -214,7 +214,7 @@ def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps
     n = 0
     for k in range(alive.shape[0]):
         i = alive[k]
-        ei = tol if tol >= 0.0 else eps[i]
+        ei = (tol if tol >= 0.0 else eps[i]) + margin
         d = ei + emax
         q0 = box[i, 0] - d
         q1 = box[i, 1] + d

@@ -1,0 +1,181 @@
+"""Kernels: a World's swept step — which pairs meet while every body moves, and where.
+
+Each body of the World moves rigidly about its centroid (design.md §3) from its current
+pose: ``x(t) = c(t) + R(θ(t)) r`` with ``r`` its rows relative to its centroid turned by
+its current angle (``r = R(angle)(bxy − cen)``, so that ``pos + r`` are the stored rows
+to the bit). The candidate pairs come from the swept broad phase of
+:func:`polycontact.first_impacts` (:mod:`polycontact._kernels.swept`), and each pair runs
+``exact_query`` of :mod:`polycontact._kernels.impact` exactly as
+:func:`polycontact.time_of_impact` does.
+
+The circle tree of each body's edges (:func:`polycontact._kernels.advance.edge_table`)
+is built once, about the body's base rows (:func:`frame_tables`), and turned with the
+body at each step: a rigid turn moves the smallest circles with the points they hold
+(their radii keep their relative margin of 1e-12 over the rounding of the turn).
+
+At the first contact time of a pair (time 0 when it touches or penetrates at the
+start), both bodies are placed and classified, and the contact's point and normal are
+those of :func:`polycontact._kernels.contact_geometry.pair_geometry_into` in that state.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .advance import edge_table
+from .contact_geometry import geometry_buffers, pair_geometry_into
+from .impact import _eps_at, _placed_state, exact_query, place, work_floats
+from .relation import _scratch_views, scratch_floats
+
+
+@njit(cache=True, nogil=True)
+def frame_tables(bxy, ls, lo, nl, cen, bodies, tint, tflt, tio, tfo):
+    """Build the circle tree of each body of ``bodies`` about its base rows (``bxy``
+    relative to ``cen``), into ``tint`` (``nxt`` then ``links``) from ``tio[b]`` and
+    ``tflt`` (``circles``) from ``tfo[b]``, offsets set by the caller (n vertices: n +
+    3 (2n − 1) ints, 4 (2n − 1) floats)."""
+    for k in range(bodies.shape[0]):
+        b = bodies[k]
+        f = ls[lo[b]]
+        n = ls[lo[b] + nl[b]] - f
+        r = np.empty((n, 2))
+        for i in range(n):
+            r[i, 0] = bxy[f + i, 0] - cen[b, 0]
+            r[i, 1] = bxy[f + i, 1] - cen[b, 1]
+        st = np.empty(nl[b] + 1, np.int64)
+        for q in range(nl[b] + 1):
+            st[q] = ls[lo[b] + q] - f
+        nxt, links, circles, _ = edge_table(r, st)
+        m = 2 * n - 1
+        io = tio[b]
+        fo = tfo[b]
+        tint[io:io + n] = nxt
+        for q in range(m):
+            for c in range(3):
+                tint[io + n + 3 * q + c] = links[q, c]
+            for c in range(4):
+                tflt[fo + 4 * q + c] = circles[q, c]
+
+
+@njit(cache=True, nogil=True)
+def _frame(b, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, r, circles, r_len, st):
+    """Body b in its frame turned by ``ang[b]``: its rows ``r`` and circles (written into
+    the given scratch), its starts and tables; returns ``(r, starts, table)``."""
+    f = ls[lo[b]]
+    n = ls[lo[b] + nl[b]] - f
+    m = 2 * n - 1
+    cs = math.cos(ang[b])
+    sn = math.sin(ang[b])
+    cx = cen[b, 0]
+    cy = cen[b, 1]
+    for i in range(n):
+        dx = bxy[f + i, 0] - cx
+        dy = bxy[f + i, 1] - cy
+        x = dx * cs - dy * sn
+        y = dx * sn + dy * cs
+        r[i, 0] = x
+        r[i, 1] = y
+        r_len[i] = np.sqrt(x * x + y * y)
+    fo = tfo[b]
+    for q in range(m):
+        x = tflt[fo + 4 * q]
+        y = tflt[fo + 4 * q + 1]
+        u = x * cs - y * sn
+        v = x * sn + y * cs
+        circles[q, 0] = u
+        circles[q, 1] = v
+        circles[q, 2] = tflt[fo + 4 * q + 2]
+        circles[q, 3] = np.sqrt(u * u + v * v)
+    for q in range(nl[b] + 1):
+        st[q] = ls[lo[b] + q] - f
+    io = tio[b]
+    links = tint[io + n:io + n + 3 * m].reshape((m, 3))
+    return r[:n], st[:nl[b] + 1], (tint[io:io + n], links, circles[:m], r_len[:n])
+
+
+@njit(cache=True, nogil=True)
+def _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
+                 tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
+                 max_iter, k0, k1, out):
+    code, t_hi, t_contact, state, point, normal = out
+    ra = np.empty((vmax, 2))
+    rb = np.empty((vmax, 2))
+    ca_ = np.empty((2 * vmax, 4))
+    cb_ = np.empty((2 * vmax, 4))
+    la_ = np.empty(vmax)
+    lb_ = np.empty(vmax)
+    sta = np.empty(lmax + 1, np.int64)
+    stb = np.empty(lmax + 1, np.int64)
+    xa = np.empty((vmax, 2))
+    xb = np.empty((vmax, 2))
+    work = np.empty(work_floats(2 * vmax))
+    scratch = _scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
+    buffers = geometry_buffers(vmax)
+    m = k1 - k0
+    dist = np.empty(m)
+    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
+            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
+    for k in range(k0, k1):
+        p = pi[k]
+        q = pj[k]
+        a = ids[p]
+        b = ids[q]
+        r1, s1, e1 = _frame(a, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, ra, ca_, la_,
+                            sta)
+        r2, s2, e2 = _frame(b, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, rb, cb_, lb_,
+                            stb)
+        ma = motion[p]
+        mb = motion[q]
+        c1 = pos[a]
+        c2 = pos[b]
+        eps_rel = rel * max(extent[a], extent[b])
+        lam = resolution * (rad[a] + rad[b])
+        got = exact_query(r1, s1, c1, ma, rad[a], e1, r2, s2, c2, mb, rad[b], e2, t_max,
+                          inflate, time_tol, eps_rel, ulps, lam, max_iter, work)
+        c = got[1]
+        code[k] = c
+        t_hi[k] = got[2]
+        t = got[4] if c != 2 else 0.0
+        if c == 3 and t < 0.0:
+            t = got[6]
+        t_contact[k] = t
+        if t < 0.0:
+            state[k] = 0
+            continue
+        state[k] = 2 if c == 1 or c == 2 else 1
+        # the contact's point and normal, where the bodies are at that time
+        place(r1, c1, ma, t, xa[:r1.shape[0]])
+        place(r2, c2, mb, t, xb[:r2.shape[0]])
+        ya = xa[:r1.shape[0]]
+        yb = xb[:r2.shape[0]]
+        eps = _eps_at(c1, ma, rad[a], c2, mb, rad[b], t, eps_rel, ulps)
+        now = _placed_state(ya, s1, yb, s2, eps, scratch)
+        pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
+        if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
+            normal[k, 0] = np.nan
+            normal[k, 1] = np.nan
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def sweep_pairs(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
+                tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
+                max_iter, chunks):
+    """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
+    ``ids[pj[k]]``), the bodies moving with the rows of ``motion`` (``[vx, vy, ax, ay,
+    ω, α]``, indexed like ``ids``) over [0, ``t_max``], in parallel chunks. Returns
+    ``(code, t_hi, t_contact, state, point, normal)``: the search's status code and
+    penetration time (as ``exact_query``), the first contact time (0 when penetrating
+    at the start; the time reached by a search without a verdict; -1 when they never
+    touch), 2 when they penetrate within the step and 1 when they only touch (0: never),
+    and the point and normal of the contact at its time."""
+    n = pi.shape[0]
+    out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8),
+           np.full((n, 2), np.nan), np.full((n, 2), np.nan))
+    for c in prange(chunks):
+        _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
+                     tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
+                     resolution, max_iter, n * c // chunks, n * (c + 1) // chunks, out)
+    return out
