@@ -339,10 +339,13 @@ class Query:
         return self.container_state < 2 and not bool((self.states == 2).any())
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Sweep:
     """Answer of :meth:`World.sweep`: every pair that meets within the step, sorted by
     time, then by ids.
+
+    The points and normals are computed together, in one compiled pass, the first time
+    one of them is read (the bodies placed at each pair's time and classified there).
 
     Attributes
     ----------
@@ -355,10 +358,6 @@ class Sweep:
     states : ndarray of shape (K,), int8
         2 when the bodies penetrate within the step (or at its start), 1 when they only
         touch.
-    points, normals : ndarray of shape (K, 2)
-        Contact point and unit normal (from the first body of the pair towards the
-        second) at ``times``, as :attr:`Contacts.points` and :attr:`Contacts.normals`
-        give them for the bodies placed there.
     penetration_times : ndarray of shape (K,)
         The first penetration time (``time_of_impact(...).time``; 0 when penetrating at
         the start), NaN for a pair that only touches.
@@ -367,19 +366,65 @@ class Sweep:
         iterations (no verdict).
     dt : float
         The step.
+    points, normals : ndarray of shape (K, 2)
+        Contact point and unit normal (from the first body of the pair towards the
+        second) at ``times``, as :attr:`Contacts.points` and :attr:`Contacts.normals`
+        give them for the bodies placed there.
     """
 
     pairs: np.ndarray
     times: np.ndarray
     states: np.ndarray
-    points: np.ndarray
-    normals: np.ndarray
     penetration_times: np.ndarray
     status: np.ndarray
     dt: float
+    _events: tuple[Any, ...] = field(repr=False)  # what the points and normals come from
 
     def __len__(self) -> int:
         return len(self.times)
+
+    @cached_property
+    def _geometry(self) -> tuple[np.ndarray, np.ndarray]:
+        from ._kernels.world_sweep import event_geometry
+
+        ev = self._events
+        point, normal = event_geometry(*ev, _chunks(len(self.times)))
+        for k in np.flatnonzero(np.isnan(normal[:, 0])).tolist():
+            point[k], normal[k] = _event_by_shapes(ev, k)
+        point.flags.writeable = False
+        normal.flags.writeable = False
+        return point, normal
+
+    @property
+    def points(self) -> np.ndarray:
+        """Contact point of every pair at its time."""
+        return self._geometry[0]
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Unit normal of every pair at its time, from its first body to its second."""
+        return self._geometry[1]
+
+
+def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Point and normal of pair k of a Sweep's events by :func:`polycontact.classify`
+    (for bodies too large for the compiled depth)."""
+    pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb = ev[:12]
+    ma, mb = ev[15], ev[16]
+    shapes = []
+    for b, c, turn, m in ((pa[k], ca[k], ta[k], ma[k]), (pb[k], cb[k], tb[k], mb[k])):
+        st = ls[lo[b] : lo[b] + nl[b] + 1]
+        r = bxy[st[0] : st[-1]] - cen[b]
+        cs, sn = np.cos(turn), np.sin(turn)
+        xy = np.c_[r[:, 0] * cs - r[:, 1] * sn, r[:, 0] * sn + r[:, 1] * cs] + c
+        loops = [xy[st[q] - st[0] : st[q + 1] - st[0]] for q in range(len(st) - 1)]
+        motion = Motion(velocity=(m[0], m[1]), acceleration=(m[2], m[3]),
+                        angular_velocity=m[4], angular_acceleration=m[5])
+        shapes.append(Shape._trusted(loops).at(motion, float(times[k])))
+    r = classify(shapes[0], shapes[1])
+    point = r.point if r.point is not None else np.full(2, np.nan)
+    normal = r.normal if r.normal is not None else np.full(2, np.nan)
+    return point, normal
 
 
 def _angle(angle: Any) -> float:
@@ -1252,10 +1297,12 @@ class World:
         >>> s = w.sweep(1.0, [(2.5, 0.0), (0.0, 0.0), (0.0, 0.0)])
         >>> s.pairs.tolist(), s.times.round(4).tolist(), s.states.tolist()
         ([[0, 1]], [0.8], [2])
+        >>> s.penetration_times.round(4).tolist()
+        [0.8]
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]
         """
-        from ._kernels.world_sweep import sweep_pairs
+        from ._kernels.world_sweep import sweep_search
         from ._kernels.swept import box_pairs, swept_boxes
         from .impact import _ULPS, CONTACT_RESOLUTION
         from .impacts import MAX_SLICES, SWEPT_ROUNDING_ULPS
@@ -1278,32 +1325,38 @@ class World:
                 or max_iterations < 1:
             raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
         self._check_motions(ids, motion, step)
-        empty = np.empty((0, 2))
-        if n < 2:
-            return Sweep(np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int8), empty,
-                         empty, np.empty(0), np.empty(0, np.int8), step)
         pos = self._pos[ids]
-        boxes, owner = swept_boxes(pos, motion, self._rad[ids], step, MAX_SLICES,
-                                   BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
-        cand = box_pairs(boxes, owner, n)
+        if n >= 2:
+            boxes, owner = swept_boxes(pos, motion, self._rad[ids], step, MAX_SLICES,
+                                       BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
+            cand = box_pairs(boxes, owner, n)
+        else:
+            cand = np.empty((0, 2), np.int64)
         self._sweep_frames(ids[np.unique(cand)])
         tint, tflt, tio, tfo = self._frames[:4]
-        extent = np.maximum(self._box[:, 1] - self._box[:, 0], self._box[:, 3] - self._box[:, 2])
+        box = self._box
+        extent = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2])
         pi = np.ascontiguousarray(cand[:, 0])
         pj = np.ascontiguousarray(cand[:, 1])
-        code, t_hit, t_contact, state, point, normal = sweep_pairs(
+        code, t_hit, t_contact, state = sweep_search(
             pi, pj, ids, self._bxy, self._ls, self._lo, self._nl, self._cen, self._pos,
             self._ang, self._rad, extent, motion, tint, tflt, tio, tfo, self._vmax,
             self._lmax, step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, _ULPS,
             CONTACT_RESOLUTION, int(max_iterations), _chunks(len(pi)))
         met = np.flatnonzero(state > 0)
         order = met[np.lexsort((pj[met], pi[met], t_contact[met]))]
-        for k in order[np.isnan(normal[order, 0])].tolist():
-            point[k], normal[k] = self._event_geometry(ids[pi[k]], ids[pj[k]], motion[pi[k]],
-                                                       motion[pj[k]], float(t_contact[k]))
+        i, j = pi[order], pj[order]
+        a, b = ids[i], ids[j]
+        times = t_contact[order]
+        events = (a, b, times, self._bxy, self._ls, self._lo.copy(), self._nl.copy(),
+                  self._cen, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
+                  self._rad[a], self._rad[b],
+                  RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i],
+                  motion[j], tint, tflt, tio.copy(), tfo.copy(), self._vmax, self._lmax,
+                  _ULPS)
         hit = np.where(code[order] == 2, 0.0, np.where(code[order] == 1, t_hit[order], np.nan))
-        return Sweep(np.stack([ids[pi[order]], ids[pj[order]]], axis=1), t_contact[order],
-                     state[order], point[order], normal[order], hit, code[order], step)
+        return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
+                     events)
 
     def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float) -> None:
         """Refuse motions that would carry a body's coordinates, its points' speeds or
@@ -1360,23 +1413,6 @@ class World:
             frame_tables(self._bxy, self._ls, self._lo, self._nl, self._cen, todo, tint, tflt,
                          tio, tfo)
         self._frames = (tint, tflt, tio, tfo, itop, ftop)
-
-    def _event_geometry(self, a: int, b: int, ma: np.ndarray, mb: np.ndarray,
-                        t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Point and normal of bodies a and b at time t of the sweep's motions, as
-        :func:`polycontact.classify` gives them (for bodies too large for the compiled
-        depth)."""
-        from .motion import Motion
-
-        shapes = []
-        for body, m in ((a, ma), (b, mb)):
-            motion = Motion(velocity=(m[0], m[1]), acceleration=(m[2], m[3]),
-                            angular_velocity=m[4], angular_acceleration=m[5])
-            shapes.append(self.body(body).shape.at(motion, t))
-        r = classify(shapes[0], shapes[1])
-        point = r.point if r.point is not None else np.full(2, np.nan)
-        normal = r.normal if r.normal is not None else np.full(2, np.nan)
-        return point, normal
 
     def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:
         """Every pair of bodies that meets within ``[0, t_max]`` as they follow their

@@ -170,16 +170,17 @@ def carrier(xa, sa, xb, sb, dx, dy):
 
 
 @njit(cache=True, nogil=True)
-def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc):
+def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids):
     """Geometry of a penetrating pair: ``(depth, nx, ny, px, py, area, cx, cy, side,
     vertex, edge)``, NaN depth when undecided here (see the module docstring)."""
     na = ya.shape[0]
     nb = yb.shape[0]
-    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, cross, ts, acc)
+    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, cross, ts, acc,
+                                       boxes, ids)
     if nc < 0:  # more crossings than the scratch holds: a buffer of the bodies' size
         big = np.empty((na * nb + 1, 6))
         area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, big,
-                                           np.empty(na * nb + na + nb + 3), acc)
+                                           np.empty(na * nb + na + nb + 3), acc, boxes, ids)
         cross = big
     if na + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
@@ -243,10 +244,11 @@ def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
     vertex, edge) for one pair in ``state`` (see the module docstring); ``buffers`` as
     :func:`geometry_buffers` makes them."""
     dist, normal, point, area, centroid, side, vert, edge = out
-    depth_buf, deg_a, deg_b, cross, ts, acc = buffers
+    depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids = buffers
     if state == PENETRATING:
         d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, depth_buf,
-                                                           deg_a, deg_b, cross, ts, acc)
+                                                           deg_a, deg_b, cross, ts, acc,
+                                                           boxes, ids)
         dist[k] = -d
     elif state == CONTACT:
         nx, ny, s, v, f = touch(ya, sa, yb, sb, e)
@@ -295,7 +297,8 @@ def geometry_buffers(vmax):
     m = min(vmax, FEW_VERTICES)
     cap = 8 * vmax + 64
     return (depth_buffers(m, m), np.empty(vmax, np.bool_), np.empty(vmax, np.bool_),
-            np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(3))
+            np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(3),
+            np.empty((vmax, 4)), np.empty(2 * vmax, np.int64))
 
 
 @njit(cache=True, nogil=True)
@@ -318,6 +321,9 @@ def pair_geometry(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, chunks):
     n = pi.shape[0]
     out = (np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n), np.empty((n, 2)),
            np.empty(n, np.int8), np.empty(n, np.int64), np.empty(n, np.int64))
+    if chunks == 1:
+        _geometry_range(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, 0, n, out)
+        return out
     for c in prange(chunks):
         _geometry_range(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, n * c // chunks,
                         n * (c + 1) // chunks, out)
@@ -330,14 +336,22 @@ def boundary_gaps(xy, ls, lo, nl, pi, pj, lmax, chunks):
     :func:`closest_features`), in parallel chunks."""
     n = pi.shape[0]
     out = np.empty(n)
+    if chunks == 1:
+        _gaps_range(xy, ls, lo, nl, pi, pj, lmax, 0, n, out)
+        return out
     for c in prange(chunks):
-        ba = np.empty(lmax + 1, np.int64)
-        bb = np.empty(lmax + 1, np.int64)
-        for k in range(n * c // chunks, n * (c + 1) // chunks):
-            ya, sa = _view(xy, ls, lo, nl, pi[k], ba)
-            yb, sb = _view(xy, ls, lo, nl, pj[k], bb)
-            out[k] = closest_features(ya, sa, yb, sb)[0]
+        _gaps_range(xy, ls, lo, nl, pi, pj, lmax, n * c // chunks, n * (c + 1) // chunks, out)
     return out
+
+
+@njit(cache=True, nogil=True)
+def _gaps_range(xy, ls, lo, nl, pi, pj, lmax, k0, k1, out):
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    for k in range(k0, k1):
+        ya, sa = _view(xy, ls, lo, nl, pi[k], ba)
+        yb, sb = _view(xy, ls, lo, nl, pj[k], bb)
+        out[k] = closest_features(ya, sa, yb, sb)[0]
 
 
 @njit(cache=True, nogil=True)
@@ -350,7 +364,8 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
     side, v, f = carrier(xa, sa, xb, sb, dx, dy)
     cross = np.empty((na * nb + 1, 6))
     nc = overlap_moments(xa, sa, xb, sb, e, np.empty(na, np.bool_), np.empty(nb, np.bool_),
-                         cross, np.empty(na * nb + na + nb + 3), np.empty(3))[3]
+                         cross, np.empty(na * nb + na + nb + 3), np.empty(3),
+                         np.empty((nb, 4)), np.empty(2 * nb, np.int64))[3]
     px, py = point_of(xa, sa, xb, sb, e, side, v, cross, nc)
     nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
     return nx, ny, px, py, side, v, f

@@ -89,7 +89,7 @@ def _edges_into(x, st, e, nxt):
 
 
 @njit(cache=True, nogil=True)
-def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
+def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
     """Append the kept segments of the vertices of one body (``xv``, loop starts ``sv``,
     edges ``ev`` of :func:`_edges`) against the edges of the other (``xe``, edges
     ``ee``, successors ``ne``) nearer than ``bound``: rows ``(x0, y0, x1, y1, squared
@@ -99,11 +99,23 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
     Kept: a vertex that may touch the edge (the other body's interior on its left)
     without overlap: convex, and both of its edges on the outer (right) side of the
     edge, each up to :data:`_SIN_SLACK` and ``slack`` (an absolute allowance for the
-    rounding of the coordinates) in the cross products.
+    rounding of the coordinates) in the cross products. ``near`` (one entry per vertex
+    of the other body) is scratch.
     """
     b2 = bound * bound
     # (the segments of vertex i lie in the box of v_i - (the other body's box))
     ex0, ex1, ey0, ey1 = _bbox(xe, xe.shape[0])
+    # only the edges whose boxes come within bound of V's box can hold one: listed in
+    # ``near`` (the rest are farther than bound from every vertex of V)
+    vx0, vx1, vy0, vy1 = _bbox(xv, xv.shape[0])
+    m = 0
+    for j in range(xe.shape[0]):
+        jj = ne[j]
+        if (min(xe[j, 0], xe[jj, 0]) < vx1 + bound and max(xe[j, 0], xe[jj, 0]) > vx0 - bound
+                and min(xe[j, 1], xe[jj, 1]) < vy1 + bound
+                and max(xe[j, 1], xe[jj, 1]) > vy0 - bound):
+            near[m] = j
+            m += 1
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
             gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])
@@ -115,7 +127,8 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
             vx, vy, lv = ev[i, 0], ev[i, 1], ev[i, 2]
             if (ux * vy - uy * vx) < -(_SIN_SLACK * lu * lv + slack * (lu + lv)):
                 continue  # reflex: its wedge overlaps any edge it touches
-            for j in range(xe.shape[0]):
+            for t in range(m):
+                j = near[t]
                 gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
                 if ((gx * vy - gy * vx) > _SIN_SLACK * lg * lv + slack * (lg + lv)
                         or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
@@ -290,11 +303,12 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
 @njit(cache=True, nogil=True)
 def depth_buffers(m, n):
     """Scratch of :func:`contact_depth_into` for bodies of up to ``m`` and ``n``
-    vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb)``."""
+    vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near)``."""
     k = 2 * m * n
     return (np.empty((k, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
             np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 3)),
-            np.empty(m, np.int64), np.empty((n, 3)), np.empty(n, np.int64))
+            np.empty(m, np.int64), np.empty((n, 3)), np.empty(n, np.int64),
+            np.empty(max(m, n), np.int64))
 
 
 @njit(cache=True, nogil=True)
@@ -305,14 +319,14 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
     segment it lies on, the vertex of one body brought onto the edge of the other (side
     0: a vertex of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows
     of each body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
-    seg, pts, ts, moved, scratch, ea, nxa, eb, nxb = buffers
+    seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near = buffers
     m = xa.shape[0]
     nb = xb.shape[0]
     tol = 4.0 * eps
     _edges_into(xa, sa, ea[:m], nxa[:m])
     _edges_into(xb, sb, eb[:nb], nxb[:nb])
-    n = _add_segments(xb, sb, eb, xa, ea, nxa, 1.0, bound, eps, seg, 0)
-    n = _add_segments(xa, sa, ea, xb, eb, nxb, -1.0, bound, eps, seg, n)
+    n = _add_segments(xb, sb, eb[:nb], xa, ea[:m], nxa[:m], 1.0, bound, eps, seg, 0, near)
+    n = _add_segments(xa, sa, ea[:m], xb, eb[:nb], nxb[:nb], -1.0, bound, eps, seg, n, near)
     moved = moved[:m]
     # Segments and pieces are taken in increasing distance (a linear scan each time:
     # a few of each): a segment is split when it is the nearest thing left, each piece
@@ -322,6 +336,23 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
     # (pieces' "tried" flags: column 3; the segment index: column 4; a segment is done
     # once its distance is set negative)
     c = 0
+    # The nearest segment's foot first: the nearest point of all, so the depth if it
+    # escapes (it then needs no split, which nearly parallel segments running together,
+    # as a flat face pressed on another, would refuse). Else it is kept as tried.
+    s = -1
+    for q in range(n):
+        if s < 0 or seg[q, 4] < seg[s, 4]:
+            s = q
+    if s >= 0 and seg[s, 4] < bound:
+        px, py, d = _foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+        if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
+            return d, px, py, True, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
+        pts[0, 0] = d
+        pts[0, 1] = px
+        pts[0, 2] = py
+        pts[0, 3] = 1.0
+        pts[0, 4] = s
+        c = 1
     while True:
         s = -1
         for q in range(n):

@@ -165,52 +165,81 @@ def _edge_box_meets(x, i, j, wx0, wx1, wy0, wy1):
 
 
 @njit(cache=True, nogil=True)
-def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross):
+def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, boxes, ids):
     """Proper crossings of A's and B's edges in the window: rows of ``cross`` =
     ``(edge of A, edge of B, t along A's edge, t along B's edge, x, y)``; an edge with
     an end within ``eps`` of an edge of the other body is marked in ``deg_a``/``deg_b``
-    (its pieces are classified by midpoints). Returns the count, or -1 when ``cross``
-    is too short."""
+    (its pieces are classified by midpoints). ``boxes`` (rows of 4) and ``ids`` (one
+    per vertex of B) are scratch: B's edges in the window. Returns the count, or -1
+    when ``cross`` is too short."""
+    m = 0
+    for kb in range(sb.shape[0] - 1):
+        for f in range(sb[kb], sb[kb + 1]):
+            f1 = _next(f, sb, kb)
+            x0 = min(xb[f, 0], xb[f1, 0])
+            x1 = max(xb[f, 0], xb[f1, 0])
+            y0 = min(xb[f, 1], xb[f1, 1])
+            y1 = max(xb[f, 1], xb[f1, 1])
+            if x1 < wx0 or x0 > wx1 or y1 < wy0 or y0 > wy1:
+                continue
+            boxes[m, 0] = x0 - eps
+            boxes[m, 1] = x1 + eps
+            boxes[m, 2] = y0 - eps
+            boxes[m, 3] = y1 + eps
+            ids[2 * m] = f
+            ids[2 * m + 1] = f1
+            m += 1
     c = 0
     for ka in range(sa.shape[0] - 1):
         for e in range(sa[ka], sa[ka + 1]):
             e1 = _next(e, sa, ka)
             px, py, qx, qy = xa[e, 0], xa[e, 1], xa[e1, 0], xa[e1, 1]
-            if not _edge_box_meets(xa, e, e1, wx0, wx1, wy0, wy1):
+            ex0 = min(px, qx)
+            ex1 = max(px, qx)
+            ey0 = min(py, qy)
+            ey1 = max(py, qy)
+            if ex1 < wx0 or ex0 > wx1 or ey1 < wy0 or ey0 > wy1:
                 continue
-            ex0 = min(px, qx) - eps
-            ex1 = max(px, qx) + eps
-            ey0 = min(py, qy) - eps
-            ey1 = max(py, qy) + eps
-            for kb in range(sb.shape[0] - 1):
-                for f in range(sb[kb], sb[kb + 1]):
-                    f1 = _next(f, sb, kb)
-                    if not _edge_box_meets(xb, f, f1, ex0, ex1, ey0, ey1):
-                        continue
-                    rx, ry, sx, sy = xb[f, 0], xb[f, 1], xb[f1, 0], xb[f1, 1]
-                    if (_point_segment_distance(px, py, rx, ry, sx, sy) <= eps
-                            or _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps
-                            or _point_segment_distance(rx, ry, px, py, qx, qy) <= eps
-                            or _point_segment_distance(sx, sy, px, py, qx, qy) <= eps):
-                        deg_a[e] = True
-                        deg_b[f] = True
-                        continue
-                    o1 = _orient(px, py, qx, qy, rx, ry)
-                    o2 = _orient(px, py, qx, qy, sx, sy)
-                    o3 = _orient(rx, ry, sx, sy, px, py)
-                    o4 = _orient(rx, ry, sx, sy, qx, qy)
-                    if (o1 > 0.0) == (o2 > 0.0) or (o3 > 0.0) == (o4 > 0.0):
-                        continue
-                    if c == cross.shape[0]:
-                        return -1
-                    te = o3 / (o3 - o4)
-                    cross[c, 0] = e
-                    cross[c, 1] = f
-                    cross[c, 2] = te
-                    cross[c, 3] = o1 / (o1 - o2)
-                    cross[c, 4] = px + te * (qx - px)
-                    cross[c, 5] = py + te * (qy - py)
-                    c += 1
+            # squared: "an end farther than eps from the other edge's line"
+            e_pq = eps * eps * ((qx - px) ** 2 + (qy - py) ** 2)
+            for g in range(m):
+                if (boxes[g, 0] > ex1 or boxes[g, 1] < ex0 or boxes[g, 2] > ey1
+                        or boxes[g, 3] < ey0):
+                    continue
+                f = ids[2 * g]
+                f1 = ids[2 * g + 1]
+                rx, ry, sx, sy = xb[f, 0], xb[f, 1], xb[f1, 0], xb[f1, 1]
+                o1 = _orient(px, py, qx, qy, rx, ry)
+                o2 = _orient(px, py, qx, qy, sx, sy)
+                far_pq = o1 * o1 > e_pq and o2 * o2 > e_pq
+                if far_pq and (o1 > 0.0) == (o2 > 0.0):
+                    continue  # B's edge on one side of A's line, beyond eps
+                o3 = _orient(rx, ry, sx, sy, px, py)
+                o4 = _orient(rx, ry, sx, sy, qx, qy)
+                e_rs = eps * eps * ((sx - rx) ** 2 + (sy - ry) ** 2)
+                far_rs = o3 * o3 > e_rs and o4 * o4 > e_rs
+                if far_rs and (o3 > 0.0) == (o4 > 0.0):
+                    continue
+                if not (far_pq and far_rs) and (
+                        _point_segment_distance(px, py, rx, ry, sx, sy) <= eps
+                        or _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps
+                        or _point_segment_distance(rx, ry, px, py, qx, qy) <= eps
+                        or _point_segment_distance(sx, sy, px, py, qx, qy) <= eps):
+                    deg_a[e] = True
+                    deg_b[f] = True
+                    continue
+                if (o1 > 0.0) == (o2 > 0.0) or (o3 > 0.0) == (o4 > 0.0):
+                    continue
+                if c == cross.shape[0]:
+                    return -1
+                te = o3 / (o3 - o4)
+                cross[c, 0] = e
+                cross[c, 1] = f
+                cross[c, 2] = te
+                cross[c, 3] = o1 / (o1 - o2)
+                cross[c, 4] = px + te * (qx - px)
+                cross[c, 5] = py + te * (qy - py)
+                c += 1
     return c
 
 
@@ -271,14 +300,15 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
 
 
 @njit(cache=True, nogil=True)
-def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc):
+def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, ids):
     """Area and centroid of A ∩ B: ``(area, cx, cy, crossings)``; the proper crossings
     of the boundaries are left in ``cross[:crossings]`` (rows as :func:`_crossings`
     writes them), -1 when ``cross`` is too short (nothing else computed).
 
     ``deg_a``, ``deg_b`` (bool, one per vertex of A and of B), ``cross`` (rows of 6),
-    ``ts`` (at least the vertices of both bodies plus crossings plus 2) and ``acc`` (3)
-    are scratch.
+    ``ts`` (at least the vertices of both bodies plus crossings plus 2), ``acc`` (3),
+    ``boxes`` (a row of 4 per vertex of B) and ``ids`` (2 per vertex of B) are
+    scratch.
     The area is 0 (and the centroid NaN) when the interiors do not overlap by more
     than the rounding.
 
@@ -289,7 +319,7 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc):
     >>> st = np.array([0, 4])
     >>> got = overlap_moments(sq, st, sq + 1.0, st, 1e-12, np.zeros(4, np.bool_),
     ...                       np.zeros(4, np.bool_), np.empty((16, 6)), np.empty(32),
-    ...                       np.empty(3))
+    ...                       np.empty(3), np.empty((4, 4)), np.empty(8, np.int64))
     >>> [float(v) for v in got]
     [1.0, 1.5, 1.5, 2.0]
     """
@@ -305,7 +335,7 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc):
         return 0.0, np.nan, np.nan, 0
     deg_a[:na] = False
     deg_b[:nb] = False
-    nc = _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross)
+    nc = _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, boxes, ids)
     if nc < 0:
         return 0.0, np.nan, np.nan, -1
     ox = 0.5 * (wx0 + wx1)

@@ -195,9 +195,12 @@ def pose_rows(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, c
     In parallel chunks (``chunks`` = 1: serial, no thread start). Returns the largest
     |coordinate| and the largest tolerance written."""
     n = ids.shape[0]
-    for c in prange(chunks):
-        _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps,
-                    n * c // chunks, n * (c + 1) // chunks)
+    if chunks == 1:
+        _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, 0, n)
+    else:
+        for c in prange(chunks):
+            _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps,
+                        n * c // chunks, n * (c + 1) // chunks)
     big = 0.0
     emax = 0.0
     for k in range(n):

@@ -61,14 +61,14 @@ def frame_tables(bxy, ls, lo, nl, cen, bodies, tint, tflt, tio, tfo):
 
 
 @njit(cache=True, nogil=True)
-def _frame(b, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, r, circles, r_len, st):
-    """Body b in its frame turned by ``ang[b]``: its rows ``r`` and circles (written into
+def _frame(b, turn, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, r, circles, r_len, st):
+    """Body b in its frame turned by ``turn``: its rows ``r`` and circles (written into
     the given scratch), its starts and tables; returns ``(r, starts, table)``."""
     f = ls[lo[b]]
     n = ls[lo[b] + nl[b]] - f
     m = 2 * n - 1
-    cs = math.cos(ang[b])
-    sn = math.sin(ang[b])
+    cs = math.cos(turn)
+    sn = math.sin(turn)
     cx = cen[b, 0]
     cy = cen[b, 1]
     for i in range(n):
@@ -97,44 +97,38 @@ def _frame(b, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, r, circles, r_len
 
 
 @njit(cache=True, nogil=True)
-def _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
-                 tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
-                 max_iter, k0, k1, out):
-    code, t_hi, t_contact, state, point, normal = out
-    ra = np.empty((vmax, 2))
-    rb = np.empty((vmax, 2))
-    ca_ = np.empty((2 * vmax, 4))
-    cb_ = np.empty((2 * vmax, 4))
-    la_ = np.empty(vmax)
-    lb_ = np.empty(vmax)
-    sta = np.empty(lmax + 1, np.int64)
-    stb = np.empty(lmax + 1, np.int64)
-    xa = np.empty((vmax, 2))
-    xb = np.empty((vmax, 2))
+def _frames_of(a, ta, b, tb, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, scratch):
+    """:func:`_frame` of bodies a and b (turned by ``ta``, ``tb``) into the two halves
+    of ``scratch``."""
+    ra, rb, ca, cb, la, lb, sta, stb = scratch
+    fa = _frame(a, ta, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, ra, ca, la, sta)
+    fb = _frame(b, tb, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, rb, cb, lb, stb)
+    return fa, fb
+
+
+@njit(cache=True, nogil=True)
+def _frame_scratch(vmax, lmax):
+    return (np.empty((vmax, 2)), np.empty((vmax, 2)), np.empty((2 * vmax, 4)),
+            np.empty((2 * vmax, 4)), np.empty(vmax), np.empty(vmax),
+            np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+
+
+@njit(cache=True, nogil=True)
+def _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
+                  tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
+                  max_iter, k0, k1, out):
+    code, t_hi, t_contact, state = out
+    fs = _frame_scratch(vmax, lmax)
     work = np.empty(work_floats(2 * vmax))
-    scratch = _scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
-    buffers = geometry_buffers(vmax)
-    m = k1 - k0
-    dist = np.empty(m)
-    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
-            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
     for k in range(k0, k1):
-        p = pi[k]
-        q = pj[k]
-        a = ids[p]
-        b = ids[q]
-        r1, s1, e1 = _frame(a, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, ra, ca_, la_,
-                            sta)
-        r2, s2, e2 = _frame(b, bxy, ls, lo, nl, cen, ang, tint, tflt, tio, tfo, rb, cb_, lb_,
-                            stb)
-        ma = motion[p]
-        mb = motion[q]
-        c1 = pos[a]
-        c2 = pos[b]
-        eps_rel = rel * max(extent[a], extent[b])
-        lam = resolution * (rad[a] + rad[b])
-        got = exact_query(r1, s1, c1, ma, rad[a], e1, r2, s2, c2, mb, rad[b], e2, t_max,
-                          inflate, time_tol, eps_rel, ulps, lam, max_iter, work)
+        a = ids[pi[k]]
+        b = ids[pj[k]]
+        (r1, s1, e1), (r2, s2, e2) = _frames_of(a, ang[a], b, ang[b], bxy, ls, lo, nl, cen,
+                                                 tint, tflt, tio, tfo, fs)
+        got = exact_query(r1, s1, pos[a], motion[pi[k]], rad[a], e1, r2, s2, pos[b],
+                          motion[pj[k]], rad[b], e2, t_max, inflate, time_tol,
+                          rel * max(extent[a], extent[b]), ulps,
+                          resolution * (rad[a] + rad[b]), max_iter, work)
         c = got[1]
         code[k] = c
         t_hi[k] = got[2]
@@ -142,16 +136,56 @@ def _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motio
         if c == 3 and t < 0.0:
             t = got[6]
         t_contact[k] = t
-        if t < 0.0:
-            state[k] = 0
-            continue
-        state[k] = 2 if c == 1 or c == 2 else 1
-        # the contact's point and normal, where the bodies are at that time
-        place(r1, c1, ma, t, xa[:r1.shape[0]])
-        place(r2, c2, mb, t, xb[:r2.shape[0]])
+        state[k] = 0 if t < 0.0 else (2 if c == 1 or c == 2 else 1)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def sweep_search(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
+                 tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
+                 max_iter, chunks):
+    """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
+    ``ids[pj[k]]``), the bodies moving with the rows of ``motion`` (``[vx, vy, ax, ay,
+    ω, α]``, indexed like ``ids``) over [0, ``t_max``], in parallel chunks (``chunks``
+    = 1: serial). Returns ``(code, t_hi, t_contact, state)``: the search's status code
+    and penetration time (as ``exact_query``), the first contact time (0 when
+    penetrating at the start; the time reached by a search without a verdict; -1 when
+    they never touch), and 2 when they penetrate within the step, 1 when they only
+    touch, 0 when they never do."""
+    n = pi.shape[0]
+    out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8))
+    if chunks == 1:
+        _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
+                      tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
+                      resolution, max_iter, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
+                      tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
+                      resolution, max_iter, n * c // chunks, n * (c + 1) // chunks, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel, ma,
+                 mb, tint, tflt, tio, tfo, vmax, lmax, ulps, k0, k1, point, normal):
+    fs = _frame_scratch(vmax, lmax)
+    xa = np.empty((vmax, 2))
+    xb = np.empty((vmax, 2))
+    scratch = _scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
+    buffers = geometry_buffers(vmax)
+    m = k1 - k0
+    dist = np.empty(m)
+    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
+            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
+    for k in range(k0, k1):
+        (r1, s1, _), (r2, s2, _) = _frames_of(pa[k], ta[k], pb[k], tb[k], bxy, ls, lo, nl,
+                                               cen, tint, tflt, tio, tfo, fs)
+        t = times[k]
         ya = xa[:r1.shape[0]]
         yb = xb[:r2.shape[0]]
-        eps = _eps_at(c1, ma, rad[a], c2, mb, rad[b], t, eps_rel, ulps)
+        place(r1, ca[k], ma[k], t, ya)
+        place(r2, cb[k], mb[k], t, yb)
+        eps = _eps_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
         now = _placed_state(ya, s1, yb, s2, eps, scratch)
         pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
         if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
@@ -160,22 +194,23 @@ def _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motio
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def sweep_pairs(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
-                tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
-                max_iter, chunks):
-    """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
-    ``ids[pj[k]]``), the bodies moving with the rows of ``motion`` (``[vx, vy, ax, ay,
-    ω, α]``, indexed like ``ids``) over [0, ``t_max``], in parallel chunks. Returns
-    ``(code, t_hi, t_contact, state, point, normal)``: the search's status code and
-    penetration time (as ``exact_query``), the first contact time (0 when penetrating
-    at the start; the time reached by a search without a verdict; -1 when they never
-    touch), 2 when they penetrate within the step and 1 when they only touch (0: never),
-    and the point and normal of the contact at its time."""
-    n = pi.shape[0]
-    out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8),
-           np.full((n, 2), np.nan), np.full((n, 2), np.nan))
+def event_geometry(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel, ma,
+                   mb, tint, tflt, tio, tfo, vmax, lmax, ulps, chunks):
+    """The contact point and normal of bodies ``pa[k]`` and ``pb[k]`` at ``times[k]``,
+    each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]`` (``tb[k]``)
+    with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact search's
+    tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``) and described by
+    :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN normals where
+    the depth is left undecided. In parallel chunks."""
+    n = pa.shape[0]
+    point = np.full((n, 2), np.nan)
+    normal = np.full((n, 2), np.nan)
+    if chunks == 1:
+        _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel,
+                     ma, mb, tint, tflt, tio, tfo, vmax, lmax, ulps, 0, n, point, normal)
+        return point, normal
     for c in prange(chunks):
-        _sweep_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
-                     tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
-                     resolution, max_iter, n * c // chunks, n * (c + 1) // chunks, out)
-    return out
+        _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel,
+                     ma, mb, tint, tflt, tio, tfo, vmax, lmax, ulps, n * c // chunks,
+                     n * (c + 1) // chunks, point, normal)
+    return point, normal
