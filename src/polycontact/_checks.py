@@ -104,6 +104,9 @@ def real_array(value: Any, what: str, shape: tuple[int, ...]) -> np.ndarray:
     """
     try:
         raw = np.asarray(value)
+        if not isinstance(value, np.ndarray) and raw.dtype.kind != "O":
+            # nested sequences: NumPy would turn a bool among numbers into a number
+            raw = np.asarray(value, dtype=object) if raw.dtype.kind in "biu" else raw
     except (TypeError, ValueError):
         raise ValueError(f"{what}: expected an array of shape {shape}, got "
                          f"{type(value).__name__}") from None

@@ -148,8 +148,8 @@ class Contacts:
     points : ndarray of shape (K, 2), float64
         A contact point: the midpoint of the closest points when apart, the touching
         vertex at contact; when penetrating, a point of the overlap's boundary: the
-        vertex of the contact segment that carries the depth when it lies in the other
-        body, else the boundaries' crossing nearest it.
+        vertex of the contact segment that carries the depth when it lies inside the
+        other body, else the boundaries' crossing nearest it.
     overlap_areas : ndarray of shape (K,), float64
         Area of the intersection of the two bodies (holes excluded); 0 unless they
         penetrate.

@@ -191,7 +191,7 @@ def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, box
         return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
     if side < 0:
         side, v, f = carrier(ya, sa, yb, sb, dx, dy)
-    px, py = point_of(ya, sa, yb, sb, e, side, v, cross, nc)
+    px, py = point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc)
     nx, ny = normal_of(ya, sa, yb, sb, d, dx, dy, side, f)
     return d, nx, ny, px, py, area, cx, cy, side, v, f
 
@@ -216,16 +216,19 @@ def normal_of(ya, sa, yb, sb, d, dx, dy, side, f):
 
 
 @njit(cache=True, nogil=True)
-def point_of(ya, sa, yb, sb, e, side, v, cross, nc):
+def point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc):
     """A point of the overlap's boundary for a penetrating pair: the carrying vertex
-    ``v`` (of A for side 0, of B for side 1) when it lies in the other body, else the
-    boundaries' crossing nearest it (``cross[:nc]``, rows of
-    :func:`polycontact._kernels.overlap.overlap_moments`), else the vertex."""
+    ``v`` (of A for side 0, of B for side 1) when it lies inside the other body, else
+    the boundaries' crossing nearest it (``cross[:nc]``, rows of
+    :func:`polycontact._kernels.overlap.overlap_moments`), else the point of the
+    boundary that kernel left in ``acc``."""
     xv, xo, so = (ya, yb, sb) if side == 0 else (yb, ya, sa)
     px = xv[v, 0]
     py = xv[v, 1]
-    if nc == 0 or where(px, py, xo, so, e) >= 0:
+    if where(px, py, xo, so, e) > 0:
         return px, py
+    if nc == 0:
+        return (acc[4], acc[5]) if acc[3] == 1.0 else (px, py)
     best = np.inf
     qx = px
     qy = py
@@ -297,7 +300,7 @@ def geometry_buffers(vmax):
     m = min(vmax, FEW_VERTICES)
     cap = 8 * vmax + 64
     return (depth_buffers(m, m), np.empty(vmax, np.bool_), np.empty(vmax, np.bool_),
-            np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(3),
+            np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(6),
             np.empty((vmax, 4)), np.empty(2 * vmax, np.int64))
 
 
@@ -363,10 +366,11 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
     nb = xb.shape[0]
     side, v, f = carrier(xa, sa, xb, sb, dx, dy)
     cross = np.empty((na * nb + 1, 6))
+    acc = np.empty(6)
     nc = overlap_moments(xa, sa, xb, sb, e, np.empty(na, np.bool_), np.empty(nb, np.bool_),
-                         cross, np.empty(na * nb + na + nb + 3), np.empty(3),
-                         np.empty((nb, 4)), np.empty(2 * nb, np.int64))[3]
-    px, py = point_of(xa, sa, xb, sb, e, side, v, cross, nc)
+                         cross, np.empty(na * nb + na + nb + 3), acc, np.empty((nb, 4)),
+                         np.empty(2 * nb, np.int64))[3]
+    px, py = point_of(xa, sa, xb, sb, e, side, v, cross, nc, acc)
     nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
     return nx, ny, px, py, side, v, f
 

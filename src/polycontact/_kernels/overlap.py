@@ -78,7 +78,12 @@ def _on_same_way(px, py, ux, uy, x, starts, eps):
 @njit(cache=True, nogil=True, inline="always")
 def _green(ux, uy, vx, vy, ox, oy, acc):
     """Add the piece u → v (from the origin (ox, oy)) to ``acc`` = (2 area, 6 area cx,
-    6 area cy) relative to the origin."""
+    6 area cy) relative to the origin; the first piece's midpoint goes to ``acc[4:6]``
+    (``acc[3]`` set to 1: a point of the intersection's boundary)."""
+    if acc[3] == 0.0:
+        acc[3] = 1.0
+        acc[4] = 0.5 * (ux + vx)
+        acc[5] = 0.5 * (uy + vy)
     ax = ux - ox
     ay = uy - oy
     bx = vx - ox
@@ -306,9 +311,10 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     writes them), -1 when ``cross`` is too short (nothing else computed).
 
     ``deg_a``, ``deg_b`` (bool, one per vertex of A and of B), ``cross`` (rows of 6),
-    ``ts`` (at least the vertices of both bodies plus crossings plus 2), ``acc`` (3),
-    ``boxes`` (a row of 4 per vertex of B) and ``ids`` (2 per vertex of B) are
-    scratch.
+    ``ts`` (at least the vertices of both bodies plus crossings plus 2), ``boxes`` (a
+    row of 4 per vertex of B) and ``ids`` (2 per vertex of B) are scratch; ``acc`` (6)
+    receives in ``acc[4:6]`` a point of the intersection's boundary (the midpoint of
+    a piece of it) when ``acc[3]`` is 1.
     The area is 0 (and the centroid NaN) when the interiors do not overlap by more
     than the rounding.
 
@@ -319,10 +325,11 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     >>> st = np.array([0, 4])
     >>> got = overlap_moments(sq, st, sq + 1.0, st, 1e-12, np.zeros(4, np.bool_),
     ...                       np.zeros(4, np.bool_), np.empty((16, 6)), np.empty(32),
-    ...                       np.empty(3), np.empty((4, 4)), np.empty(8, np.int64))
+    ...                       np.empty(6), np.empty((4, 4)), np.empty(8, np.int64))
     >>> [float(v) for v in got]
     [1.0, 1.5, 1.5, 2.0]
     """
+    acc[:] = 0.0
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
     ba = _bbox(xa, na)
@@ -340,7 +347,6 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
         return 0.0, np.nan, np.nan, -1
     ox = 0.5 * (wx0 + wx1)
     oy = 0.5 * (wy0 + wy1)
-    acc[:] = 0.0
     _boundary_inside(xa, sa, xb, sb, eps, bb, wx0, wx1, wy0, wy1, deg_a, cross, nc, 0,
                      True, ts, ox, oy, acc)
     _boundary_inside(xb, sb, xa, sa, eps, ba, wx0, wx1, wy0, wy1, deg_b, cross, nc, 1,
