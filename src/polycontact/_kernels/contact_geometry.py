@@ -53,7 +53,7 @@ def closest_features(xa, sa, xb, sb):
     >>> st = np.array([0, 4])
     >>> got = closest_features(sq, st, sq + np.array([3.0, 0.5]), st)
     >>> [float(v) for v in got[:5]], got[5:]
-    ([2.0, 1.0, 0.5, 3.0, 0.5], (1, 0, 1))
+    ([2.0, 1.0, 1.0, 3.0, 1.0], (0, 2, 3))
     """
     best = np.inf
     out = (np.inf, 0.0, 0.0, 0.0, 0.0, -1, -1, -1)
