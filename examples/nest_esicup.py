@@ -34,7 +34,7 @@ def candidates(region: shapely.Geometry) -> np.ndarray:
     return np.concatenate(pts) if pts else np.empty((0, 2))
 
 
-def nest(instance: pc.esicup.Instance) -> tuple[pc.World, float, float]:
+def nest(instance: pc.Instance) -> tuple[pc.World, float, float]:
     """The filled strip, its used length and the density of the pieces in it."""
     height = instance.strip_height
     pieces = []
