@@ -93,8 +93,10 @@ def main() -> None:
     print(f"  pairs in contact {int((c.states == 1).sum())}, penetrating 0, "
           f"all pieces inside the strip")
     if args.plot:
-        import matplotlib
-
+        try:
+            import matplotlib
+        except ImportError:
+            raise SystemExit("--plot needs matplotlib: pip install 'polycontact[plot]'") from None
         matplotlib.use("Agg")
         strip = pc.World(pc.Shape([(0, 0), (length, 0), (length, instance.strip_height),
                                    (0, instance.strip_height)]))
