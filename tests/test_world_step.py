@@ -301,7 +301,7 @@ def test_geometry_in_parallel_chunks_equals_one_chunk(monkeypatch):
     world = pc.World()
     world.add_many(items, rng.uniform(0, 12, (60, 2)), rng.uniform(-3, 3, 60))
     one = world.contacts(margin=0.5)
-    monkeypatch.setattr(world_module, "_chunks", lambda count: 3)
+    monkeypatch.setattr(world_module, "_chunks", lambda count, work=1.0: 3)
     many = world.contacts(margin=0.5)
     assert one.pairs.tolist() == many.pairs.tolist()
     for name in ("distances", "normals", "points", "overlap_areas", "overlap_centroids",
@@ -429,7 +429,7 @@ def test_sweep_in_parallel_chunks_equals_one_chunk(monkeypatch):
     world.add_many(items, rng.uniform(0, 14, (40, 2)), rng.uniform(-3, 3, 40))
     vel, spin = rng.normal(0, 2, (40, 2)), rng.normal(0, 2, 40)
     one = world.sweep(0.5, vel, spin)
-    monkeypatch.setattr(world_module, "_chunks", lambda count: 3)
+    monkeypatch.setattr(world_module, "_chunks", lambda count, work=1.0: 3)
     many = world.sweep(0.5, vel, spin)
     for name in ("pairs", "times", "states", "penetration_times", "status", "points",
                  "normals"):
@@ -445,3 +445,13 @@ def test_the_dem_example_runs_a_small_hopper(tmp_path, monkeypatch):
                            "--out", str(out)])
     assert out.stat().st_size > 0
     assert got["checked"] == 3 and got["skipped"] == 0
+
+
+def test_near_pairs_are_listed_separate_and_drawn_as_neither_contact_nor_penetration():
+    world = pc.World()
+    world.add_many([body(3, 1.0, "shape")] * 2, [(0.5, 0.5), (1.75, 0.5)])
+    c = world.contacts(margin=0.5)
+    assert c.states.tolist() == [0] and c.distances.tolist() == [0.25]
+    assert c.to_dict()["contacts"][0]["state"] == "separate"
+    assert c.plot().get_title() == "2 bodies: 0 contacts, 0 penetrating pairs, 0 outside the " \
+                                   "container"

@@ -81,11 +81,20 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 }
 
 
-def _chunks(count: int) -> int:
-    """Parallel chunks for ``count`` items: 1 (serial, no thread start) below 4096."""
+#: Work, in units of one pair's classification (about half a microsecond), below which
+#: a compiled pass runs on the calling thread (starting threads would cost more).
+_SERIAL_WORK = 4096
+#: The work of one item of the passes that are not classifications, in those units.
+_POSE_WORK = 0.5  # placing a body (a 12-gon) and updating its box
+_GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
+
+
+def _chunks(count: int, work: float = 1.0) -> int:
+    """Parallel chunks for ``count`` items of ``work`` each: 1 (serial, no thread start)
+    below :data:`_SERIAL_WORK` in all, else four per Numba thread."""
     import numba
 
-    return 1 if count < 4096 else 4 * numba.get_num_threads()
+    return 1 if count * work < _SERIAL_WORK else 4 * numba.get_num_threads()
 
 
 @dataclass(frozen=True)
@@ -388,7 +397,7 @@ class Sweep:
         from ._kernels.world_sweep import event_geometry
 
         ev = self._events
-        point, normal = event_geometry(*ev, _chunks(len(self.times)))
+        point, normal = event_geometry(*ev, _chunks(len(self.times), _GEOMETRY_WORK))
         for k in np.flatnonzero(np.isnan(normal[:, 0])).tolist():
             point[k], normal[k] = _event_by_shapes(ev, k)
         point.flags.writeable = False
@@ -519,7 +528,8 @@ def _contact_geometry(store: tuple[Any, ...], pairs: np.ndarray, states: np.ndar
     pi = np.ascontiguousarray(pairs[:, 0])
     pj = np.ascontiguousarray(pairs[:, 1])
     dist, normal, point, area, cen, side, vert, edge = kg.pair_geometry(
-        xy, ls, lo, nl, pi, pj, states, tolerances, vmax, lmax, _chunks(len(pi)))
+        xy, ls, lo, nl, pi, pj, states, tolerances, vmax, lmax,
+        _chunks(len(pi), _GEOMETRY_WORK))
     for k in np.flatnonzero(np.isnan(dist)).tolist():
         # a depth the contact segments leave undecided: the search over convex sums
         from ._kernels.depth import penetration
@@ -803,7 +813,8 @@ class World:
         if placed and count:
             _, emax = pose_rows(ids, self._bxy, self._xy, self._ls, self._lo, self._nl,
                                 self._cen, p[:, 0].copy(), p[:, 1].copy(), a, self._box,
-                                self._eps, RELATIVE_TOLERANCE, ROUNDING_ULPS, _chunks(count))
+                                self._eps, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                                _chunks(count, _POSE_WORK))
             self._emax = max(self._emax, float(emax))
         self._pos[ids] = p
         self._ang[ids] = a
@@ -957,7 +968,7 @@ class World:
         _, emax = pose_rows(idx, self._bxy, self._xy, self._ls, self._lo, self._nl, self._cen,
                             np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
                             np.ascontiguousarray(ang), self._box, self._eps,
-                            RELATIVE_TOLERANCE, ROUNDING_ULPS, _chunks(len(idx)))
+                            RELATIVE_TOLERANCE, ROUNDING_ULPS, _chunks(len(idx), _POSE_WORK))
         self._emax = max(self._emax, float(emax))
         self._pos[idx] = pos
         self._ang[idx] = ang
@@ -1359,7 +1370,7 @@ class World:
             pi, pj, ids, self._bxy, self._ls, self._lo, self._nl, self._cen, self._pos,
             self._ang, self._rad, extent, motion, tint, tflt, tio, tfo, self._vmax,
             self._lmax, step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, _ULPS,
-            CONTACT_RESOLUTION, int(max_iterations), _chunks(len(pi)))
+            CONTACT_RESOLUTION, int(max_iterations), _chunks(len(pi), _GEOMETRY_WORK))
         met = np.flatnonzero(state > 0)
         order = met[np.lexsort((pj[met], pi[met], t_contact[met]))]
         i, j = pi[order], pj[order]
