@@ -16,7 +16,7 @@ import polycontact as pc
 from polycontact._kernels import contact_geometry as kg
 from polycontact._kernels.convolution import contact_depth_into, depth_buffers
 from polycontact._kernels.depth import box_escape
-from polycontact._kernels.overlap import overlap_moments
+from polycontact._kernels.overlap import overlap_moments, where
 from polycontact._kernels.poses import centroids, pairwise_sum
 
 SHAPES = [
@@ -41,14 +41,15 @@ def make(spec, frame):
     return s.moved((x * scale + offset * scale, y * scale + offset * scale), a)
 
 
-def moments(a: pc.Shape, b: pc.Shape, eps: float):
+def moments(a: pc.Shape, b: pc.Shape, eps: float, places=None):
     (xa, sa), (xb, sb) = a.packed, b.packed
     n = len(xa) + len(xb)
     acc = np.empty(6)
+    places = places or (np.empty(len(xa), np.int8), np.empty(len(xb), np.int8))
     got = overlap_moments(xa, sa, xb, sb, eps, np.empty(len(xa), np.bool_),
                           np.empty(len(xb), np.bool_), np.empty((n * n, 6)),
                           np.empty(n * n + n + 2), acc, np.empty((len(xb), 4)),
-                          np.empty(2 * len(xb), np.int64))
+                          np.empty(2 * len(xb), np.int64), *places)
     return got, acc
 
 
@@ -90,6 +91,19 @@ def test_overlap_area_and_centroid_equal_shapely_intersection(sa, sb, frame):
         assert math.isnan(cx) and math.isnan(cy)
 
 
+@examples(100)
+@given(placed, placed, frames)
+def test_the_overlap_walk_knows_where_every_vertex_lies(sa, sb, frame):
+    a, b = make(sa, frame), make(sb, frame)
+    eps = pc.default_tolerance(a.packed[0], b.packed[0])
+    places = (np.empty(a.n_vertices, np.int8), np.empty(b.n_vertices, np.int8))
+    moments(a, b, eps, places)
+    for own, other, got in ((a, b, places[0]), (b, a, places[1])):
+        xo, so = other.packed
+        want = [where(x, y, xo, so, eps) for x, y in own.packed[0]]
+        assert got.tolist() == want
+
+
 def test_overlap_of_shared_and_collinear_boundaries():
     sq = pc.Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
     frame = pc.Shape([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]])
@@ -126,7 +140,7 @@ def test_the_depth_segment_takes_its_vertex_onto_its_edge(sa, sb, frame):
     (xa, sta), (xb, stb) = a.packed, b.packed
     if len(xa) + len(xb) > 64:
         return
-    got = contact_depth_into(xa, sta, xb, stb, *box_escape(xa, xb), r.tolerance,
+    got = contact_depth_into(xa, sta, xb, stb, *box_escape(xa, xb), r.tolerance, 0.0,
                              depth_buffers(len(xa), len(xb)))
     depth, dx, dy, ok, side, v, f = got
     if not ok:

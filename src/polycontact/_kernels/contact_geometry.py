@@ -170,22 +170,27 @@ def carrier(xa, sa, xb, sb, dx, dy):
 
 
 @njit(cache=True, nogil=True)
-def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids):
+def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids,
+                 where_a, where_b):
     """Geometry of a penetrating pair: ``(depth, nx, ny, px, py, area, cx, cy, side,
     vertex, edge)``, NaN depth when undecided here (see the module docstring)."""
     na = ya.shape[0]
     nb = yb.shape[0]
     area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, cross, ts, acc,
-                                       boxes, ids)
+                                       boxes, ids, where_a, where_b)
     if nc < 0:  # more crossings than the scratch holds: a buffer of the bodies' size
         big = np.empty((na * nb + 1, 6))
         area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, big,
-                                           np.empty(na * nb + na + nb + 3), acc, boxes, ids)
+                                           np.empty(na * nb + na + nb + 3), acc, boxes, ids,
+                                           where_a, where_b)
         cross = big
     if na + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
     bound, bdx, bdy = box_escape(ya, yb)
-    d, dx, dy, ok, side, v, f = contact_depth_into(ya, sa, yb, sb, bound, bdx, bdy, e,
+    # A vertex inside the other body by more than a length keeps the bodies penetrating
+    # through any translation shorter than it (less the tolerance): no test there.
+    low = max(_deepest(ya, where_a, yb, sb), _deepest(yb, where_b, ya, sa)) - 2.0 * e
+    d, dx, dy, ok, side, v, f = contact_depth_into(ya, sa, yb, sb, bound, bdx, bdy, e, low,
                                                    depth_buf)
     if not ok:
         return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
@@ -194,6 +199,26 @@ def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, box
     px, py = point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc)
     nx, ny = normal_of(ya, sa, yb, sb, d, dx, dy, side, f)
     return d, nx, ny, px, py, area, cx, cy, side, v, f
+
+
+@njit(cache=True, nogil=True)
+def _deepest(xv, where_v, xo, so):
+    """The largest distance from the other body's boundary ``(xo, so)`` of the vertices
+    of ``xv`` that ``where_v`` says lie inside it (0 when none does)."""
+    best = 0.0
+    for i in range(xv.shape[0]):
+        if where_v[i] != 1:
+            continue
+        px = xv[i, 0]
+        py = xv[i, 1]
+        near = np.inf
+        for k in range(so.shape[0] - 1):
+            for f in range(so[k], so[k + 1]):
+                g = _next(f, so, k)
+                near = min(near, closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0],
+                                                    xo[g, 1])[2])
+        best = max(best, near)
+    return np.sqrt(best)
 
 
 @njit(cache=True, nogil=True)
@@ -247,11 +272,11 @@ def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
     vertex, edge) for one pair in ``state`` (see the module docstring); ``buffers`` as
     :func:`geometry_buffers` makes them."""
     dist, normal, point, area, centroid, side, vert, edge = out
-    depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids = buffers
+    depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids, where_a, where_b = buffers
     if state == PENETRATING:
         d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, depth_buf,
                                                            deg_a, deg_b, cross, ts, acc,
-                                                           boxes, ids)
+                                                           boxes, ids, where_a, where_b)
         dist[k] = -d
     elif state == CONTACT:
         nx, ny, s, v, f = touch(ya, sa, yb, sb, e)
@@ -301,7 +326,8 @@ def geometry_buffers(vmax):
     cap = 8 * vmax + 64
     return (depth_buffers(m, m), np.empty(vmax, np.bool_), np.empty(vmax, np.bool_),
             np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(6),
-            np.empty((vmax, 4)), np.empty(2 * vmax, np.int64))
+            np.empty((vmax, 4)), np.empty(2 * vmax, np.int64), np.empty(vmax, np.int8),
+            np.empty(vmax, np.int8))
 
 
 @njit(cache=True, nogil=True)
@@ -369,7 +395,8 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
     acc = np.empty(6)
     nc = overlap_moments(xa, sa, xb, sb, e, np.empty(na, np.bool_), np.empty(nb, np.bool_),
                          cross, np.empty(na * nb + na + nb + 3), acc, np.empty((nb, 4)),
-                         np.empty(2 * nb, np.int64))[3]
+                         np.empty(2 * nb, np.int64), np.empty(na, np.int8),
+                         np.empty(nb, np.int8))[3]
     px, py = point_of(xa, sa, xb, sb, e, side, v, cross, nc, acc)
     nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
     return nx, ny, px, py, side, v, f

@@ -264,6 +264,20 @@ def _penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
 
 
 @njit(cache=True, nogil=True)
+def _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+    """Whether A moved by p = (px, py), a point at distance d of a contact segment, ends
+    the overlap, up to the tolerance: first tried 2 ``eps`` further along p (the bodies
+    apart there by about ``eps`` where p makes them touch: the state kernel's cheaper
+    case, no touch to look into), then at p itself. Every translation nearer than p
+    having been found to penetrate, either makes p the depth within 2 ``eps``."""
+    if d > 0.0:
+        f = 1.0 + 2.0 * eps / d
+        if not _penetrates(xa, sa, xb, sb, px * f, py * f, eps, moved, scratch):
+            return True
+    return not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch)
+
+
+@njit(cache=True, nogil=True)
 def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     """Penetration depth of A into B from the contact segments: ``(depth, dx, dy, ok)``.
 
@@ -296,7 +310,7 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     nb = xb.shape[0]
     if m + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, False
-    got = contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, depth_buffers(m, nb))
+    got = contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, 0.0, depth_buffers(m, nb))
     return got[0], got[1], got[2], got[3]
 
 
@@ -312,13 +326,15 @@ def depth_buffers(m, n):
 
 
 @njit(cache=True, nogil=True)
-def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
+def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
     """:func:`contact_depth` with its scratch (:func:`depth_buffers`, for at least the
-    bodies' vertex counts) passed in, so that a loop over pairs allocates nothing.
-    Returns ``(depth, dx, dy, ok, side, vertex, edge)``: with the depth, the contact
-    segment it lies on, the vertex of one body brought onto the edge of the other (side
-    0: a vertex of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows
-    of each body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
+    bodies' vertex counts) passed in, so that a loop over pairs allocates nothing, and
+    ``low``, a length below which every translation is known to leave the bodies
+    penetrating (their points nearer are not tested; 0: none known). Returns
+    ``(depth, dx, dy, ok, side, vertex, edge)``: with the depth, the contact segment it
+    lies on, the vertex of one body brought onto the edge of the other (side 0: a vertex
+    of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows of each
+    body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
     seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near = buffers
     m = xa.shape[0]
     nb = xb.shape[0]
@@ -343,9 +359,9 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
     for q in range(n):
         if s < 0 or seg[q, 4] < seg[s, 4]:
             s = q
-    if s >= 0 and seg[s, 4] < bound:
+    if s >= 0 and low <= seg[s, 4] < bound:
         px, py, d = _foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-        if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
+        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
             return d, px, py, True, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
         pts[0, 0] = d
         pts[0, 1] = px
@@ -376,9 +392,9 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, buffers):
             break
         d, px, py = pts[r, 0], pts[r, 1], pts[r, 2]
         pts[r, 3] = 1.0
-        if _tried(pts, c, r):
-            continue  # (an end shared by several pieces is tried once)
-        if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
+        if d < low or _tried(pts, c, r):
+            continue  # (known to penetrate; an end shared by several pieces is tried once)
+        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
             q = int(pts[r, 4])
             return d, px, py, True, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
     if _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):

@@ -250,10 +250,11 @@ def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, box
 
 @njit(cache=True, nogil=True)
 def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc, col,
-                     first_side, ts, ox, oy, acc):
+                     first_side, ts, ox, oy, acc, where_v):
     """Add the parts of body V's boundary inside body O (see the module docstring):
     ``bo`` O's box, ``deg`` V's edges to classify by midpoints, ``cross[:nc]`` the
-    crossings with V's edge in column ``col`` and its parameter in ``col + 2``."""
+    crossings with V's edge in column ``col`` and its parameter in ``col + 2``. Each
+    vertex's place goes to ``where_v`` (as :func:`where` gives it)."""
     for k in range(sv.shape[0] - 1):
         s0 = sv[k]
         s1 = sv[k + 1]
@@ -274,6 +275,7 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
             px, py, qx, qy = xv[e, 0], xv[e, 1], xv[e1, 0], xv[e1, 1]
             if not _edge_box_meets(xv, e, e1, wx0, wx1, wy0, wy1):
                 status = -1  # outside O's box: outside, and so is its end
+                where_v[e1] = status
                 e = e1
                 continue
             n = 0
@@ -301,11 +303,13 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
                     inside = not inside
                     t0 = t1
                 status = -1 if inside else 1  # (flipped once past the last piece)
+            where_v[e1] = status
             e = e1
 
 
 @njit(cache=True, nogil=True)
-def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, ids):
+def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, ids, where_a,
+                    where_b):
     """Area and centroid of A ∩ B: ``(area, cx, cy, crossings)``; the proper crossings
     of the boundaries are left in ``cross[:crossings]`` (rows as :func:`_crossings`
     writes them), -1 when ``cross`` is too short (nothing else computed).
@@ -314,7 +318,10 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     ``ts`` (at least the vertices of both bodies plus crossings plus 2), ``boxes`` (a
     row of 4 per vertex of B) and ``ids`` (2 per vertex of B) are scratch; ``acc`` (6)
     receives in ``acc[4:6]`` a point of the intersection's boundary (the midpoint of
-    a piece of it) when ``acc[3]`` is 1.
+    a piece of it) when ``acc[3]`` is 1; ``where_a`` and ``where_b`` (int8, one per
+    vertex) where each vertex of A and of B lies (as :func:`where` gives it: 1 inside
+    the other body by more than ``eps``), known from the walk (not filled when
+    ``cross`` is too short).
     The area is 0 (and the centroid NaN) when the interiors do not overlap by more
     than the rounding.
 
@@ -325,7 +332,8 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     >>> st = np.array([0, 4])
     >>> got = overlap_moments(sq, st, sq + 1.0, st, 1e-12, np.zeros(4, np.bool_),
     ...                       np.zeros(4, np.bool_), np.empty((16, 6)), np.empty(32),
-    ...                       np.empty(6), np.empty((4, 4)), np.empty(8, np.int64))
+    ...                       np.empty(6), np.empty((4, 4)), np.empty(8, np.int64),
+    ...                       np.empty(4, np.int8), np.empty(4, np.int8))
     >>> [float(v) for v in got]
     [1.0, 1.5, 1.5, 2.0]
     """
@@ -338,6 +346,8 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     wx1 = min(ba[1], bb[1]) + eps
     wy0 = max(ba[2], bb[2]) - eps
     wy1 = min(ba[3], bb[3]) + eps
+    where_a[:na] = -1
+    where_b[:nb] = -1
     if wx0 > wx1 or wy0 > wy1:
         return 0.0, np.nan, np.nan, 0
     deg_a[:na] = False
@@ -348,9 +358,9 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
     ox = 0.5 * (wx0 + wx1)
     oy = 0.5 * (wy0 + wy1)
     _boundary_inside(xa, sa, xb, sb, eps, bb, wx0, wx1, wy0, wy1, deg_a, cross, nc, 0,
-                     True, ts, ox, oy, acc)
+                     True, ts, ox, oy, acc, where_a)
     _boundary_inside(xb, sb, xa, sa, eps, ba, wx0, wx1, wy0, wy1, deg_b, cross, nc, 1,
-                     False, ts, ox, oy, acc)
+                     False, ts, ox, oy, acc, where_b)
     if not acc[0] > 0.0:
         return 0.0, np.nan, np.nan, nc
     return 0.5 * acc[0], ox + acc[1] / (3.0 * acc[0]), oy + acc[2] / (3.0 * acc[0]), nc
