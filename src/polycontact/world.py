@@ -85,7 +85,7 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 #: a compiled pass runs on the calling thread (starting threads would cost more).
 _SERIAL_WORK = 4096
 #: The work of one item of the passes that are not classifications, in those units.
-_POSE_WORK = 0.5  # placing a body (a 12-gon) and updating its box
+_POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
 
 
