@@ -17,24 +17,37 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import finite_number
+from ._checks import finite_number, point
+from .tolerances import COORDINATE_LIMIT
 
 __all__ = ["Motion"]
 
 
 def _pair(value: Any, what: str) -> tuple[float, float]:
-    try:
-        x, y = (float(c) for c in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected two numbers, got {value!r}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise ValueError(f"{what}: expected finite numbers, got {[x, y]}")
+    x, y = point(value, what).tolist()
     return x, y
+
+
+def _angular_velocity(value: Any) -> float:
+    """Finite and within ±COORDINATE_LIMIT: beyond, every query refuses the motion
+    (products would overflow float64), so it is refused here, as a velocity or an
+    acceleration beyond it is. (An angular acceleration beyond it can still be used,
+    on a body small enough over a window short enough: the queries judge it.)"""
+    x = finite_number(value, "angular_velocity")
+    if abs(x) > COORDINATE_LIMIT:
+        raise ValueError(f"angular_velocity: {x:g} is beyond ±{COORDINATE_LIMIT:g}: products "
+                         "of coordinates would overflow float64")
+    return x
 
 
 @dataclass(frozen=True)
 class Motion:
     """Constant-acceleration rigid motion about the body's area centroid.
+
+    Every component is a real number (not a string, a boolean or a complex number) and
+    finite; the velocity, the acceleration and the angular velocity are within ±1e100
+    (:data:`polycontact.tolerances.COORDINATE_LIMIT`: no query could use more); anything
+    else raises ``TypeError`` or ``ValueError`` naming the parameter.
 
     Parameters
     ----------
@@ -67,9 +80,7 @@ class Motion:
     def __post_init__(self) -> None:
         object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
         object.__setattr__(self, "acceleration", _pair(self.acceleration, "acceleration"))
-        object.__setattr__(
-            self, "angular_velocity", finite_number(self.angular_velocity, "angular_velocity")
-        )
+        object.__setattr__(self, "angular_velocity", _angular_velocity(self.angular_velocity))
         object.__setattr__(
             self,
             "angular_acceleration",
@@ -92,11 +103,15 @@ class Motion:
         The placed body is the body at t = 0 rotated by ``angle`` about its centroid,
         then translated by ``translation`` (what :meth:`polycontact.Shape.moved` does).
         """
-        t = float(t)
+        t = finite_number(t, "t")
         v = np.asarray(self.velocity)
         a = np.asarray(self.acceleration)
         translation = v * t + 0.5 * a * t * t
         angle = self.angular_velocity * t + 0.5 * self.angular_acceleration * t * t
+        if not (np.abs(translation).max() <= COORDINATE_LIMIT and abs(angle) < math.inf):
+            raise ValueError(f"t: at t = {t:g} the motion carries the body beyond "
+                             f"±{COORDINATE_LIMIT:g}: products of coordinates would overflow "
+                             "float64")
         return translation, float(angle)
 
     @property
