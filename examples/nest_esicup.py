@@ -91,12 +91,12 @@ def main() -> None:
     print(f"  pairs in contact {int((c.states == 1).sum())}, penetrating 0, "
           f"all pieces inside the strip")
     if args.plot:
-        from polycontact.cli.contacts import plot, report
+        from polycontact.cli.contacts import save_plot
 
         height = float(np.ptp(world.container.exterior[:, 1]))
         strip = pc.World(pc.Shape([(0, 0), (length, 0), (length, height), (0, height)]))
         strip.add_many([b.shape for b in world.bodies()])
-        plot(strip, report(strip, strip.contacts(), [str(i) for i in strip.ids]), args.plot)
+        save_plot(strip.contacts(), args.plot)
 
 
 if __name__ == "__main__":
