@@ -371,7 +371,8 @@ def no_fit_polygon(
     region, pts, segs, eps = _entrance_result(out, pieces)
     fits, slides = _clean_degenerate(pts, segs, eps, lambda: _touching(a, b, a0, eps))
     for array in (fits, slides, a0):
-        array.flags.writeable = False  # a result cannot be changed
+        if array is not _NO_FITS and array is not _NO_SLIDES and array is not _ORIGIN:
+            array.flags.writeable = False  # a result cannot be changed (shared ones are not)
     # Built as the frozen dataclass's __init__ would, at a fraction of its cost; with
     # the kernel's rings, ``region`` is made on first access (NoFitPolygon.__getattr__)
     nfp = _new(NoFitPolygon)

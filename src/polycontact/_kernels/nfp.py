@@ -686,65 +686,100 @@ def tidy_rings(xy, starts, sums, eps):
 
     - A coordinate within the rounding of a sum vertex's coordinate on the same axis
       (:data:`SNAP_ULPS` units of 2**-52 of the sums' largest |coordinate|) is that
-      coordinate: a crossing computed as -2.2e-16 on the line x = 0 is 0.
+      coordinate (:func:`_snap_to_sums`, in place): a crossing computed as -2.2e-16 on
+      the line x = 0 is 0.
     - A vertex within ``eps`` of the segment joining the vertices kept before and after
-      it (one that changes nothing) is dropped; every dropped vertex stays within
-      ``eps`` of the segment that replaces it, so the outline moves by at most ``eps``.
-      A ring with no vertex off its neighbours' segment (a sliver, dropped later) is
-      kept as it is.
+      it (one that changes nothing) is dropped (:func:`without_collinear`).
 
     >>> import numpy as np
     >>> ring = np.array([[-1.5, -1.5], [-2.220446049250313e-16, -1.5], [3.0, -1.5],
     ...                  [3.0, 4.0], [1.5, 4.0], [-1.5, 4.0]])
-    >>> xy, st = tidy_rings(ring, np.array([0, 6]), ring, 1e-12)
+    >>> xy, st = tidy_rings(ring.copy(), np.array([0, 6]), ring, 1e-12)
     >>> xy.tolist(), st.tolist()
     ([[-1.5, -1.5], [3.0, -1.5], [3.0, 4.0], [-1.5, 4.0]], [0, 4])
     """
+    _snap_to_sums(xy, sums)
+    return without_collinear(xy, starts, eps)
+
+
+@njit(cache=True, nogil=True)
+def _snap_to_sums(xy, sums):
+    """Each coordinate of ``xy`` (in place) within :data:`SNAP_ULPS` units of 2**-52 of
+    the sums' largest |coordinate| of a coordinate of a sum vertex on the same axis
+    becomes the nearest such. Few vertices against few sums (the common case) are
+    compared directly; more against the sorted coordinates."""
     if xy.shape[0] == 0:
-        return xy, starts
+        return
     mag = 0.0
     for i in range(sums.shape[0]):
         mag = max(mag, abs(sums[i, 0]), abs(sums[i, 1]))
     near = SNAP_ULPS * 2.0**-52 * mag
-    out = np.empty_like(xy)
+    direct = xy.shape[0] * sums.shape[0] <= 4096
     for c in range(2):
-        values = np.sort(sums[:, c])
+        values = sums[:, c] if direct else np.sort(sums[:, c])
         for i in range(xy.shape[0]):
             v = xy[i, c]
-            k = np.searchsorted(values, v)
             best = v
-            for m in (k - 1, k):
-                if 0 <= m < values.shape[0] and abs(values[m] - v) <= near and (
-                        best == v or abs(values[m] - v) < abs(best - v)):
+            gap = near  # the nearest within it
+            lo, hi = 0, values.shape[0]
+            if not direct:
+                k = np.searchsorted(values, v)
+                lo, hi = max(k - 1, 0), min(k + 1, values.shape[0])
+            for m in range(lo, hi):
+                d = abs(values[m] - v)
+                if d <= gap:
                     best = values[m]
-            out[i, c] = best
-    keep = np.ones(xy.shape[0], np.bool_)
+                    gap = d
+                    if d == 0.0:
+                        break  # (a sum vertex's own coordinate, the common case)
+            xy[i, c] = best
+
+
+@njit(cache=True, nogil=True)
+def without_collinear(xy, starts, eps):
+    """``(xy, starts)`` of the rings (open) without the vertices that lie within ``eps``
+    of the segment joining the vertices kept before and after them: every dropped vertex
+    stays within ``eps`` of the segment that replaces it, so the outline moves by at most
+    ``eps``. The arrays themselves when there is none (nothing is allocated then); a
+    ring with no vertex off its neighbours' segment (a sliver, dropped later) is kept as
+    it is.
+    """
+    some = False
     for r in range(starts.shape[0] - 1):
         s = starts[r]
         n = starts[r + 1] - s
+        for i in range(n if n > 3 else 0):
+            if not _off_segment(xy, s + (i - 1) % n, s + i, s + (i + 1) % n, eps):
+                some = True
+                break
+    if not some:
+        return xy, starts
+    keep = np.ones(xy.shape[0], np.bool_)
+    for r in range(starts.shape[0] - 1):
         # passes from the kept vertex farthest off its kept neighbours' segment (a
         # corner, never dropped), until one drops nothing
-        while _drop_collinear(out, s, n, keep, eps):
+        while _drop_collinear(xy, starts[r], starts[r + 1] - starts[r], keep, eps):
             pass
+    out = np.empty((int(keep.sum()), 2))
     new_starts = np.empty_like(starts)
     new_starts[0] = 0
     w = 0
     for r in range(starts.shape[0] - 1):
         for i in range(starts[r], starts[r + 1]):
             if keep[i]:
-                out[w] = out[i]
+                out[w] = xy[i]
                 w += 1
         new_starts[r + 1] = w
-    return out[:w], new_starts
+    return out, new_starts
 
 
 @njit(cache=True, nogil=True)
 def _drop_collinear(xy, s, n, keep, eps):
-    """One pass of :func:`tidy_rings` over the ring of ``n`` vertices at row ``s``: from
-    its kept vertex farthest off the segment of its kept neighbours, each kept vertex
-    is dropped when every vertex between the anchor (the last one kept) and the next
-    kept one, dropped ones included, lies within ``eps`` of the segment joining these
-    two. Returns whether it dropped any (none when no vertex is more than ``eps`` off
+    """One pass of :func:`without_collinear` over the ring of ``n`` vertices at row
+    ``s``: from its kept vertex farthest off the segment of its kept neighbours, each
+    kept vertex is dropped when every vertex between the anchor (the last one kept) and
+    the next kept one, dropped ones included, lies within ``eps`` of the segment joining
+    these two. Returns whether it dropped any (none when no vertex is more than ``eps`` off
     its neighbours' segment: a sliver, left as it is); a ring keeps 3 vertices at
     least."""
     first = -1
@@ -866,7 +901,8 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
         eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])
     if starts.shape[0] == 2:
-        ring_xy, rs = tidy_rings(sums, np.array([0, sums.shape[0]], np.int64), sums, eps)
+        # one sum: its vertices are the sums' (nothing to snap)
+        ring_xy, rs = without_collinear(sums, np.array([0, sums.shape[0]], np.int64), eps)
         area, length = _ring_stats(ring_xy, rs)
         ring_xy, ring_starts = _closed(ring_xy, rs)
         return (sums, starts, ring_xy, ring_starts, np.column_stack((area, length)),
