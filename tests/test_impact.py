@@ -443,10 +443,6 @@ def test_time_of_impact_refuses_exactly_the_motions_that_check_reach_refuses(
     from polycontact.broad_phase import check_reach
 
     v, acc, w, alpha = norms
-    if max(v, acc, w) > 1e100:  # no query could use it: the Motion refuses it itself
-        with pytest.raises(ValueError, match="beyond"):
-            Motion(velocity=(v, 0.0), acceleration=(0.0, acc), angular_velocity=w)
-        return
     moving = Motion(velocity=(v, 0.0), acceleration=(0.0, acc), angular_velocity=w,
                     angular_acceleration=alpha)
     a = Shape(np.array([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]) * size)

@@ -430,10 +430,8 @@ def test_huge_squares_time_of_impact_is_refused_not_no_hit(side):
     # Before: "no hit" where there is one (the same squares as the NFP crash above).
     sq = np.array(SQ, dtype=float) * side
     with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
-        pc.time_of_impact(sq, pc.Motion(velocity=(1.0, 0.0)), sq + [3.0 * side, 0.0],
+        pc.time_of_impact(sq, pc.Motion(velocity=(side, 0.0)), sq + [3.0 * side, 0.0],
                           pc.Motion(), t_max=5.0)
-    with pytest.raises(ValueError, match="velocity: .* overflow float64"):
-        pc.Motion(velocity=(side, 0.0))  # (no query could use it)
 
 
 def test_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):

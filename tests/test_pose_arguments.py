@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from profiles import examples
 
 import polycontact as pc
+from polycontact.esicup import turned
 
 SQ = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 BIN = pc.Shape([(-5, -5), (5, -5), (5, 5), (-5, 5)])
@@ -40,6 +41,12 @@ def _world() -> tuple[pc.World, int]:
     return w, w.add(SQ, (0, 0))
 
 
+def _moving(**motion):
+    """time_of_impact of a square given this motion: a Motion refuses what is not a
+    finite real number, the query a motion its products would overflow with."""
+    pc.time_of_impact(SQ, pc.Motion(**motion), SQ.moved((3, 0)), pc.Motion(), t_max=5)
+
+
 def _tmax(bad):
     pc.time_of_impact(SQ, pc.Motion(velocity=(1, 0)), SQ.moved((3, 0)), pc.Motion(), t_max=bad)
 
@@ -49,13 +56,11 @@ def _tmax(bad):
 NUMBER_CALLS = {
     "Shape.moved angle": ("angle", lambda bad: SQ.moved((0, 0), bad), False),
     "Shape.at t": ("t", lambda bad: SQ.at(pc.Motion(velocity=(1, 0)), bad), True),
-    "Motion angular_velocity": ("angular_velocity", lambda bad: pc.Motion(angular_velocity=bad),
-                                True),
-    # (beyond ±1e100 it can still be used by a tiny body: the query judges, naming it)
-    "Motion angular_acceleration": (
-        "angular_acceleration|motion_a", lambda bad: pc.time_of_impact(
-            SQ, pc.Motion(angular_acceleration=bad), SQ.moved((3, 0)), pc.Motion(), t_max=5),
-        True),
+    # (a motion beyond the range is refused by the query that would use it, naming it)
+    "Motion angular_velocity": ("angular_velocity|motion_a", lambda bad: _moving(
+        angular_velocity=bad), True),
+    "Motion angular_acceleration": ("angular_acceleration|motion_a", lambda bad: _moving(
+        angular_acceleration=bad), True),
     "Motion.pose t": ("t", lambda bad: pc.Motion(velocity=(1, 0)).pose(bad), True),
     "World.add angle": ("angle", lambda bad: _world()[0].add(SQ, (1, 1), bad), False),
     "World.move angle": ("angle", lambda bad: (lambda w, i: w.move(i, (0, 0), bad))(*_world()),
@@ -66,6 +71,9 @@ NUMBER_CALLS = {
                                 False),
     "World.feasible_region angle": ("angle", lambda bad: _world()[0].feasible_region(SQ, bad),
                                     False),
+    "turned degrees": ("degrees", lambda bad: turned(SQ, bad), False),
+    "nfp_table orientations": ("orientations", lambda bad: pc.nfp_table(
+        [SQ], [[bad]], progress=False), False),
     "time_of_impact t_max": ("t_max", _tmax, True),
     "broad_phase_intervals t_max": ("t_max", lambda bad: pc.broad_phase_intervals(
         SQ, pc.Motion(velocity=(1, 0)), SQ.moved((3, 0)), pc.Motion(), t_max=bad), True),
@@ -76,8 +84,8 @@ NUMBER_CALLS = {
 #: (argument name, call with one point argument set to ``bad``)
 POINT_CALLS = {
     "Shape.moved translation": ("translation", lambda bad: SQ.moved(bad)),
-    "Motion velocity": ("velocity", lambda bad: pc.Motion(velocity=bad)),
-    "Motion acceleration": ("acceleration", lambda bad: pc.Motion(acceleration=bad)),
+    "Motion velocity": ("velocity|motion_a", lambda bad: _moving(velocity=bad)),
+    "Motion acceleration": ("acceleration|motion_a", lambda bad: _moving(acceleration=bad)),
     "World.add position": ("position", lambda bad: _world()[0].add(SQ, bad)),
     "World.move position": ("position", lambda bad: (lambda w, i: w.move(i, bad))(*_world())),
     "World.query position": ("position", lambda bad: _world()[0].query(SQ, bad)),

@@ -141,18 +141,19 @@ def points(value: Any, what: str, shape: tuple[int, ...] = (-1, 2)) -> np.ndarra
     return arr
 
 
-def point(value: Any, what: str, *, error: type[ValueError] = ValueError) -> np.ndarray:
+def point(value: Any, what: str, *, error: type[ValueError] = ValueError,
+          limit: float | None = COORDINATE_LIMIT) -> np.ndarray:
     """``value`` as a new float64 array of shape (2,) with finite entries within
-    ±:data:`~polycontact.tolerances.COORDINATE_LIMIT`, else ``error`` naming ``what``;
-    ``TypeError`` if the entries are not real numbers (strings, booleans, complex
-    numbers) or ``value`` is a string, a set or a mapping."""
+    ±``limit`` (None: any), else ``error`` naming ``what``; ``TypeError`` if the entries
+    are not real numbers (strings, booleans, complex numbers) or ``value`` is a string,
+    a set or a mapping."""
     arr = real_array(value, what, error)
     if arr.shape != (2,):
         raise error(f"{what}: expected two numbers (x, y), got {shown(value)}")
     if not np.isfinite(arr).all():
         raise error(f"{what}: expected two finite numbers (x, y), got {shown(value)}")
-    if np.abs(arr).max() > COORDINATE_LIMIT:
-        raise error(f"{what}: {shown(value)} is beyond ±{COORDINATE_LIMIT:g}: products of "
+    if limit is not None and np.abs(arr).max() > limit:
+        raise error(f"{what}: {shown(value)} is beyond ±{limit:g}: products of "
                     "coordinates would overflow float64")
     return arr
 

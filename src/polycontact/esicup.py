@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import shown
+from ._checks import finite_number, shown
 from ._json import load_json
 from .errors import InvalidShapeError, PolycontactError
 from .shape import Shape
@@ -88,9 +88,7 @@ def turned(shape: Shape, degrees: float) -> Shape:
     >>> turned(sq, 180).exterior.tolist()
     [[-1.0, 0.0], [-2.0, 0.0], [-2.0, -1.0], [-1.0, -1.0]]
     """
-    deg = float(degrees)
-    if not math.isfinite(deg):
-        raise InvalidShapeError(f"degrees: expected a finite angle, got {degrees!r}")
+    deg = finite_number(degrees, "degrees", error=InvalidShapeError)
     quarter = deg / 90.0
     if quarter == round(quarter):
         c, s = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(quarter)) % 4]

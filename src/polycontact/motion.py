@@ -24,20 +24,9 @@ __all__ = ["Motion"]
 
 
 def _pair(value: Any, what: str) -> tuple[float, float]:
-    x, y = point(value, what).tolist()
+    # (no range: the queries refuse a motion whose products would overflow, naming it)
+    x, y = point(value, what, limit=None).tolist()
     return x, y
-
-
-def _angular_velocity(value: Any) -> float:
-    """Finite and within ±COORDINATE_LIMIT: beyond, every query refuses the motion
-    (products would overflow float64), so it is refused here, as a velocity or an
-    acceleration beyond it is. (An angular acceleration beyond it can still be used,
-    on a body small enough over a window short enough: the queries judge it.)"""
-    x = finite_number(value, "angular_velocity")
-    if abs(x) > COORDINATE_LIMIT:
-        raise ValueError(f"angular_velocity: {x:g} is beyond ±{COORDINATE_LIMIT:g}: products "
-                         "of coordinates would overflow float64")
-    return x
 
 
 @dataclass(frozen=True)
@@ -45,9 +34,9 @@ class Motion:
     """Constant-acceleration rigid motion about the body's area centroid.
 
     Every component is a real number (not a string, a boolean or a complex number) and
-    finite; the velocity, the acceleration and the angular velocity are within ±1e100
-    (:data:`polycontact.tolerances.COORDINATE_LIMIT`: no query could use more); anything
-    else raises ``TypeError`` or ``ValueError`` naming the parameter.
+    finite, else ``TypeError`` or ``ValueError`` naming the parameter. A motion that
+    would carry a body's coordinates, speeds or accelerations beyond ±1e100 within a
+    query's window is refused by that query, naming the motion.
 
     Parameters
     ----------
@@ -80,7 +69,9 @@ class Motion:
     def __post_init__(self) -> None:
         object.__setattr__(self, "velocity", _pair(self.velocity, "velocity"))
         object.__setattr__(self, "acceleration", _pair(self.acceleration, "acceleration"))
-        object.__setattr__(self, "angular_velocity", _angular_velocity(self.angular_velocity))
+        object.__setattr__(
+            self, "angular_velocity", finite_number(self.angular_velocity, "angular_velocity")
+        )
         object.__setattr__(
             self,
             "angular_acceleration",

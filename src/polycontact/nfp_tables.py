@@ -203,13 +203,14 @@ class NfpTable:
             k = operator.index(piece)
         except TypeError:
             raise KeyError(f"{what}: expected a piece index, got {piece!r}") from None
+        if isinstance(piece, bool):
+            raise KeyError(f"{what}: expected a piece index, got {piece!r}")
         if not 0 <= k < len(self.pieces):
             raise KeyError(f"{what}: piece {k} out of range (the table has "
                            f"{len(self.pieces)} pieces)")
-        try:
-            deg = float(angle)
-        except (TypeError, ValueError):
-            raise KeyError(f"angle of piece {k}: expected degrees, got {angle!r}") from None
+        if not _is_number(angle):  # (a string is not parsed, a bool is no angle)
+            raise KeyError(f"angle of piece {k}: expected degrees, got {angle!r}")
+        deg = float(angle)
         for n, a in enumerate(self.orientations[k]):
             if abs(math.remainder(deg - a, 360.0)) <= ANGLE_MATCH:
                 return k, n
@@ -414,8 +415,12 @@ def _pieces_and_orientations(
 
 
 def _is_number(a: Any) -> bool:
-    return isinstance(a, int | float | np.integer | np.floating) and not isinstance(
-        a, bool) and math.isfinite(float(a))
+    if isinstance(a, bool) or not isinstance(a, int | float | np.integer | np.floating):
+        return False
+    try:
+        return math.isfinite(float(a))
+    except OverflowError:  # an integer beyond float64
+        return False
 
 
 def _prepare(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],

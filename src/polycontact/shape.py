@@ -423,7 +423,7 @@ class Shape:
         [2.0, 1.0]
         """
         c = self._centroid
-        t = point(translation, "translation")
+        t = point(translation, "translation", error=InvalidShapeError)
         angle = finite_number(angle, "angle")
         cs, sn = np.cos(angle), np.sin(angle)
         rot = np.array([[cs, sn], [-sn, cs]])  # row-vector form of R(angle)
