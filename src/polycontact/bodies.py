@@ -40,7 +40,6 @@ TypeError: a: expected a body (Shape, (N, 2) array, shapely Polygon, GeoJSON or 
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Mapping
 from typing import Any, Protocol, Union
@@ -48,6 +47,7 @@ from typing import Any, Protocol, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._json import load_json
 from .errors import InvalidShapeError
 from .shape import Shape
 
@@ -146,8 +146,8 @@ def _from_text(text: str, repair: bool) -> Shape:
     stripped = text.lstrip()
     if stripped.startswith("{"):
         try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
+            data = load_json(text)
+        except ValueError as exc:
             raise InvalidShapeError(f"not valid JSON ({exc})") from None
         if not isinstance(data, Mapping):
             raise InvalidShapeError("JSON text: expected an object")

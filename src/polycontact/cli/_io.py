@@ -38,6 +38,21 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
         raise CommandError(str(exc)) from None
 
 
+#: What ``--plot`` says when matplotlib is missing (it is the ``plot`` extra).
+NO_MATPLOTLIB = "--plot needs matplotlib: pip install 'polycontact[plot]'"
+
+
+def plotting() -> None:
+    """Make sure a ``--plot`` can be drawn, before anything is computed: matplotlib is
+    there (else a :class:`CommandError` that says how to install it), with the
+    non-interactive backend."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise CommandError(NO_MATPLOTLIB) from None
+    matplotlib.use("Agg")
+
+
 def integer_at_least(minimum: int) -> Callable[[str], int]:
     """An argparse ``type`` for an integer option >= ``minimum``."""
 

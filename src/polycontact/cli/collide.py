@@ -8,7 +8,7 @@ import sys
 from typing import Any
 
 from .. import datasets
-from ._io import CommandError, index_text, integer_at_least, positive_number
+from ._io import CommandError, index_text, integer_at_least, plotting, positive_number
 
 
 def add_parser(subparsers: Any) -> None:
@@ -71,6 +71,8 @@ def _text(rep: dict[str, Any]) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..scene import load_scene
 
+    if args.plot:
+        plotting()
     scene = load_scene(datasets.locate(args.scene, "scenes"), repair=args.repair)
     for body in scene.bodies:
         for note in body.shape.repairs:
@@ -96,9 +98,6 @@ def run(args: argparse.Namespace) -> int:
         rep = impact.to_dict((body_a.name, body_b.name))
         print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         ax = impact.plot(names=(body_a.name, body_b.name))
         try:
             ax.figure.savefig(args.plot, dpi=120, bbox_inches="tight")

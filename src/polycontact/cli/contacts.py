@@ -9,8 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from .. import datasets
+from .._json import load_json
 from ..errors import InvalidShapeError
-from ._io import CommandError, non_negative_number
+from ._io import CommandError, non_negative_number, plotting
 
 
 def add_parser(subparsers: Any) -> None:
@@ -61,10 +62,10 @@ def read_layout(path: str, progress: bool = False) -> tuple[Any, list[Any], list
     from ..bodies import as_shape
 
     try:
-        data = json.loads(Path(path).read_text())
+        data = load_json(Path(path).read_bytes())
     except OSError as exc:
         raise CommandError(f"{path}: cannot read ({exc.strerror})") from None
-    except json.JSONDecodeError as exc:
+    except ValueError as exc:
         raise CommandError(f"{path}: not valid JSON ({exc})") from None
     if not isinstance(data, dict) or not ("placed" in data or "bodies" in data):
         raise CommandError(f"{path}: expected an object with 'placed' or 'bodies'")
@@ -112,9 +113,7 @@ def text(rep: dict[str, Any]) -> list[str]:
 
 def save_plot(contacts: Any, path: str) -> None:
     """Draw the contacts (:meth:`Contacts.plot`) into the image file ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
+    plotting()
     import matplotlib.pyplot as plt
 
     ax = contacts.plot()
@@ -129,6 +128,8 @@ def save_plot(contacts: Any, path: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..world import World
 
+    if args.plot:
+        plotting()
     container, bodies, names = read_layout(datasets.locate(args.layout, "layouts"),
                                            progress=not args.no_progress)
     world = World(container)

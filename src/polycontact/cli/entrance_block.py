@@ -8,7 +8,7 @@ import math
 import sys
 from typing import Any
 
-from ._io import CommandError, read_shape
+from ._io import CommandError, plotting, read_shape
 from .classify import relation_text
 
 _FAMILIES = (("A2-B0", "E(A(2), B(0))"), ("A0-B2", "E(A(0), B(2))"), ("A1-B1", "E(A(1), B(1))"))
@@ -65,6 +65,8 @@ def _text(rep: dict[str, Any], a: str, b: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..entrance import entrance_block
 
+    if args.plot:
+        plotting()
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)
     for path, shape in ((args.a, a), (args.b, b)):
@@ -74,9 +76,6 @@ def run(args: argparse.Namespace) -> int:
     rep = block.to_dict()
     print(json.dumps(rep) if args.json else _text(rep, args.a, args.b))
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         from ..plotting.entrance_block import plot_entrance_block
 
         fig = plot_entrance_block(block)

@@ -7,7 +7,7 @@ import json
 import math
 from typing import Any
 
-from ._io import CommandError, positive_number, read_shape
+from ._io import CommandError, plotting, positive_number, read_shape
 
 
 def _reference(text: str) -> Any:
@@ -60,12 +60,14 @@ def run(args: argparse.Namespace) -> int:
 
     import polycontact as pc
 
+    if args.plot:
+        if args.inner:
+            raise CommandError("--plot draws no-fit polygons only, not with --inner")
+        plotting()
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)
     if args.inner:
         geom = pc.inner_fit_polygon(a, b, args.reference, tolerance=args.tolerance)
-        if args.plot:
-            raise CommandError("--plot draws no-fit polygons only, not with --inner")
         if args.json:
             print(json.dumps({"inner_fit": json.loads(shapely.to_geojson(geom))}))
         else:
@@ -94,9 +96,6 @@ def run(args: argparse.Namespace) -> int:
         for (x0, y0), (x1, y1) in slides:
             print(f"  ({x0:.12g}, {y0:.12g}) to ({x1:.12g}, {y1:.12g})")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         ax = nfp.plot()
         try:
             ax.figure.savefig(args.plot, dpi=120)
