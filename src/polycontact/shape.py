@@ -95,7 +95,7 @@ def _whole_body(obj: Any) -> bool:
 def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
     """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
     through :mod:`polycontact.bodies`; such a body carries its own holes."""
-    if len(holes):
+    if len(list(holes)):
         raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
                         "holes only with an array of vertices")
     if isinstance(obj, Shape):
@@ -109,11 +109,9 @@ def _first_unreal(ring: ArrayLike) -> tuple[int, Any] | None:
     """``(vertex, coordinate)``: the first coordinate of ``ring`` that is not a real number
     (a string, a bool, a complex number, None...); None if no vertex holds one (for the
     message of a ring refused for its type)."""
-    try:
-        rows = list(ring)
-    except TypeError:
+    if not isinstance(ring, (list, tuple, np.ndarray)):  # (a set or a mapping has no order)
         return None
-    for i, row in enumerate(rows):
+    for i, row in enumerate(ring):
         if isinstance(row, (str, bytes)) or not hasattr(row, "__iter__"):
             if not is_real(row):
                 return i, row

@@ -49,14 +49,12 @@ example:
 
 
 def add_parser(subparsers: Any) -> None:
-    import argparse
-
     p = subparsers.add_parser(
         "collide",
         help="first time of impact among the bodies of a scene",
-        description="Find when and where the bodies of a scene first penetrate "
-        "(the first impact among all pairs), each body moving with constant linear and "
-        "angular acceleration. The scene file's format follows the options.",
+        description="Find when and where the bodies of a scene first penetrate (the first\n"
+        "impact among all pairs), each body moving with constant linear and angular\n"
+        "acceleration. The scene file's format follows the options.",
         epilog=SCENE_FORMAT,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -70,12 +70,12 @@ def run(args: argparse.Namespace) -> int:
     if args.inner:
         with announced(f"computing the inner-fit polygon of {bodies}"):
             geom = pc.inner_fit_polygon(a, b, args.reference, tolerance=args.tolerance)
-        _print_inner_fit(geom, _reference_point(a, args.reference), args)
+        a0 = _reference_point(a, args.reference)
+        _print_inner_fit(geom, a0, args)
         if args.plot:
             from ..plotting.nfp import plot_inner_fit
 
-            ax = plot_inner_fit(a, b, geom, _reference_point(a, args.reference))
-            save_figure(ax.figure, args.plot)
+            save_figure(plot_inner_fit(a, b, geom, a0).figure, args.plot)
         return 0
     with announced(f"computing the no-fit polygon of {bodies}"):
         nfp = pc.no_fit_polygon(a, b, args.reference, tolerance=args.tolerance)
