@@ -51,7 +51,7 @@ CASES = {
     "classify: deeply nested body": ({"a.json": '{"vertices": ' + DEEP + "}"},
                                      ["classify", "{a.json}", "{square}"], "nested"),
     "classify: deeply nested text": ({"a.json": DEEP}, ["classify", "{a.json}", "{square}"],
-                                     "WKT"),
+                                     "nested"),
     "classify: nested body": ({"a.json": NESTED}, ["classify", "{a.json}", "{square}"],
                               "nested"),
     "classify: 5000-digit integer": (

@@ -216,9 +216,12 @@ def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) ->
         raise TypeError(f"path: expected a path or a mapping, got {type(path).__name__}")
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise InvalidSceneError(f"{path}: cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError as exc:
+        raise InvalidSceneError(f"{path}: not a JSON text ({exc.reason} at byte "
+                                f"{exc.start})") from None
     try:
         data = load_json(text)
     except ValueError as exc:

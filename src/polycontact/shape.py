@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import finite_number, point, real_array
+from ._checks import finite_number, is_real, point, real_array, shown
 from ._json import load_json
 from .errors import InvalidShapeError
 from .motion import Motion
@@ -50,7 +50,16 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
     if isinstance(ring, (str, bytes)):
         raise TypeError(f"{what}: expected an array of real numbers, got {type(ring).__name__}")
-    arr = real_array(ring, what, InvalidShapeError)
+    try:
+        arr = real_array(ring, what, InvalidShapeError)
+    except TypeError:
+        where = _first_unreal(ring)
+        if where is None:
+            raise
+        i, x = where
+        value = x.item() if isinstance(x, np.generic) else x  # 0j, not np.complex128(0j)
+        raise TypeError(f"{what}: vertex {i}: expected real numbers, got {shown(value)} "
+                        f"({type(x).__name__})") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidShapeError(
             f"{what}: expected an array of shape (N, 2), got shape {arr.shape}"
@@ -76,6 +85,43 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
+def _whole_body(obj: Any) -> bool:
+    """Whether ``obj`` is a body in a form other than an array of vertices: a Shape, a
+    Shapely geometry, anything with ``__geo_interface__``, a mapping, text or WKB."""
+    return (isinstance(obj, (Shape, str, bytes, bytearray, memoryview, Mapping))
+            or hasattr(obj, "__geo_interface__") or hasattr(obj, "geom_type"))
+
+
+def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
+    """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
+    through :mod:`polycontact.bodies`; such a body carries its own holes."""
+    if len(list(holes)):
+        raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
+                        "holes only with an array of vertices")
+    if isinstance(obj, Shape):
+        return obj
+    from .bodies import as_shape
+
+    return as_shape(obj, "vertices", repair=repair)
+
+
+def _first_unreal(ring: ArrayLike) -> tuple[int, Any] | None:
+    """``(vertex, coordinate)``: the first coordinate of ``ring`` that is not a real number
+    (a string, a bool, a complex number, None...); None if no vertex holds one (for the
+    message of a ring refused for its type)."""
+    if not isinstance(ring, (list, tuple, np.ndarray)):  # (a set or a mapping has no order)
+        return None
+    for i, row in enumerate(ring):
+        if isinstance(row, (str, bytes)) or not hasattr(row, "__iter__"):
+            if not is_real(row):
+                return i, row
+            continue
+        for x in row:
+            if not is_real(x):
+                return i, x
+    return None
+
+
 def _loop_name(k: int) -> str:
     return "outer loop" if k == 0 else f"hole {k - 1}"
 
@@ -85,10 +131,14 @@ class Shape:
 
     Parameters
     ----------
-    vertices : array_like of shape (N, 2)
-        The outer loop, closed or not, in either orientation.
+    vertices : array_like of shape (N, 2), or a whole body
+        The outer loop, closed or not, in either orientation. Or a body in any other
+        form polycontact takes (:mod:`polycontact.bodies`), holes included: a Shape, a
+        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or body
+        mapping ``{"vertices": ..., "holes": ...}``, WKT or JSON text, WKB.
     holes : sequence of array_like of shape (M, 2), optional
         Hole loops, closed or not, in either orientation (None or empty: no holes).
+        Only with an array of vertices: the other forms carry their own holes.
     repair : bool, default False
         If the loops are invalid, try ``shapely.make_valid`` and keep the result when it
         is a single polygon; :attr:`repairs` then says what changed. Indices still
@@ -106,9 +156,9 @@ class Shape:
         shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
         message then says which, how far apart, and the float spacing.
     TypeError
-        Coordinates that are not real numbers (strings, booleans, complex numbers), or
-        a body in another form (a Shapely polygon, a mapping, text): pass those to
-        :func:`polycontact.bodies.as_shape`, which takes every form.
+        Coordinates that are not real numbers (strings, booleans, complex numbers: the
+        message names the loop and the vertex), or ``holes`` with a body that carries
+        its own.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
 
@@ -117,6 +167,9 @@ class Shape:
     >>> sq = Shape([(0, 0), (0, 2), (2, 2), (2, 0)])    # clockwise: stored reversed
     >>> sq.area, sq.centroid.tolist(), sq.exterior[1].tolist()
     (4.0, [1.0, 1.0], [2.0, 2.0])
+    >>> import shapely
+    >>> Shape(shapely.box(0, 0, 2, 2)).area, Shape("POLYGON ((0 0, 2 0, 0 2, 0 0))").area
+    (4.0, 2.0)
     >>> Shape([(0, 0), (2, 2), (2, 0), (0, 2)])
     Traceback (most recent call last):
     ...
@@ -142,12 +195,9 @@ class Shape:
     ) -> None:
         if holes is None:
             holes = ()
-        if isinstance(vertices, (str, bytes, Mapping)) or hasattr(vertices, "__geo_interface__"):
-            raise TypeError(
-                f"vertices: expected an (N, 2) array-like, got {type(vertices).__name__}; "
-                "polycontact.bodies.as_shape takes every form of a body (Shape, Shapely, "
-                "GeoJSON, body mapping, WKT, WKB)"
-            )
+        if _whole_body(vertices):
+            self._adopt(_other_form(vertices, holes, repair))
+            return
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
             raise InvalidShapeError(
                 "holes: expected a sequence of (M, 2) loops, got a single (M, 2) array; "
@@ -166,6 +216,12 @@ class Shape:
         self._input = _input_maps([vertices, *holes], given, self._loops)
 
     # -- construction -------------------------------------------------------------
+    def _adopt(self, other: Shape) -> None:
+        """Take the state of ``other`` (immutable, so its arrays are shared)."""
+        for name in Shape.__slots__:
+            if _bound(other, name):
+                object.__setattr__(self, name, object.__getattribute__(other, name))
+
     @classmethod
     def _trusted(
         cls,
@@ -526,6 +582,34 @@ class Shape:
         """The shape as a GeoJSON Polygon mapping with closed rings."""
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
+
+    def plot(self, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+        """Draw the shape (solid filled, holes open); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, imported only
+            here: ``pip install 'polycontact[plot]'``).
+        numbers : bool, default False
+            Write each vertex's number, as features report it (see
+            :func:`polycontact.plotting.plot_shape`).
+        **style
+            Passed to the matplotlib patch (``facecolor``, ``alpha``, ``label``...).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> ax = Shape([(0, 0), (2, 0), (2, 1), (0, 1)]).plot(numbers=True)
+        >>> ax.get_title(), len(ax.texts)
+        ('4 vertices, 0 holes, area 2', 4)
+        """
+        from .plotting.shape import plot_shape
+
+        return plot_shape(self, ax, numbers=numbers, **style)
 
     def __repr__(self) -> str:
         holes = f", {len(self.holes)} hole(s)" if self.holes else ""

@@ -11,7 +11,8 @@ from typing import Any
 from .. import datasets
 from .._json import load_json
 from ..errors import InvalidShapeError
-from ._io import CommandError, non_negative_number, plotting
+from ._io import CommandError, non_negative_number, plotting, save_figure
+from ._progress import announced
 
 
 def add_parser(subparsers: Any) -> None:
@@ -111,20 +112,6 @@ def text(rep: dict[str, Any]) -> list[str]:
     return lines
 
 
-def save_plot(contacts: Any, path: str) -> None:
-    """Draw the contacts (:meth:`Contacts.plot`) into the image file ``path``."""
-    plotting()
-    import matplotlib.pyplot as plt
-
-    ax = contacts.plot()
-    try:
-        ax.figure.savefig(path, dpi=110)
-    except (OSError, ValueError) as exc:
-        raise CommandError(f"{path}: cannot write the plot ({exc})") from None
-    finally:
-        plt.close(ax.figure)
-
-
 def run(args: argparse.Namespace) -> int:
     from ..world import World
 
@@ -133,13 +120,14 @@ def run(args: argparse.Namespace) -> int:
     container, bodies, names = read_layout(datasets.locate(args.layout, "layouts"),
                                            progress=not args.no_progress)
     world = World(container)
-    world.add_many(bodies, names=names)
-    try:
-        contacts = world.contacts(args.tolerance)
-    except ValueError as exc:
-        raise CommandError(str(exc)) from None
-    rep = contacts.to_dict(names)
+    with announced(f"finding the contacts of {len(bodies)} bodies"):
+        world.add_many(bodies, names=names)
+        try:
+            contacts = world.contacts(args.tolerance)
+        except ValueError as exc:
+            raise CommandError(str(exc)) from None
+        rep = contacts.to_dict(names)
     print(json.dumps(rep) if args.json else "\n".join(text(rep)))
     if args.plot:
-        save_plot(contacts, args.plot)
+        save_figure(contacts.plot().figure, args.plot, dpi=110)
     return 0
