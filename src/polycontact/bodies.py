@@ -12,7 +12,12 @@ Everywhere polycontact takes a body (the functions, :class:`Shape` itself,
 - a body mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
   ``"name"`` is ignored), the scene files' form;
 - WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
-  above, WKB bytes or hex WKB text.
+  above or of a list of vertices (``"[[0, 0], [1, 0], [0, 1]]"``), WKB bytes or hex WKB
+  text.
+
+:class:`~polycontact.Shape` itself takes every one of these forms (``Shape(polygon)``);
+:func:`as_shape` is the same coercion for functions, which names the argument in its
+errors and returns a Shape unchanged.
 
 A value of another type raises ``TypeError``; a value of an accepted type that is not a
 valid polygon raises :class:`~polycontact.InvalidShapeError` (a ``ValueError``). Both
@@ -40,7 +45,6 @@ TypeError: a: expected a body (Shape, (N, 2) array, shapely Polygon, GeoJSON or 
 
 from __future__ import annotations
 
-import json
 import re
 from collections.abc import Mapping
 from typing import Any, Protocol, Union
@@ -48,6 +52,7 @@ from typing import Any, Protocol, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._json import load_json
 from .errors import InvalidShapeError
 from .shape import Shape
 
@@ -143,23 +148,29 @@ def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
 
 
 def _from_text(text: str, repair: bool) -> Shape:
-    stripped = text.lstrip()
-    if stripped.startswith("{"):
+    stripped = text.strip()
+    if not stripped:
+        raise InvalidShapeError("empty text: no body in it")
+    if stripped.startswith(("{", "[")):
         try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
+            data = load_json(text)
+        except ValueError as exc:
             raise InvalidShapeError(f"not valid JSON ({exc})") from None
+        if isinstance(data, list):  # the vertices alone: [[x, y], ...]
+            return Shape(data, repair=repair)
         if not isinstance(data, Mapping):
-            raise InvalidShapeError("JSON text: expected an object")
+            raise InvalidShapeError("JSON text: expected an object or a list of vertices")
         return _from_mapping(data, repair)
-    if _HEX.fullmatch(stripped.rstrip()):  # hex WKB, as shapely's ``wkb_hex``
-        return Shape.from_shapely(_from_wkb(bytes.fromhex(stripped.rstrip())), repair=repair)
+    if _HEX.fullmatch(stripped):  # hex WKB, as shapely's ``wkb_hex``
+        return Shape.from_shapely(_from_wkb(bytes.fromhex(stripped)), repair=repair)
     return Shape.from_wkt(text, repair=repair)
 
 
 def _from_wkb(data: bytes) -> Any:
     import shapely
 
+    if not data:
+        raise InvalidShapeError("empty WKB: no body in it")
     try:
         return shapely.from_wkb(data)
     except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types

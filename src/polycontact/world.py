@@ -30,6 +30,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, cast
@@ -37,7 +38,7 @@ from typing import Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from ._checks import finite_number, real_array
+from ._checks import finite_number, points, real_array
 from ._checks import point as point_arg
 from .broad_phase import BROAD_PHASE_INFLATION
 from .impact import MAX_ITERATIONS
@@ -126,6 +127,9 @@ class WorldBody:
     angle: float
     motion: Motion | None = None
 
+    def __post_init__(self) -> None:
+        self.position.flags.writeable = False  # (the world's own record: read-only)
+
 
 @dataclass(frozen=True, eq=False)
 class Contacts:
@@ -194,6 +198,11 @@ class Contacts:
     container: Shape | None = field(default=None, repr=False)
     margin: float = 0.0
 
+    def __post_init__(self) -> None:
+        for array in (self.pairs, self.states, self.tolerances, self.container_ids,
+                      self.container_states, self.ids):
+            array.flags.writeable = False  # a result cannot be changed
+
     def __len__(self) -> int:
         return len(self.states)
 
@@ -244,6 +253,7 @@ class Contacts:
     def relation(self, k: int) -> Relation:
         """The full :class:`~polycontact.Relation` of pair ``k`` (features, point,
         normal, depth), as :func:`polycontact.classify` gives it."""
+        k = _integer(k, "k")
         if not 0 <= k < len(self.states):
             raise IndexError(f"k: pair {k} out of range (0..{len(self.states) - 1})")
         i, j = (int(v) for v in self.pairs[k])
@@ -257,6 +267,7 @@ class Contacts:
 
     def shape(self, id: int) -> Shape:
         """The Shape of body ``id`` as it was when the contacts were found."""
+        id = _integer(id, "id")
         if id not in set(self.ids.tolist()):
             raise IndexError(f"id: no body {id} among the contacts' bodies")
         return _snapshot_shape(self._store, int(id))
@@ -338,6 +349,10 @@ class Query:
     states: np.ndarray
     container_state: int
     shape: Shape = field(repr=False)
+
+    def __post_init__(self) -> None:
+        self.ids.flags.writeable = False  # a result cannot be changed
+        self.states.flags.writeable = False
 
     @property
     def inside_container(self) -> bool:
@@ -438,6 +453,27 @@ def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarra
 
 def _angle(angle: Any) -> float:
     return finite_number(angle, "angle")
+
+
+def _integer(value: Any, what: str) -> int:
+    """``value`` as an int, if it is an integer (Python or NumPy, not a bool), else a
+    TypeError naming ``what``: a float id is not rounded to a body."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what}: expected an integer, got {type(value).__name__} {value!r}")
+    return int(value)
+
+
+def _values(value: Any, what: str, count: int) -> np.ndarray:
+    """``value`` as a new float64 array of ``count`` finite real numbers, else an error
+    naming ``what`` (and the index of a number that is not finite)."""
+    arr = real_array(value, what)
+    if arr.shape != (count,):
+        raise ValueError(f"{what}: expected {count} numbers, got shape {arr.shape}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"{what}[{k}]: expected a finite number, got {float(arr[k])!r}")
+    return arr
 
 
 def _place(base: Shape, position: np.ndarray | None, angle: float, what: str) -> Shape:
@@ -695,8 +731,8 @@ class World:
 
     def _record(self, id: Any, what: str) -> list[Any]:
         try:
-            return self._records[id]
-        except (KeyError, TypeError):
+            return self._records[_integer(id, what)]
+        except KeyError:
             raise KeyError(f"{what}: no body {id!r} in this world (never added, or "
                            "removed)") from None
 
@@ -787,11 +823,14 @@ class World:
         xy, ls, bs, sign = _pack(shapes, "shapes", objects)
         count = len(sign)
         if names is not None:
+            if isinstance(names, (str, bytes)) or not isinstance(names, (Sequence, np.ndarray)):
+                raise TypeError(f"names: expected a sequence of {count} strings, got "
+                                f"{type(names).__name__}")
             names = list(names)
             if len(names) != count or not all(isinstance(n, str) for n in names):
                 raise ValueError(f"names: expected {count} strings")
-        pos = None if positions is None else real_array(positions, "positions", (count, 2))
-        ang = None if angles is None else real_array(angles, "angles", (count,))
+        pos = None if positions is None else points(positions, "positions", (count, 2))
+        ang = None if angles is None else _values(angles, "angles", count)
         rows, vmap, lmap = _stored_rows(xy, ls, bs, sign, objects)
         check_range(rows, "shapes")
         cen = np.empty((count, 2))
@@ -863,13 +902,13 @@ class World:
         ([[0, 1]], [[0.5, 0.5], [1.5, 0.5]])
         """
         idx = self._ids(ids, "ids", unique=True)
-        pos = real_array(positions, "positions", (len(idx), 2))
+        pos = points(positions, "positions", (len(idx), 2))
         if angles is None:
             ang = self._ang[idx]
         elif np.ndim(angles) == 0:
             ang = np.full(len(idx), finite_number(angles, "angles"))
         else:
-            ang = real_array(angles, "angles", (len(idx),))
+            ang = _values(angles, "angles", len(idx))
         self._check_reach(pos, ang, self._rad[idx], idx, None, None, None, None,
                           "body ids[{k}] placed at positions[{k}]")
         self._write_poses(idx, pos, ang)
@@ -1238,7 +1277,8 @@ class World:
         ----------
         shape : Shape, shapely Polygon or array_like of shape (N, 2)
         positions : array_like of shape (P, 2)
-            Where the shape's area centroid goes.
+            Where the shape's area centroid goes: real numbers (not strings, booleans
+            or complex numbers), finite and within ±1e100.
         angles : float or array_like of shape (P,)
             Radians, about the centroid.
 
@@ -1247,18 +1287,17 @@ class World:
         ndarray of shape (P,), int8
         """
         base = as_shape(shape, "shape")
-        pos = np.ascontiguousarray(positions, dtype=np.float64)
-        if pos.ndim != 2 or pos.shape[1] != 2:
-            raise ValueError(f"positions: expected an array of shape (P, 2), got {pos.shape}")
-        if np.ndim(angles) == 0:
+        pos = points(positions, "positions")
+        if np.ndim(angles) == 0 and not isinstance(angles, (str, bytes)):
             ang = np.full(len(pos), _angle(angles))
         else:
-            ang = np.ascontiguousarray(angles, dtype=np.float64)
+            ang = real_array(angles, "angles")
             if ang.shape != (len(pos),):
                 raise ValueError(f"angles: expected a number or {len(pos)} numbers, got "
                                  f"shape {ang.shape}")
-        if not (np.isfinite(pos).all() and np.isfinite(ang).all()):
-            raise ValueError("positions, angles: expected finite numbers")
+            if not np.isfinite(ang).all():
+                k = int(np.flatnonzero(~np.isfinite(ang))[0])
+                raise ValueError(f"angles[{k}]: expected a finite number, got {ang[k]!r}")
         tol = self._tol(tolerance)
         sxy, ss = base.packed
         c = base.centroid
@@ -1339,13 +1378,13 @@ class World:
         ids = self.ids
         n = len(ids)
         motion = np.zeros((n, 6))
-        motion[:, 0:2] = real_array(velocities, "velocities", (n, 2))
+        motion[:, 0:2] = points(velocities, "velocities", (n, 2))
         for col, arr, name in ((4, angular_velocities, "angular_velocities"),
                                (5, angular_accelerations, "angular_accelerations")):
             if arr is not None:
-                motion[:, col] = real_array(arr, name, (n,))
+                motion[:, col] = _values(arr, name, n)
         if accelerations is not None:
-            motion[:, 2:4] = real_array(accelerations, "accelerations", (n, 2))
+            motion[:, 2:4] = points(accelerations, "accelerations", (n, 2))
         tol = 1e-4 * step if time_tolerance is None else finite_number(
             time_tolerance, "time_tolerance", positive=True)
         tol = tol if tol > 0.0 else 1e-4

@@ -77,6 +77,10 @@ def run(args: argparse.Namespace) -> int:
         print("polycontact nfp-table: interrupted; the entries computed so far are in "
               f"{args.out}, a rerun completes the table", file=sys.stderr)
         return 130
+    except OSError as exc:  # the cache cannot be written (a file, no permission, full)
+        where = f" ({exc.filename})" if exc.filename else ""
+        raise CommandError(f"--out {args.out}: cannot write the cache: "
+                           f"{exc.strerror or exc}{where}") from None
     finally:
         if client is not None:
             client.close()

@@ -10,7 +10,7 @@ from ..impact import Impact
 from ..motion import Motion
 from ..bodies import BodyLike, as_shape
 from ..shape import Shape
-from ._style import label_axes, legend_outside
+from ._style import label_axes, legend_outside, new_axes, shape_patch
 
 __all__ = ["plot_impact"]
 
@@ -23,15 +23,8 @@ def _event_time(impact: Impact) -> float:
 
 
 def _draw(ax: Any, shape: Shape, color: str, alpha: float, label: str | None) -> None:
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path
-
-    verts, codes = [], []
-    for loop in shape.loops:
-        verts += [*loop.tolist(), loop[0].tolist()]
-        codes += [Path.MOVETO] + [Path.LINETO] * (len(loop) - 1) + [Path.CLOSEPOLY]
-    ax.add_patch(PathPatch(Path(verts, codes), facecolor=color, edgecolor=color,
-                           alpha=alpha, lw=1.0, label=label))
+    ax.add_patch(shape_patch(shape, facecolor=color, edgecolor=color, alpha=alpha, lw=1.0,
+                             label=label))
 
 
 def plot_impact(
@@ -60,13 +53,12 @@ def plot_impact(
     >>> len(ax.patches), labels[0], labels[2], labels[-1]
     (4, 'A at t = 0', "A's centroid path", 'normal, A towards B')
     """
-    import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-
     a = as_shape(a, "a")
     b = as_shape(b, "b")
     if ax is None:
-        _, ax = plt.subplots(figsize=(11, 6), layout="constrained")
+        ax = new_axes((11, 6))
+    from matplotlib.lines import Line2D
+
     t_event = _event_time(impact)
     ts = np.linspace(0.0, t_event, 200)
     for shape, motion, color, name in ((a, motion_a, "tab:red", names[0]),
