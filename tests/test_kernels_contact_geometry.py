@@ -28,8 +28,17 @@ SHAPES = [
               zip(np.linspace(0, 2 * math.pi, 12, endpoint=False), [1.6, 0.6] * 6)]),
 ]
 
-placed = st.tuples(st.integers(0, len(SHAPES) - 1), st.floats(-3.0, 3.0),
-                   st.floats(-3.0, 3.0), st.sampled_from([0.0, math.pi / 2, 0.3, -2.0]))
+def offset(lo: float, hi: float) -> st.SearchStrategy[float]:
+    """Floats in [lo, hi], those nearer 0 than 1e-9 made 0: no offset tiny against the
+    bodies, where Shapely's overlay, the oracle, loses part of an intersection (an L
+    turned a quarter and an L moved 1e-306 from it, at scale 1e-6)."""
+    return st.floats(lo, hi).map(lambda v: v if abs(v) >= 1e-9 else 0.0)
+
+
+placed = st.tuples(st.integers(0, len(SHAPES) - 1),
+                   offset(-3.0, 3.0),
+                   offset(-3.0, 3.0),
+                   st.sampled_from([0.0, math.pi / 2, 0.3, -2.0]))
 frames = st.tuples(st.sampled_from([1e-6, 1.0, 1e6]), st.sampled_from([0.0, 1e3]))
 
 

@@ -15,6 +15,7 @@ import shapely
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from profiles import examples
+from test_kernels_contact_geometry import offset
 
 import polycontact as pc
 import polycontact.world as world_module
@@ -46,16 +47,17 @@ def body(t: int, scale: float, form: str):
 
 
 poses = st.lists(st.tuples(st.integers(0, len(TEMPLATES) - 1),
-                           st.floats(0.0, 6.0), st.floats(0.0, 6.0),
+                           offset(0.0, 6.0),
+                           offset(0.0, 6.0),
                            st.floats(-math.pi, math.pi),
                            st.sampled_from(["shape", "array"])),
                  min_size=2, max_size=8)
 frames = st.tuples(st.sampled_from(SCALES), st.sampled_from(OFFSETS))
 
 
-def build(spec, scale, offset):
+def build(spec, scale, shift):
     items = [body(t, scale, form) for t, _, _, _, form in spec]
-    pos = np.array([(x, y) for _, x, y, _, _ in spec]) * scale + offset * scale
+    pos = np.array([(x, y) for _, x, y, _, _ in spec]) * scale + shift * scale
     ang = np.array([a for *_, a, _ in spec])
     return items, pos, ang
 
@@ -97,11 +99,12 @@ def test_add_many_with_poses_equals_add_in_a_loop(spec, frame):
 
 @examples(40)
 @given(poses, frames, st.lists(st.tuples(st.lists(st.booleans(), min_size=8, max_size=8),
-                                         st.floats(-1.0, 1.0), st.floats(-2.0, 2.0)),
+                                         offset(-1.0, 1.0),
+                                         st.floats(-2.0, 2.0)),
                                min_size=1, max_size=4))
 def test_set_poses_rounds_equal_move_and_a_fresh_world(spec, frame, rounds):
-    scale, offset = frame
-    items, pos, ang = build(spec, scale, offset)
+    scale, shift = frame
+    items, pos, ang = build(spec, scale, shift)
     world = pc.World()
     ids = world.add_many(items, pos, ang)
     moved = pc.World()
@@ -281,11 +284,11 @@ def test_every_geometry_array_equals_classify_and_shapely(spec, frame, margin):
                 min_size=2, max_size=8), frames)
 def test_geometry_of_exact_contacts_on_a_grid(spec, frame):
     """Flush edges, vertices on vertices, identical bodies: contacts by construction."""
-    scale, offset = frame
+    scale, shift = frame
     items = [body(t, scale, "shape") for t, *_ in spec]
     world = pc.World()
     for item, (_, x, y, a) in zip(items, spec):
-        world.add(item, (scale * (0.5 * x + offset), scale * (0.5 * y + offset)), a)
+        world.add(item, (scale * (0.5 * x + shift), scale * (0.5 * y + shift)), a)
     c = world.contacts()
     for k in range(len(c)):
         check_pair(c, k, world, 0.0)

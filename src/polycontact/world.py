@@ -1522,6 +1522,34 @@ class World:
         bodies = [self.body(k) for k in ids]
         return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
 
+    def plot(self, ax: Any = None, *, labels: bool | None = None) -> Any:
+        """Draw the bodies where they stand, with their ids, and the container; returns
+        the matplotlib Axes. ``world.contacts().plot()`` draws the contacts too.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, imported only
+            here: ``pip install 'polycontact[plot]'``).
+        labels : bool, optional
+            Write each body's id (and name) at its centroid; by default for up to 100
+            bodies (see :func:`polycontact.plotting.plot_world`).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)], name="plate")
+        >>> w.plot().get_title()
+        '1 body'
+        """
+        from .plotting.world import plot_world
+
+        return plot_world(self, ax, labels=labels)
+
     def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
         the container and penetrates no body: the container's inner-fit polygon minus
