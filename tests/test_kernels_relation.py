@@ -13,7 +13,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from polycontact import Shape
-from polycontact._kernels import depth as kd
+from polycontact._depth import penetration
 from polycontact._kernels import relation as kr
 from polycontact._kernels import relation_many as km
 from polycontact.errors import InvalidShapeError
@@ -32,6 +32,11 @@ RING = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 def _eps(a: Shape, b: Shape) -> float:
     return default_tolerance(a.packed[0], b.packed[0])
+
+
+def _raw_states(xa: np.ndarray, xb: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`km.raw_states` of rings ``xa`` against ``xb`` with the default tolerance."""
+    return km.raw_states(xa, xb, -1.0, *RING, km.raw_states_outputs(xa.shape[0]))
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
@@ -75,7 +80,7 @@ def test_penetration_of_boxes_is_the_smallest_overlap(corner, size):
         return
     # leave along x: right (bx + wb - ax) or left (ax + wa - bx); same along y
     want = min(bx + wb - ax, ax + wa - bx, by + hb - ay, ay + ha - by)
-    depth, dx, dy = kd.penetration(*a.packed, *b.packed, _eps(a, b))
+    depth, dx, dy = penetration(*a.packed, *b.packed, _eps(a, b))
     assert depth == pytest.approx(want)
     assert np.hypot(dx, dy) == pytest.approx(depth)
     moved = a.packed[0] + np.array([dx, dy])
@@ -88,7 +93,7 @@ def test_penetration_escape_ends_the_overlap(pair):
     eps = _eps(a, b)
     if kr.relate_state(*a.packed, *b.packed, eps) != kr.PENETRATING:
         return
-    depth, dx, dy = kd.penetration(*a.packed, *b.packed, eps)
+    depth, dx, dy = penetration(*a.packed, *b.packed, eps)
     moved = a.packed[0] + np.array([dx, dy])
     assert kr.relate_state(moved, a.packed[1], *b.packed, eps) != kr.PENETRATING
     # the escape is no longer than leaving B's bounding box along an axis
@@ -281,7 +286,7 @@ def test_raw_states_matches_single_pairs(many, closed):
         ra, rb = rows(a), rows(b)
         xa = np.stack([ra[0], ra[1], ra[0], ra[1]])
         xb = np.stack([rb[0], rb[0], rb[1], rb[1]])
-        got = km.raw_states(xa, xb, -1.0, *RING)
+        got = _raw_states(xa, xb)
         for p in range(4):
             want = kr.classify_raw(xa[p], xb[p], -1.0, *RING)
             assert tuple(g[p] for g in got) == want
@@ -290,15 +295,14 @@ def test_raw_states_matches_single_pairs(many, closed):
 def test_raw_states_flags_invalid_rings():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
-    states, _, used_a, _, used_b, _ = km.raw_states(
-        np.stack([sq, bow, sq]), np.stack([sq + 0.5, sq, bow]), -1.0, *RING
-    )
+    states, _, used_a, _, used_b, _ = _raw_states(np.stack([sq, bow, sq]),
+                                                  np.stack([sq + 0.5, sq, bow]))
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
     # a lopsided bow-tie (nonzero signed area, clockwise by it): invalid, with the sign
     # _raw_ring gives an invalid ring, whichever way its area turns
     lop = np.array([[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 1.0]])
-    _, _, used_a, sign_a, _, _ = km.raw_states(lop[None], sq[None], -1.0, *RING)
+    _, _, used_a, sign_a, _, _ = _raw_states(lop[None], sq[None])
     assert used_a[0] == -1 and sign_a[0] == kr._raw_ring(lop, *RING)[1] == 1.0
 
 
@@ -319,7 +323,7 @@ def test_raw_states_long_rings_that_need_the_sweep():
     star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(len(t)) % 2, 3.0, 2.0)[:, None]
     xa = np.stack([comb, comb, star, crossed, star])
     xb = np.stack([comb + [0.25, 0.5], star + [12.0, 0.0], comb, star, crossed])
-    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0, *RING)
+    states, eps, used_a, sign_a, used_b, sign_b = _raw_states(xa, xb)
     assert states.tolist()[3:] == [-1, -1]
     assert used_a.tolist()[3] == -1 and used_b.tolist()[4] == -1
     assert sign_a[3] == kr._raw_ring(crossed, *RING)[1] == sign_b[4]

@@ -20,7 +20,9 @@ from profiles import examples
 import polycontact as pc
 from polycontact import nfp as nfp_module
 from polycontact._kernels import nfp as kn
-from polycontact.tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
+from polycontact.limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
+                               MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                               SNAP_FACTOR)
 
 @pytest.fixture(autouse=True)
 def no_geos_fallback():
@@ -31,9 +33,9 @@ def no_geos_fallback():
     assert nfp_module.fallback_count() == before, "the GEOS fallback built some region"
 
 
-ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, nfp_module.ANGLE_TOLERANCE)
+ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, ANGLE_TOLERANCE)
 # the candidates' snapping and merging factors of the packed answers
-EXACT = (nfp_module._SNAP_FACTOR, nfp_module.HOLE_WIDTH_FACTOR)
+EXACT = (SNAP_FACTOR, HOLE_WIDTH_FACTOR)
 
 
 def star(n: int, seed: int, centre=(0.0, 0.0), lo=0.6, hi=3.0) -> np.ndarray:
@@ -60,7 +62,7 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     axy, ast = nfp_module._convex_pieces(a)
     want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT)
     head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS, *EXACT,
-                                 nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
+                                 EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
     assert head[0] == 1.0
     assert head == want_head
     np.testing.assert_array_equal(got, want)
@@ -150,7 +152,7 @@ def test_each_path_is_taken_and_right(monkeypatch, case):
         b = pc.Shape(star(9, 2, (1.0, 0.5), 2.0), [star(5, 3, (1.0, 0.5), 0.3, 0.5)[::-1]])
         want_path = {"ring": 0, "pieces": 1}
     elif case == "large ring":  # beyond ear clipping: GEOS's pieces
-        b = pc.Shape(star(nfp_module._EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
+        b = pc.Shape(star(EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
         want_path = {"ring": 1, "pieces": 1}
     elif case == "budget":  # the ring kernel declines, the pieces path refuses
         monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
@@ -331,7 +333,7 @@ def test_may_be_surrounded_is_false_only_where_not_surrounded(sums, seed):
     # every direction (along the edges too), never False where surrounded is True
     xy, starts = sums
     bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
-    eps, ang = 1e-12, nfp_module.ANGLE_TOLERANCE
+    eps, ang = 1e-12, ANGLE_TOLERANCE
     rng = np.random.default_rng(seed)
     pts = np.vstack([xy, 0.5 * (xy + np.roll(xy, -1, axis=0)),
                      rng.integers(0, 4, (8, 2)) + rng.choice([0.0, 0.5, 3e-13], (8, 2))])
@@ -350,7 +352,7 @@ def test_may_be_surrounded_at_a_corner_of_four_squares_and_of_one():
     xy = np.concatenate([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
     starts = np.arange(0, 17, 4, dtype=np.int64)
     bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
-    args = (starts, bb, fr, 1e-12, nfp_module.ANGLE_TOLERANCE)
+    args = (starts, bb, fr, 1e-12, ANGLE_TOLERANCE)
     for v in DIRECTIONS:  # the shared corner: every direction is entered
         assert kn._may_be_surrounded(1.0, 1.0, *v, *args)
     assert kn._may_be_surrounded(2.0, 1.0, -1.0, 0.0, *args)  # (surrounded says no)

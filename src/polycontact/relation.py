@@ -306,9 +306,9 @@ class Relation:
 
     @_cached
     def _penetration(self) -> tuple[float, float, float]:
-        from ._kernels import depth as kd
+        from ._depth import penetration
 
-        return cast("tuple[float, float, float]", kd.penetration(*self._packed, self.tolerance))
+        return penetration(*self._packed, self.tolerance)
 
     @_cached
     def distance(self) -> float:
@@ -603,15 +603,14 @@ class RelationBatch:
     @cached_property
     def distances(self) -> np.ndarray:
         """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
-        from ._kernels import depth as kd
-        from ._kernels import relation as kr
+        from ._depth import penetrations
         from ._kernels import relation_many as km
 
         pack = self._pack()
         out = km.many_distances(*pack, self.states, self.tolerances)
-        pen = np.flatnonzero(self.states == kr.PENETRATING)
+        pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
         if pen.size:
-            out[pen] = -kd.penetrations(*pack, pen, self.tolerances[pen])[:, 0]
+            out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
         return cast("np.ndarray", out)
 
 
@@ -655,7 +654,7 @@ def _classify_arrays(
 
     out = km.raw_states_outputs(arr_a.shape[0])
     _split(arr_a.shape[0], lambda p0, p1: km.raw_states(
-        arr_a[p0:p1], arr_b[p0:p1], tol, *_RING_ARGS, [o[p0:p1] for o in out]))
+        arr_a[p0:p1], arr_b[p0:p1], tol, *_RING_ARGS, tuple(o[p0:p1] for o in out)))
     states, eps, used_a, sign_a, used_b, sign_b = out
     if (states < 0).any():
         return None
@@ -713,7 +712,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, .
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def _pack(items: Any, what: str) -> tuple[Any, ...]:
+def pack_bodies(items: Any, what: str) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
@@ -764,8 +763,8 @@ def classify_many(
         batch = _classify_arrays(arr_a, arr_b, tol)
         if batch is not None:
             return batch
-    pa = _pack(shapes_a, "shapes_a")
-    pb = _pack(shapes_b, "shapes_b")
+    pa = pack_bodies(shapes_a, "shapes_a")
+    pb = pack_bodies(shapes_b, "shapes_b")
     if len(pa[3]) != len(pb[3]):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"

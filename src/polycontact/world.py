@@ -42,11 +42,10 @@ from .motion import Motion
 from .relation import Relation, classify
 from .bodies import BodyLike, as_shape
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_tolerance
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_FACTOR, check_range, default_tolerance
 
 __all__ = ["World", "WorldBody", "Contacts", "Query"]
 
-_ULP_FACTOR = ROUNDING_ULPS * 2.0**-52
 #: query_many tests every body's box, not the grid's cells, up to this many bodies.
 _SCAN_BODIES = 64
 
@@ -263,7 +262,7 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     of its two bodies' (a maximum of per-body terms), which the kernels take."""
     extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
-    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude))
+    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, ROUNDING_FACTOR * magnitude))
 
 
 def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int) -> Shape:
@@ -450,9 +449,9 @@ class World:
         >>> w.contacts().pairs.tolist()
         [[0, 1]]
         """
-        from .relation import _pack
+        from .relation import pack_bodies
 
-        xy, ls, bs, sign = _pack(shapes, "shapes")
+        xy, ls, bs, sign = pack_bodies(shapes, "shapes")
         count = len(sign)
         if names is not None:
             names = list(names)
@@ -752,7 +751,7 @@ class World:
                                             np.zeros(4), 0.0)
         states: np.ndarray = _k().query_many(
             sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
-            RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
+            RELATIVE_TOLERANCE, ROUNDING_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
             self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
             *hz, self._hmax if has_c else 0, scan, _chunks(len(pos)),
         )

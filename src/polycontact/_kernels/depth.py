@@ -28,9 +28,9 @@ in both) first take the vertex-edge contact segments of
 fallback when that kernel cannot decide (segments that run together: slides, exact
 fits).
 
-Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
-pair computed once, in parallel; for the pairs left to this search, each distinct body
-decomposed once.
+Many pairs (for ``classify_many(...).distances``): :func:`contact_depths` and
+:func:`depths_of_pairs` compute pairs in parallel, :func:`distinct_bodies` finds the
+bodies to decompose once (see :func:`polycontact._depth.penetrations`).
 """
 
 from __future__ import annotations
@@ -38,13 +38,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..errors import DepthTooLargeError
 from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
                   sum_into)
 from .convolution import FEW_VERTICES, _foot, _penetrates, contact_depth
 from .decompose import ring_pieces
 from .relation import _bbox, scratch_floats
-from .relation_many import _body, _oriented
+from .relation_many import body, _oriented
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -309,60 +308,6 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
     return best, bdx, bdy, found
 
 
-def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
-                eps: float) -> tuple[float, float, float]:
-    """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
-
-    Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). Bodies of at most
-    :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices in all take
-    :func:`polycontact._kernels.convolution.contact_depth` (no decomposition), unless
-    it cannot decide. Otherwise the first escape is :func:`first_escape`'s (out of B's
-    bounding box, or along an edge normal); then :func:`depth_from_pieces` looks for a
-    nearer one on the union of the convex sums of the pieces of B and −A (decomposed in
-    O(n log n), cached by coordinates).
-
-    Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
-    pieces whose sums reach the disk of the first escape and their K edges, plus the
-    clipping of each edge nearer than the depth (usually by one sum; by up to P when it
-    is uncovered) and one state check, O((m + n) log(m + n)), per uncovered part nearer
-    than the best escape so far. When one body is small or convex, P = O(m + n) and the
-    whole is near O((m + n) log(m + n)). Two large concave bodies whose pieces are long
-    (stars) make P grow with the product of their piece counts even for a shallow
-    overlap, up to about m n / 4 for deeply interlocked ones: O(P + K P) at worst
-    (figures: ``benchmarks/bench_scaling.py``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> st = np.array([0, 4])
-    >>> [float(v) for v in penetration(sq, st, sq + np.array([0.75, 0.5]), st, 1e-12)]
-    [0.25, -0.25, 0.0]
-    """
-    from ..nfp import _pieces_packed
-
-    if len(xa) + len(xb) <= FEW_VERTICES:
-        fast = contact_depth(xa, sa, xb, sb, *box_escape(xa, xb), eps)
-        if fast[3]:
-            return fast[0], fast[1], fast[2]
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
-                            MAX_SUM_VERTICES)
-    if np.isnan(got[0]):
-        raise _too_large(len(xa), len(xb))
-    return got
-
-
-def _too_large(m: int, n: int) -> DepthTooLargeError:
-    return DepthTooLargeError(
-        f"penetration depth: the convex sums of the pieces near the overlap would hold "
-        f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({m} and "
-        f"{n} vertices) are too large and interlocked for this depth"
-    )
-
-
 #: Up to this many vertices in both bodies, :func:`first_escape` tries the normals of
 #: every edge (O((m + n)^2)); above, only the box's axes.
 _FEW_NORMALS = 64
@@ -463,19 +408,11 @@ def box_escape(xa, xb):
     return bound, bdx, bdy
 
 
-#: Most vertices of convex sums the depth builds (about 80 bytes each with their frames
-#: and sort keys: 2.4 GB). Beyond, the depth is refused with an error, not killed by
-#: the system for want of memory.
-MAX_SUM_VERTICES = 30_000_000
-
-
-
-
 # -- many pairs (classify_many's distances) ------------------------------------------------
 
 
 @njit(cache=True, nogil=True)
-def _same_body(x, ls, bs, f, p, q):
+def _samebody(x, ls, bs, f, p, q):
     """Whether bodies p and q of a packed batch are equal (loops, orientation, vertices)."""
     if f[p] != f[q] or bs[p + 1] - bs[p] != bs[q + 1] - bs[q]:
         return False
@@ -523,7 +460,7 @@ def distinct_bodies(x, ls, bs, f, ids):
             k = order[u]
             rep[k] = k
             for v in range(m):
-                if _same_body(x, ls, bs, f, ids[reps[v]], ids[k]):
+                if _samebody(x, ls, bs, f, ids[reps[v]], ids[k]):
                     rep[k] = reps[v]
                     break
             if rep[k] == k:
@@ -598,8 +535,8 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
     out = np.empty((n, 3))
     for k in prange(n):
         p = pairs[k]
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
         ya = _oriented(ya, sa, fa[p])
         yb = _oriented(yb, sb, fb[p])
         ra = rfirst[slot_a[k]]
@@ -624,8 +561,8 @@ def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
         if (lsa[bsa[p + 1] - 1] - lsa[bsa[p]] + lsb[bsb[p + 1] - 1] - lsb[bsb[p]]
                 > FEW_VERTICES):
             continue
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
         ya = _oriented(ya, sa, fa[p])
         yb = _oriented(yb, sb, fb[p])
         bound, bdx, bdy = box_escape(ya, yb)
@@ -633,86 +570,3 @@ def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
         if got[3]:
             out[k, 0], out[k, 1], out[k, 2] = got[0], got[1], got[2]
     return out
-
-
-def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
-                  ids: np.ndarray, negate: bool) -> tuple[np.ndarray, ...]:
-    """:func:`pieces_of_bodies`, with the bodies it leaves decomposed by
-    :func:`polycontact.nfp._pieces_packed` (GEOS) and appended."""
-    from ..nfp import _EAR_CLIPPING_MAX, _pieces_packed
-    from ..tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
-
-    xy, st, first, count, ok = pieces_of_bodies(x, ls, bs, f, ids, negate,
-                                                RELATIVE_TOLERANCE, ROUNDING_ULPS,
-                                                _EAR_CLIPPING_MAX)
-    if ok.all():
-        return xy, st, first, count
-    more_xy, more_st = [xy], [st]
-    rows, at = len(xy), len(st)
-    for k in np.flatnonzero(~ok):
-        y, s = _body(x, ls, bs, ids[k])
-        if f[ids[k]] < 0.0:  # a raw clockwise ring
-            y = y[::-1].copy()
-        pxy, pst = _pieces_packed(y, s)
-        more_xy.append(-pxy if negate else pxy)
-        more_st.append(pst + rows)
-        first[k], count[k] = at, len(pst) - 1
-        rows += len(pxy)
-        at += len(pst)
-    return np.concatenate(more_xy), np.concatenate(more_st), first, count
-
-
-def _depths_by_pieces(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
-                      xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
-                      pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """:func:`depths_of_pairs` of the pairs ``pairs``, each distinct body decomposed once
-    (NaN rows as there)."""
-    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
-    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
-    ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
-    rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    return depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, *ra,
-                           slot_b, *rb, MAX_SUM_VERTICES)
-
-
-def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
-                 xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
-                 pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """Penetration depths of the pairs ``pairs`` of two packed batches (the form of
-    :mod:`polycontact._kernels.relation_many`), in parallel: ``(P, 3)`` rows ``(depth,
-    dx, dy)``, each equal to :func:`penetration` of the pair; ``eps`` per pair.
-
-    Each distinct pair (the same two bodies and tolerance) is computed once: by
-    :func:`contact_depths`, then the pairs it leaves by :func:`depths_of_pairs`, each
-    distinct body among those decomposed once, in parallel.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> ls, bs, f = np.array([0, 4]), np.array([0, 2]), np.ones(1)
-    >>> penetrations(sq, ls, bs, f, sq + 0.5, ls, bs, f, np.array([0]), np.array([1e-12]))
-    array([[ 0.5, -0.5,  0. ]])
-    """
-    pairs = np.asarray(pairs, dtype=np.int64)
-    eps = np.ascontiguousarray(eps, dtype=np.float64)
-    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
-    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
-    # equal pairs (the same A, B and tolerance) have the same depth: one computation
-    order = np.lexsort((eps.view(np.int64), slot_b, slot_a))
-    key = np.c_[slot_a[order], slot_b[order], eps[order].view(np.int64)]
-    new = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
-    one = order[new]  # the first of each group of equal pairs
-    group = np.empty(len(pairs), np.int64)
-    group[order] = np.cumsum(new) - 1
-    out = contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one])
-    rest = np.flatnonzero(np.isnan(out[:, 0]))  # (large bodies, or undecided)
-    if rest.size:
-        out[rest] = _depths_by_pieces(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one[rest]],
-                                      eps[one[rest]])
-    bad = np.flatnonzero(np.isnan(out[:, 0]))
-    if bad.size:
-        p = pairs[one[bad[0]]]
-        raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
-                         int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]))
-    return out[group]

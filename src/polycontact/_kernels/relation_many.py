@@ -52,35 +52,39 @@ def check_rings(xy, lo, n, rel, ulps, limit, floor):
 _UNDECIDED = -2
 
 
+@njit(cache=True, nogil=True)
 def raw_states_outputs(p_count):
     """Empty arrays for the six results of :func:`raw_states` over ``p_count`` pairs."""
     return (np.empty(p_count, np.int8), np.zeros(p_count), np.empty(p_count, np.int64),
             np.empty(p_count), np.empty(p_count, np.int64), np.empty(p_count))
 
 
-def raw_states(xa, xb, tol, rel, ulps, limit, floor, out=None):
+@njit(cache=True, nogil=True)
+def raw_states(xa, xb, tol, rel, ulps, limit, floor, out):
     """Validate and classify P pairs of raw outer rings, ``xa`` (P, N, 2) against
-    ``xb`` (P, M, 2), in one pass over the pairs.
+    ``xb`` (P, M, 2), in one pass over the pairs, into ``out``.
 
-    Returns ``(states, eps, used_a, sign_a, used_b, sign_b)``: per pair the state
-    (int8; -1 when either ring is not valid as given), the tolerance, and per ring
-    the vertices used (a repeated closing point dropped; -1 if invalid) and the
-    orientation sign (see :func:`polycontact._kernels.relation._raw_ring`).
-    ``tol`` < 0 means per pair the default tolerance
+    ``out`` is the tuple of arrays ``(states, eps, used_a, sign_a, used_b, sign_b)``
+    (P each; int8, float64, int64, float64, int64, float64), written and returned: per
+    pair the state (-1 when either ring is not valid as given), the tolerance, and per
+    ring the vertices used (a repeated closing point dropped; -1 if invalid) and the
+    orientation sign (see :func:`polycontact._kernels.relation._raw_ring`). ``tol`` < 0
+    means per pair the default tolerance
     (:func:`polycontact._kernels.relation.pair_tolerance` with ``rel`` and ``ulps``);
     ``limit`` and ``floor`` bound the coordinates and extents accepted.
 
     The pass itself (:func:`_raw_states_into`) allocates nothing; the few pairs it
     leaves undecided (long rings that need a sorted sweep) are finished by
-    :func:`_finish_undecided`. (A plain function: it only allocates and dispatches.)
-    ``out``, if given, is that tuple of arrays to write into (views of larger ones, say).
+    :func:`_finish_undecided`.
     """
-    if out is None:
-        out = raw_states_outputs(xa.shape[0])
-    scratch = (*_scratch(xa.shape[1] + xb.shape[1]), np.zeros(2, np.int64),
-               np.zeros(2, np.int64))
-    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch):
-        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch)
+    states, eps, used_a, sign_a, used_b, sign_b = out
+    box, ids, touch, rays, rord = _scratch(xa.shape[1] + xb.shape[1])
+    sa = np.zeros(2, np.int64)
+    sb = np.zeros(2, np.int64)
+    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
+                        used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
+        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
+                          used_b, sign_b, box, ids, touch, rays, rord, sa, sb)
     return out
 
 
@@ -147,7 +151,9 @@ def _pair_state(ya, na, fa, ba, yb, nb, fb, bb, tol, rel, ulps, sa, sb, box, ids
 
 
 @njit(cache=True, nogil=True)
-def _body(xy, ls, bs, p):
+def body(xy, ls, bs, p):
+    """``(rows, starts)`` of body ``p`` of a packed batch: its rows of ``xy`` (a view)
+    and its loop starts relative to them (a new array)."""
     first = ls[bs[p]]
     starts = ls[bs[p] : bs[p + 1]] - first
     return xy[first : ls[bs[p + 1] - 1]], starts
@@ -155,7 +161,7 @@ def _body(xy, ls, bs, p):
 
 @njit(cache=True, nogil=True)
 def _body_into(xy, ls, bs, p, buf):
-    """:func:`_body` with the loop starts written into ``buf`` (no allocation)."""
+    """:func:`body` with the loop starts written into ``buf`` (no allocation)."""
     first = ls[bs[p]]
     m = bs[p + 1] - bs[p]
     for k in range(m):
@@ -282,8 +288,8 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
     b0 = lsb[bsb[p]]
     b1 = lsb[bsb[p + 1] - 1]
     if (a1 - a0) * (b1 - b0) > _BRUTE_GAP:
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
         return closest_pair(ya, sa, yb, sb)[0]
     best = np.inf
     for i in range(a0, a1):

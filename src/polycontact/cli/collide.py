@@ -7,6 +7,7 @@ import json
 import sys
 from typing import Any
 
+from ..limits import SAMPLES, TIME_TOLERANCE
 from ._io import CommandError, index_text, integer_at_least, positive_number
 
 
@@ -21,10 +22,10 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("scene", metavar="SCENE.json", help="scene file (see the README)")
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
-    p.add_argument("--samples", type=integer_at_least(2), default=10,
-                   help="time points per round of the sampled method (default 10)")
+    p.add_argument("--samples", type=integer_at_least(2), default=SAMPLES,
+                   help=f"time points per round of the sampled method (default {SAMPLES})")
     p.add_argument("--time-tolerance", type=positive_number, default=None,
-                   help="accuracy of the time (default: the scene's, else 1e-4)")
+                   help=f"accuracy of the time (default: the scene's, else {TIME_TOLERANCE:g})")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
     p.add_argument("--all", action="store_true",

@@ -6,7 +6,10 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..shape import Shape
 
 #: Coordinates are in whatever length unit the caller used (consistent throughout).
 LENGTH_LABEL = "(length units)"
@@ -22,6 +25,19 @@ def label_axes(ax: Any) -> None:
     ax.set_xlabel(f"x {LENGTH_LABEL}")
     ax.set_ylabel(f"y {LENGTH_LABEL}")
     ax.set_aspect("equal")
+
+
+def draw_shape(ax: Any, shape: Shape, color: str, alpha: float, label: str | None) -> None:
+    """Fill every loop of ``shape`` (holes left open) in ``color`` on ``ax``."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    verts, codes = [], []
+    for loop in shape.loops:
+        verts += [*loop.tolist(), loop[0].tolist()]
+        codes += [Path.MOVETO] + [Path.LINETO] * (len(loop) - 1) + [Path.CLOSEPOLY]
+    ax.add_patch(PathPatch(Path(verts, codes), facecolor=color, edgecolor=color,
+                           alpha=alpha, lw=1.0, label=label))
 
 
 def legend_outside(ax: Any) -> Any:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._style import label_axes, legend_outside
+from ._style import draw_shape, label_axes, legend_outside
 
 __all__ = ["plot_relation"]
 
@@ -34,13 +34,11 @@ def plot_relation(relation: Any, ax: Any = None) -> Any:
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    from .impact import _draw
-
     if ax is None:
         _, ax = plt.subplots(figsize=(8, 6), layout="constrained")
     a, b = relation.shapes
-    _draw(ax, a, "tab:red", 0.45, "A")
-    _draw(ax, b, "tab:blue", 0.45, "B")
+    draw_shape(ax, a, "tab:red", 0.45, "A")
+    draw_shape(ax, b, "tab:blue", 0.45, "B")
     point, normal = relation.point, relation.normal
     if point is not None:
         ax.plot(*point, "*", color="gold", markeredgecolor="black", ms=13, zorder=5,
