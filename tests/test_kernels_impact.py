@@ -281,7 +281,7 @@ def test_sampled_search_follows_the_paper_steps():
 @given(vec, st.floats(-4, 4), vec, st.floats(-4, 4), st.floats(-1, 1), st.floats(0, 1))
 @example((0.0, 0.0), 0.0, (-1.0, 0.0), 0.0, 0.0, 0.9999999999999999)
 def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
-    from polycontact._kernels.relation import boundary_distance
+    from polycontact._kernels.distance import boundary_distance
 
     a = Shape([(0, 0), (2, 0.5), (1, 0.7), (0.5, 1.5)])
     b = Shape([(0, 0), (1, 0), (1, 3), (0.5, 1), (0, 3)]).moved((3.0, dy))
@@ -321,7 +321,7 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     """The directional step (both the all-pairs scan and, with 12-point stars, the
     sorted sweep) never lets the boundaries come within lam, with turning, spinning
     and accelerating bodies."""
-    from polycontact._kernels.relation import boundary_distance
+    from polycontact._kernels.distance import boundary_distance
 
     a = _star(n, 1.0, 0.6, 0.1)
     b = _star(n, 0.8, 0.5, 0.3).moved((2.4, dy))
@@ -354,7 +354,7 @@ def test_a_packed_body_unpacks_to_its_arrays(n, holes, offset, radius):
     table = edge_table(r, starts)
     centroid = np.array([offset, -offset])
     f, i = ki.pack_body(r, starts, centroid, radius, table)
-    r2, s2, c2, rad2, table2 = ki._unpack_body(f, i)
+    r2, s2, c2, rad2, table2 = ki.unpack_body(f, i)
     assert np.array_equal(r2, r) and np.array_equal(s2, starts)
     assert np.array_equal(c2, centroid) and rad2 == radius
     for got, want in zip(table2, table):

@@ -25,12 +25,13 @@ SRC = Path(polycontact.__file__).resolve().parents[1]
 CODE = """
 import numpy as np
 from polycontact import Shape
+from polycontact._kernels import packs as kpack
 from polycontact._kernels import relation as kr
 a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 b = a.moved((1.0, 0.5))
 # the scratch-passing kernel first: its helpers are compiled from it
 print(kr.relate_shapes_into(a._kernel, b._kernel, 1e-12))
-views = kr._scratch(8)
+views = kpack.state_scratch(8)
 print([v.base.refcount for v in views])  # one reference per view
 got = [kr.relate_state(*a.packed, *a.moved(d).packed, 1e-12)
        for d in ((1.0, 0.5), (0.5, 0.5), (3.0, 0.0)) for _ in range(50)]

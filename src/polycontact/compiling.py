@@ -39,10 +39,10 @@ __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
     "classification": ("relation.relate_shapes_into", "relation.relate_state",
-                       "relation.classify_raw", "depth.contact_depths"),
+                       "rings.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
-    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "nfp.touching_contacts",
-                       "nfp.select_contacts"),
+    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
+                       "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
 }

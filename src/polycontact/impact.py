@@ -274,7 +274,7 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     if speed <= 0.0 or t_hi - t_lo <= lam / speed:
         return t_lo, t_hi
     (ra, ea, *_), (rb, eb, *_) = body_frame(a), body_frame(b)
-    code, hi, lo, *_ = ki._prepared_exact_search(
+    code, hi, lo, *_ = ki.exact_search_tables(
         ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
         lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, ROUNDING_FACTOR, lam,
         MAX_ITERATIONS)
@@ -284,9 +284,9 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
     """The distance tolerance at time t, as the kernels compute it: the size term
     ``eps_rel`` or the float spacing of the coordinates at t, whichever is larger."""
-    from ._kernels.impact import _eps_at as eps_at
+    from ._kernels.impact import tolerance_at
 
-    return float(eps_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
+    return float(tolerance_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
                         b.bounding_radius, t, eps_rel, ROUNDING_FACTOR))
 
 
@@ -298,7 +298,7 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
     penetration (speed bound × bracket length): every vertex that can meet an edge by
     then counts as touching.
     """
-    from ._kernels.relation import boundary_distance
+    from ._kernels.distance import boundary_distance
 
     pa = a.at(ma, t)
     pb = b.at(mb, t)

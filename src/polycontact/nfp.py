@@ -20,7 +20,7 @@ calling this for many pairs of the same pieces decomposes each piece once.
 An area union loses the positions where A fits exactly: a jigsaw piece in its socket
 (an isolated point) or a square sliding in a slot of its own width (a segment). They are
 the positions inside ``E`` where the interiors do not overlap; polycontact finds them
-separately (see :mod:`polycontact._kernels.nfp`) and reports them as
+separately (see :mod:`polycontact._kernels.fits`) and reports them as
 :attr:`NoFitPolygon.exact_fits` and :attr:`NoFitPolygon.slides`.
 
 Examples
@@ -99,8 +99,9 @@ def fallback_count() -> int:
 @functools.cache
 def _kernels() -> SimpleNamespace:
     """The compiled kernels, imported on first use (Numba loads only when needed)."""
-    from ._kernels import nfp
-    return SimpleNamespace(nfp=nfp)
+    from ._kernels import fits, minkowski, nfp
+
+    return SimpleNamespace(nfp=nfp, minkowski=minkowski, fits=fits)
 
 
 #: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
@@ -516,7 +517,7 @@ def _entrance_result(
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = _kernels().nfp.convex_sums(*pieces())
+        sums, starts = _kernels().minkowski.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     if not n_cand:
@@ -625,7 +626,7 @@ def _touching(
     """The selection of :func:`_clean_degenerate` for the no-fit polygon: the candidates
     where A with its reference there (at a slide's middle and both ends) touches B
     without overlapping, verified by the classifier and selected in one kernel call."""
-    touching_contacts = _kernels().nfp.touching_contacts
+    touching_contacts = _kernels().fits.touching_contacts
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
@@ -647,7 +648,7 @@ def _checked(
 
     def select(pts: np.ndarray, segs: np.ndarray, near: float) -> Any:
         pts_ok, segs_ok = check(pts, segs)
-        return _kernels().nfp.select_contacts(
+        return _kernels().fits.select_contacts(
             np.ascontiguousarray(pts), np.asarray(pts_ok, dtype=np.bool_), segs,
             np.asarray(segs_ok, dtype=np.bool_), near)
 
@@ -664,7 +665,7 @@ def _clean_degenerate(
     of sum edges, and the kernel has snapped them to those (within
     ``SNAP_FACTOR * eps``) and merged collinear slides. ``make_select()`` gives
     ``select(pts, segs, near)``: the verified candidates with fits on a kept slide or
-    near a kept fit dropped (:func:`polycontact._kernels.nfp.select_contacts`, after
+    near a kept fit dropped (:func:`polycontact._kernels.fits.select_contacts`, after
     the no-fit polygon's check :func:`_touching` or any other, :func:`_checked`).
     """
     if len(pts) == 0 and len(segs) == 0:

@@ -300,9 +300,9 @@ class Relation:
 
     @_cached
     def _closest(self) -> tuple[float, float, float, float, float]:
-        from ._kernels import relation as kr
+        from ._kernels.distance import closest_pair
 
-        return cast("tuple[float, float, float, float, float]", kr.closest_pair(*self._packed))
+        return cast("tuple[float, float, float, float, float]", closest_pair(*self._packed))
 
     @_cached
     def _penetration(self) -> tuple[float, float, float]:
@@ -328,9 +328,9 @@ class Relation:
 
     @_cached
     def _raw_features(self) -> tuple[Any, ...]:
-        from ._kernels import relation as kr
+        from ._kernels.features import features
 
-        return cast("tuple[Any, ...]", kr.features(*self._packed, self.tolerance))
+        return cast("tuple[Any, ...]", features(*self._packed, self.tolerance))
 
     @_cached
     def features(self) -> tuple[Feature, ...]:
@@ -561,7 +561,9 @@ def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relati
         and b.flags.c_contiguous
     ):
         if not _RAW:
-            _RAW.append(_kr().classify_raw)
+            from ._kernels.rings import classify_raw
+
+            _RAW.append(classify_raw)
         code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, *_RING_ARGS)
         if code >= 0:
             # The lean path: the bytes are the copy the lazy parts are computed from.

@@ -642,7 +642,7 @@ def _fmt(v: float) -> str:
 def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                  tolerance: float) -> bytes:
     """The shape as the bytes of one float64 array, the layout of
-    :data:`polycontact._kernels.relation.PACK_HEAD`: loop count, bounding box ``(xmin,
+    :data:`polycontact._kernels.packs.PACK_HEAD`: loop count, bounding box ``(xmin,
     ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the shape's
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
     patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the

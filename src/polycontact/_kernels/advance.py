@@ -28,7 +28,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .validate import closest_on_segment
+from .primitives import closest_on_segment, outward_normal
+
 
 #: Entries of the traversal stack (see :func:`traversal_stack`).
 STACK_SIZE = 160
@@ -199,19 +200,7 @@ def _root_or_linear(g, r, k, speed, cap):
 
 
 @njit(cache=True, nogil=True)
-def outward_normal(ax, ay, bx, by):
-    """``(length, nx, ny)`` of edge ab and its unit outward normal (the interior is on
-    the edge's left, so the normal points right); the normal is (0, 0) for a point."""
-    ex = bx - ax
-    ey = by - ay
-    ln = np.sqrt(ex * ex + ey * ey)
-    if ln == 0.0:
-        return 0.0, 0.0, 0.0
-    return ln, ey / ln, -ex / ln
-
-
-@njit(cache=True, nogil=True)
-def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap, dax,
+def line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap, dax,
                day):
     """A time in [0, cap] during which vertex p stays more than ``level`` in front of the
     line of edge ab as the line turns with its body E (0 if it is not now; arguments as
@@ -245,7 +234,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     """``(d², τ)``: the squared distance from vertex p to edge ab of the other body E, and
     a time in [0, cap] during which p stays more than ``lam`` from the edge. A pair within
     ``lam`` now gets 0, or, when ``touch`` > 0, the time during which p stays no more
-    than ``touch`` behind the edge's turning line (:func:`_line_time`; see
+    than ``touch`` behind the edge's turning line (:func:`line_time`; see
     :func:`pair_step` for what that proves).
 
     ``(vx, vy)`` is p's velocity, ``rp`` its distance from its body's centroid; ``ra``,
@@ -264,7 +253,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     - the same with the plain speed bound |f'| <= V + W_v |r_p| + W_e |r_x|
       (:func:`_root_or_linear`);
     - when p is more than ``lam`` outside the edge's line, its signed distance to the
-      line turning with E (:func:`_line_time`), a lower bound of the distance to the
+      line turning with E (:func:`line_time`), a lower bound of the distance to the
       edge. Its slope now is the velocity of p relative to E's point under it, so a
       vertex sliding along the line (or closing slowly towards it while the edge
       turns) keeps long steps.
@@ -272,7 +261,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     if d2 <= lam * lam:
         if touch > 0.0:
-            return d2, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
+            return d2, line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
                                   -touch, cap, dax, day)
         return d2, 0.0
     sp = kin[3] + kin[4] * rp
@@ -293,7 +282,7 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
                               (vx - ubx) * nx + (vy - uby) * ny, kp + kin[2] * rb,
                               sp + kin[5] * rb, cap))
     if tau < cap:
-        tau = max(tau, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
+        tau = max(tau, line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
                                   lam, cap, dax, day))
     return d2, tau
 

@@ -38,25 +38,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
-                  sum_into)
-from .convolution import FEW_VERTICES, _foot, _penetrates, contact_depth
+from .convolution import FEW_VERTICES, contact_depth, penetrates
 from .decompose import ring_pieces
-from .relation import _bbox, scratch_floats
-from .relation_many import body, _oriented
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot_sq(ax, ay, bx, by, ux, uy, c):
-    """Squared distance from the origin to segment ab, of unit direction (ux, uy) and
-    line offset c (:func:`polycontact._kernels.nfp._frames`: the origin lies at -c
-    from the line): no division."""
-    s = -(ax * ux + ay * uy)  # where the foot of the line falls, from a towards b
-    if s <= 0.0:
-        return ax * ax + ay * ay
-    if s >= (bx - ax) * ux + (by - ay) * uy:
-        return bx * bx + by * by
-    return c * c
+from .minkowski import (GRID, GRID_MIN_SUMS, boxes, clip_edge, frames, in_some_sum, lowest,
+                        sum_index, sum_into)
+from .packs import scratch_floats
+from .primitives import bbox, origin_distance_sq_framed, origin_foot
+from .relation_many import body, oriented
 
 
 @njit(cache=True, nogil=True)
@@ -137,33 +125,15 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     for k in range(pairs.shape[0]):
         ps = bstarts[pairs[k, 0]]
         pe = bstarts[pairs[k, 0] + 1]
-        w = sum_into(bxy, ps, pe, _lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
+        w = sum_into(bxy, ps, pe, lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
                      rstarts[pairs[k, 1] + 1], out, w)
         starts[k + 1] = w
     return out[:w].copy(), starts
 
 
 @njit(cache=True, nogil=True)
-def _covered(px, py, starts, bb, fr, skip, eps):
-    """Whether p lies inside a convex sum other than ``skip`` by more than eps (edge
-    frames ``fr``, boxes ``bb``: :mod:`polycontact._kernels.nfp`)."""
-    for q in range(starts.shape[0] - 1):
-        if (q == skip or px <= bb[q, 0] + eps or px >= bb[q, 2] - eps or py <= bb[q, 1] + eps
-                or py >= bb[q, 3] - eps):
-            continue
-        inside = True
-        for i in range(starts[q], starts[q + 1]):
-            if fr[i, 3] != 0.0 and fr[i, 0] * py - fr[i, 1] * px - fr[i, 2] <= eps:
-                inside = False
-                break
-        if inside:
-            return True
-    return False
-
-
-@njit(cache=True, nogil=True)
 def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                      max_vertices, grid_from=_GRID_MIN_SUMS):
+                      max_vertices, grid_from=GRID_MIN_SUMS):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
     ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
@@ -174,7 +144,7 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     kernel; if rounding left it penetrating, the search is made again from the box's
     escape), NaNs when the sums would hold more than ``max_vertices`` vertices (none
     is built). The edges are clipped with the grid of
-    :func:`polycontact._kernels.nfp.sum_index` from ``grid_from`` sums on, else by the
+    :func:`polycontact._kernels.minkowski.sum_index` from ``grid_from`` sums on, else by the
     scan alone (a 12-gon pair makes about 9 sums; the grid's set-up cost 83 of its 105
     us).
 
@@ -188,7 +158,7 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     scratch = np.empty(scratch_floats(xa.shape[0] + xb.shape[0]))
     got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
                           max_vertices, grid_from, moved, scratch)
-    if got[3] or np.isnan(got[0]) or not _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    if got[3] or np.isnan(got[0]) or not penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return got[0], got[1], got[2]
     # (a normal's escape left touching within rounding, yet penetrating: the box's)
     bound, bdx, bdy = box_escape(xa, xb)
@@ -202,7 +172,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
                     max_vertices, grid_from, moved, scratch):
     """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
     when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
-    confirmed); ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution._penetrates`.
+    confirmed); ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution.penetrates`.
 
     The origin's distance to the outline of a sum that holds it is a lower bound of the
     depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
@@ -210,7 +180,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
     foot on that outline escapes, it is the depth.
     """
     best = bound
-    pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound,
+    pairs = _select_pairs(boxes(bxy, bstarts), boxes(rxy, rstarts), bound,
                           bstarts, rstarts, max_vertices)
     if pairs.shape[0] == 1 and pairs[0, 0] < 0:
         return np.nan, np.nan, np.nan, False
@@ -218,8 +188,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
         return best, bdx, bdy, False
     xy, starts = _pair_sums(bxy, bstarts, rxy, rstarts, pairs)
     k = starts.shape[0] - 1
-    bb = _bboxes(xy, starts)
-    fr = _frames(xy, starts)
+    bb = boxes(xy, starts)
+    fr = frames(xy, starts)
     n_edges = xy.shape[0]
     dist = np.empty(n_edges)  # squared distances of the edges from the origin
     owner = np.empty(n_edges, np.int64)
@@ -240,8 +210,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
                 if -fr[i, 2] < inner:  # the origin's distance inside edge i
                     inner = -fr[i, 2]
                     nearest = i
-                dist[i] = _foot_sq(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], fr[i, 0], fr[i, 1],
-                                   fr[i, 2])
+                dist[i] = origin_distance_sq_framed(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1],
+                                                    fr[i, 0], fr[i, 1], fr[i, 2])
         if inner < np.inf and inner > low:
             low = inner
             deepest = p
@@ -253,13 +223,13 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
     if deepest >= 0:
         fx = low * fr[side, 1]
         fy = -low * fr[side, 0]
-        if (not _covered(fx, fy, starts, bb, fr, deepest, eps)
-                and not _penetrates(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
+        if (not in_some_sum(fx, fy, starts, bb, fr, eps, deepest)
+                and not penetrates(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
             return low, fx, fy, True
     near = np.flatnonzero(dist < best * best)  # (only these are visited: sorted alone)
     by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
-    index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID, grid_from)
+    index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / GRID, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = deepest
     found = False
@@ -293,13 +263,13 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
             py0 = ay + lo * dy
             px1 = ax + hi * dx
             py1 = ay + hi * dy
-            fx, fy, fd = _foot(px0, py0, px1, py1)
+            fx, fy, fd = origin_foot(px0, py0, px1, py1)
             if fd >= best:
                 continue
             for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
                            (0.5 * (px0 + px1), 0.5 * (py0 + py1))):
                 cd = np.hypot(cx, cy)
-                if cd < best and not _penetrates(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
+                if cd < best and not penetrates(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
                     best = cd
                     bdx = cx
                     bdy = cy
@@ -389,8 +359,8 @@ def box_escape(xa, xb):
     """The shortest of the four axis translations of A (vertices ``xa``) that take it
     out of the bounding box of B (vertices ``xb``): ``(length, dx, dy)``; the first of
     +x, −x, +y, −y on a tie."""
-    ax0, ax1, ay0, ay1 = _bbox(xa, xa.shape[0])
-    bx0, bx1, by0, by1 = _bbox(xb, xb.shape[0])
+    ax0, ax1, ay0, ay1 = bbox(xa, xa.shape[0])
+    bx0, bx1, by0, by1 = bbox(xb, xb.shape[0])
     bound = bx1 - ax0
     bdx = bound
     bdy = 0.0
@@ -537,8 +507,8 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
         p = pairs[k]
         ya, sa = body(xa, lsa, bsa, p)
         yb, sb = body(xb, lsb, bsb, p)
-        ya = _oriented(ya, sa, fa[p])
-        yb = _oriented(yb, sb, fb[p])
+        ya = oriented(ya, sa, fa[p])
+        yb = oriented(yb, sb, fb[p])
         ra = rfirst[slot_a[k]]
         rb = bfirst[slot_b[k]]
         bound, bdx, bdy = first_escape(ya, yb)
@@ -552,7 +522,8 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
 def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
     """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches by
     :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
-    segments are split lazily: a nearer start saves less than it costs), in parallel; a row of NaNs where that kernel does not decide (the caller takes
+    segments are split lazily: a nearer start saves less than it costs), in parallel; a
+    row of NaNs where that kernel does not decide (the caller takes
     :func:`depths_of_pairs`); ``eps`` per pair."""
     n = pairs.shape[0]
     out = np.full((n, 3), np.nan)
@@ -563,8 +534,8 @@ def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
             continue
         ya, sa = body(xa, lsa, bsa, p)
         yb, sb = body(xb, lsb, bsb, p)
-        ya = _oriented(ya, sa, fa[p])
-        yb = _oriented(yb, sb, fb[p])
+        ya = oriented(ya, sa, fa[p])
+        yb = oriented(yb, sb, fb[p])
         bound, bdx, bdy = box_escape(ya, yb)
         got = contact_depth(ya, sa, yb, sb, bound, bdx, bdy, eps[k])
         if got[3]:

@@ -25,11 +25,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .advance import STACK_SIZE, _line_time, edge_table, outward_normal, pair_step, window_kinematics
+from .advance import STACK_SIZE, edge_table, line_time, pair_step, window_kinematics
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
-from .relation import _scratch_views, _state_in, scratch_floats
-from .validate import closest_on_segment
-from .views import vector, view
+from .packs import scratch_floats, state_scratch_views, vector, view
+from .primitives import closest_on_segment, outward_normal
+from .relation import state_in
+
 
 NO_HIT = 0
 HIT = 1
@@ -168,7 +169,7 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
     {σ <= eps} at all times if all its vertices do now (the line turns with E). Each
     edge of V is charged the time during which either both its ends keep
     σ >= −eps — each end by the second-order bound towards the turning line
-    (:func:`polycontact._kernels.advance._line_time`), and a segment lies on the side
+    (:func:`polycontact._kernels.advance.line_time`), and a segment lies on the side
     of its ends — or it stays outside E's bounding circle (its distance from E's
     centroid shrinks no faster than V + W_v max |r|, as in the pair bounds). Until the
     shortest of these times no edge of V meets W = {σ < −eps} ∩ (open circle), a convex
@@ -217,10 +218,10 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
 @njit(cache=True, nogil=True)
 def _end_time(xv, cv, mv, rv_len, m, ax, ay, bx, by, ce, me, kin, dax, day, eps, cap):
     """How long V's vertex m keeps σ >= −eps for the line of ab turning with E
-    (:func:`polycontact._kernels.advance._line_time`), up to ``cap``."""
+    (:func:`polycontact._kernels.advance.line_time`), up to ``cap``."""
     x = xv[m, 0]
     y = xv[m, 1]
-    return _line_time(x, y, mv[0] - mv[2] * (y - cv[1]), mv[1] + mv[2] * (x - cv[0]), rv_len[m],
+    return line_time(x, y, mv[0] - mv[2] * (y - cv[1]), mv[1] + mv[2] * (x - cv[0]), rv_len[m],
                       ax, ay, bx, by, ce[0], ce[1], me[0], me[1], me[2], kin, -eps, cap, dax,
                       day)
 
@@ -257,7 +258,7 @@ def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1
 @njit(cache=True, nogil=True)
 def state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch):
     """The state of the two bodies placed at time t (``xa``, ``xb`` and ``scratch``, a
-    :func:`polycontact._kernels.relation._scratch` tuple, are scratch)."""
+    :func:`polycontact._kernels.packs.state_scratch` tuple, are scratch)."""
     place(ra, ca, ma, t, xa)
     place(rb, cb, mb, t, xb)
     return _placed_state(xa, sa, xb, sb, eps, scratch)
@@ -267,7 +268,7 @@ def state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch):
 def _placed_state(xa, sa, xb, sb, eps, scratch):
     """``relate_state`` of placed bodies, with the state kernel's scratch passed in."""
     box, ids, touch, rays, rord = scratch
-    return _state_in(xa, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays, rord)
+    return state_in(xa, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays, rord)
 
 
 @njit(cache=True, nogil=True)
@@ -309,7 +310,7 @@ def _work_views(work, na, nb):
     xb = view(work, k + 2 * na, nb, 2, np.float64)
     k += 2 * size
     return (iv, bw, pa, pb, crit, stack, stau, xa, xb,
-            _scratch_views(work[k:k + scratch_floats(size)], size))
+            state_scratch_views(work[k:k + scratch_floats(size)], size))
 
 
 @njit(cache=True, nogil=True)
@@ -361,13 +362,13 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     tolerance thus decides how precisely ``t_hi`` is reported, never whether a hit is
     found, nor how many probes are taken.
     """
-    return _prepared_exact_search(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
+    return exact_search_tables(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
                                   edge_table(rb, sb), intervals, time_tol, eps_rel, ulps, lam,
                                   max_iter)
 
 
 @njit(cache=True, nogil=True)
-def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
+def exact_search_tables(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
                            eps_rel, ulps, lam, max_iter):
     """:func:`exact_search` with each body's :func:`edge_table` given (built once per
     shape by the caller)."""
@@ -379,7 +380,7 @@ def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, inter
 
 
 @njit(cache=True, nogil=True)
-def _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
+def tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
     """The distance tolerance at time t (:func:`local_tolerances` on [t, t])."""
     return max(eps_rel, ulps * max(_reach(ca, ma, la, t, t), _reach(cb, mb, lb, t, t)))
 
@@ -393,9 +394,9 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                   ulps, lam0, max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
     """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
     of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair; ``stack``,
-    ``stau``: :func:`traversal_stack`). The bodies are placed (``xa``, ``xb``) only to be
-    classified or for a slide: the steps read each vertex they need from the body
-    frame."""
+    ``stau``: :func:`polycontact._kernels.advance.traversal_stack`). The bodies are
+    placed (``xa``, ``xb``) only to be classified or for a slide: the steps read each
+    vertex they need from the body frame."""
     first_contact = -1.0
     t_guess = -1.0
     h_prev = np.inf
@@ -409,7 +410,7 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
         pb[0], pb[1] = centre(cb, mb, t)
         # after t = 0 an interval opens with the bounding circles just touching: apart
         if t == 0.0 and state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
-                                 _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
+                                 tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
                                  scratch) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
@@ -443,7 +444,7 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 # bounds converge quadratically near contact), once per guess.
                 t_guess = min(t + h + 0.99 * effective_time_tolerance(time_tol, t + h), t2)
                 if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_guess,
-                            _eps_at(ca, ma, la, cb, mb, lb, t_guess, eps_rel, ulps),
+                            tolerance_at(ca, ma, la, cb, mb, lb, t_guess, eps_rel, ulps),
                             scratch) == _PENETRATING:
                     return HIT, t_guess, t + h, first_contact if first_contact >= 0.0 else t + h, \
                         it, t_guess
@@ -483,7 +484,7 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             pa[0], pa[1] = centre(ca, ma, t_new)
             pb[0], pb[1] = centre(cb, mb, t_new)
             if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new,
-                        _eps_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
+                        tolerance_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
                         scratch) == _PENETRATING:
                 # the probe brackets the first penetration (no point moved more than
                 # lam in it); narrowed to the time tolerance by bisection
@@ -508,7 +509,8 @@ def _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, lo, hi, time_tol, ep
             break
         it += 1
         if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, mid,
-                    _eps_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps), scratch) == _PENETRATING:
+                    tolerance_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps),
+                    scratch) == _PENETRATING:
             hi = mid
         else:
             lo = mid
@@ -545,7 +547,7 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
         if lo == 0.0:
             evals += 1
             if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0,
-                        _eps_at(ca, ma, la, cb, mb, lb, 0.0, eps_rel, ulps),
+                        tolerance_at(ca, ma, la, cb, mb, lb, 0.0, eps_rel, ulps),
                         scratch) == _PENETRATING:
                 return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, evals
         found = False
@@ -555,7 +557,7 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
                 st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
-                              _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), scratch)
+                              tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), scratch)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
                     first_contact = t
                 if st == _PENETRATING:
@@ -628,7 +630,7 @@ def pack_body(r, starts, centroid, radius, table):
 
 
 @njit(cache=True, nogil=True)
-def _unpack_body(f, i):
+def unpack_body(f, i):
     """``(r, starts, centroid, radius, table)`` of a :func:`pack_body`, as views."""
     n = i[0]
     k = i[1]
@@ -643,8 +645,8 @@ def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, 
                work):
     """:func:`exact_query` with each body given as its :func:`pack_body` (the call
     ``polycontact.time_of_impact`` makes)."""
-    ra, sa, ca, la, ea = _unpack_body(fa, ia)
-    rb, sb, cb, lb, eb = _unpack_body(fb, ib)
+    ra, sa, ca, la, ea = unpack_body(fa, ia)
+    rb, sb, cb, lb, eb = unpack_body(fb, ib)
     return exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate,
                        time_tol, eps_rel, ulps, lam, max_iter, work)
 

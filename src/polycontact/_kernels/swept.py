@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .impact import _unpack_body, exact_query, sampled_query, work_floats
+from .impact import exact_query, sampled_query, unpack_body, work_floats
 
 
 @njit(cache=True, nogil=True)
@@ -192,9 +192,9 @@ def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, floats, f_off, ints, i_off, t_m
         p = todo[k]
         a = sa[p]
         b = sb[p]
-        ra, sta, ca, la, ea = _unpack_body(floats[f_off[a]:f_off[a + 1]],
+        ra, sta, ca, la, ea = unpack_body(floats[f_off[a]:f_off[a + 1]],
                                            ints[i_off[a]:i_off[a + 1]])
-        rb, stb, cb, lb, eb = _unpack_body(floats[f_off[b]:f_off[b + 1]],
+        rb, stb, cb, lb, eb = unpack_body(floats[f_off[b]:f_off[b + 1]],
                                            ints[i_off[b]:i_off[b + 1]])
         if exact:
             out = exact_query(ra, sta, ca, ma[p], la, ea, rb, stb, cb, mb[p], lb, eb, t_max,

@@ -24,7 +24,10 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .relation import _bbox, _scratch, _state_in
+from .packs import state_scratch
+from .primitives import bbox
+from .relation import state_in
+
 
 #: Levels L = idx - 512, idx in [0, 1024): cells from 2**-512 to 2**511.
 _LEVEL_OFFSET = 512
@@ -46,14 +49,6 @@ def place(xy, cx, cy, px, py, angle, out):
 
 
 @njit(cache=True, nogil=True)
-def _tolerance(xy, n, rel, ulp_factor):
-    """:func:`polycontact.tolerances.default_tolerance` of one body's rows ``xy[:n]``."""
-    x0, x1, y0, y1 = _bbox(xy, n)
-    mag = max(max(-x0, x1), max(-y0, y1))
-    return max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
-
-
-@njit(cache=True, nogil=True)
 def _level(x0, x1, y0, y1):
     """Level index of a box: the smallest L with 2**L >= its larger side."""
     s = max(x1 - x0, y1 - y0)
@@ -66,12 +61,14 @@ def _level(x0, x1, y0, y1):
 
 @njit(cache=True, nogil=True)
 def _cell(v, c):
+    """The cell of side c holding coordinate v, clamped to ±2**25."""
     f = math.floor(v / c)
     return int(min(max(f, -_CELL_LIMIT), _CELL_LIMIT - 1.0))
 
 
 @njit(cache=True, nogil=True)
 def _key(idx, ix, iy):
+    """The hash key of cell (ix, iy) of level index ``idx``."""
     return (idx << 52) | ((ix + 33554432) << 26) | (iy + 33554432)
 
 
@@ -194,6 +191,7 @@ def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, 
 
 @njit(cache=True, nogil=True)
 def _meet(box, b, q0, q1, q2, q3):
+    """Whether body b's box meets [q0, q1] x [q2, q3]."""
     return not (box[b, 0] > q1 or box[b, 1] < q0 or box[b, 2] > q3 or box[b, 3] < q2)
 
 
@@ -256,7 +254,7 @@ def _view(xy, ls, lo, nl, b, buf):
 
 @njit(cache=True, nogil=True)
 def _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, k0, k1, states, used):
-    box, ids, touch, rays, rord = _scratch(2 * vmax)
+    box, ids, touch, rays, rord = state_scratch(2 * vmax)
     _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, ids, touch,
                    rays, rord, np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
 
@@ -276,7 +274,7 @@ def _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, 
         yb, sb = _view(xy, ls, lo, nl, j, bb)
         e = tol if tol >= 0.0 else max(eps[i], eps[j])
         used[k] = e
-        states[k] = _state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
+        states[k] = state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -319,7 +317,7 @@ def _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, ro
     worst = 0
     for h in range(hnl.shape[0]):
         yh, sh = _view(hxy, hls, hlo, hnl, h, hbuf)
-        s = _state_in(ya, sa, 1.0, yh, sh, 1.0, e, box, ids, touch, rays, rord)
+        s = state_in(ya, sa, 1.0, yh, sh, 1.0, e, box, ids, touch, rays, rord)
         if s > worst:
             worst = s
             if worst == 2:
@@ -334,7 +332,7 @@ def container_states(xy, ls, lo, nl, box, eps, tol, alive, hxy, hls, hlo, hnl, c
     n = alive.shape[0]
     out = np.empty(n, np.int8)
     for c in prange(chunks):  # few bodies: chunks = 1, one thread
-        bx, ids, touch, rays, rord = _scratch(vmax + hmax)
+        bx, ids, touch, rays, rord = state_scratch(vmax + hmax)
         ba = np.empty(lmax + 1, np.int64)
         hb = np.empty(hnl.max() + 1, np.int64)
         for k in range(n * c // chunks, n * (c + 1) // chunks):
@@ -352,13 +350,13 @@ def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, orig
                  lo, nl, box, eps, tol, emax, n_ids, vmax, lmax):
     """Ids and states of the bodies the placed shape (qxy, qs) touches or penetrates."""
     n = qs[qs.shape[0] - 1]
-    x0, x1, y0, y1 = _bbox(qxy, n)
+    x0, x1, y0, y1 = bbox(qxy, n)
     cand = np.empty(n_ids, np.int64)
     e0 = tol if tol >= 0.0 else qeps
     d = e0 + (tol if tol >= 0.0 else emax)
     m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d, y0 - d,
                 y1 + d, 0, n_ids, cand)
-    bx, ids, touch, rays, rord = _scratch(n + vmax)
+    bx, ids, touch, rays, rord = state_scratch(n + vmax)
     buf = np.empty(lmax + 1, np.int64)
     out_ids = np.empty(m, np.int64)
     out_st = np.empty(m, np.int8)
@@ -369,7 +367,7 @@ def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, orig
         if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
             continue
         yb, sb = _view(xy, ls, lo, nl, j, buf)
-        s = _state_in(qxy, qs, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+        s = state_in(qxy, qs, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
         if s > 0:
             out_ids[k] = j
             out_st[k] = s
@@ -382,11 +380,11 @@ def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, orig
 def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
     """Container state of one placed shape (see :func:`_container_state`)."""
     n = qs[qs.shape[0] - 1]
-    x0, x1, y0, y1 = _bbox(qxy, n)
+    x0, x1, y0, y1 = bbox(qxy, n)
     hmax = 0
     for h in range(hnl.shape[0]):
         hmax = max(hmax, hls[hlo[h] + hnl[h]] - hls[hlo[h]])
-    bx, ids, touch, rays, rord = _scratch(n + hmax)
+    bx, ids, touch, rays, rord = state_scratch(n + hmax)
     hb = np.empty(hnl.max() + 1, np.int64)
     e = tol if tol >= 0.0 else max(qeps, ceps)
     return _container_state(qxy, qs, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox, hb, bx, ids,
@@ -400,12 +398,12 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
     n = ss[ss.shape[0] - 1]
     qxy = np.empty((n, 2))
     cand = np.empty(n_ids, np.int64)
-    bx, ids, touch, rays, rord = _scratch(n + max(vmax, hmax))
+    bx, ids, touch, rays, rord = state_scratch(n + max(vmax, hmax))
     buf = np.empty(lmax + 1, np.int64)
     hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
     for p in range(p0, p1):
         place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
-        x0, x1, y0, y1 = _bbox(qxy, n)
+        x0, x1, y0, y1 = bbox(qxy, n)
         mag = max(max(-x0, x1), max(-y0, y1))
         qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
         worst = 0
@@ -430,7 +428,7 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
                 if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
                     continue
                 yb, sb = _view(xy, ls, lo, nl, j, buf)
-                s = _state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+                s = state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
                 if s > worst:
                     worst = s
                     if worst == 2:
