@@ -54,7 +54,7 @@ def _from_box(a: pc.Shape, b: pc.Shape, eps: float,
     (xa, sa), (xb, sb) = a.packed, b.packed
     bxy, bst = pieces_packed(xb, sb)
     axy, ast = pieces_packed(xa, sa)
-    return kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *escape(xa, xb),
+    return kd.depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), escape(xa, xb),
                                 eps, MAX_SUM_VERTICES)
 
 
@@ -151,8 +151,8 @@ def test_depth_from_a_first_escape_that_does_not_escape_falls_back_to_the_box():
     (xa, sa), (xb, sb) = a.packed, b.packed
     bxy, bst = pieces_packed(xb, sb)
     axy, ast = pieces_packed(xa, sa)
-    got = kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, 0.1, 0.1, 0.0, 1e-12,
-                               MAX_SUM_VERTICES)
+    got = kd.depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), (0.1, 0.1, 0.0),
+                               1e-12, MAX_SUM_VERTICES)
     assert got == pytest.approx((0.5, 0.0, -0.5) if got[2] else (0.5, -0.5, 0.0))
     assert pc.classify(sq + np.array(got[1:]), sq + [0.5, 0.25]).state is not \
         pc.State.PENETRATING

@@ -106,7 +106,7 @@ def test_depth_without_the_grid_equals_the_depth_with_it(seed, na, nb, cx, cy):
     (xa, sa), (xb, sb) = a.packed, b.packed
     bxy, bst = pieces_packed(xb, sb)
     axy, ast = pieces_packed(xa, sa)
-    args = (xa, sa, xb, sb, bxy, bst, -axy, ast, *kd.box_escape(xa, xb), rel.tolerance,
+    args = ((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), kd.box_escape(xa, xb), rel.tolerance,
             MAX_SUM_VERTICES)
     scan = kd.depth_from_pieces(*args, 10**9)
     grid = kd.depth_from_pieces(*args, 0)

@@ -31,12 +31,12 @@ FACTORS = (0.0, 0.5, 1.0 - 1e-6, 1.0, 1.0 + 1e-12, 1.0 + 1e-9, 1.0 + 1e-6, 1.0 +
 
 
 def _states(xa, sa, xb, sb, eps):
-    """(``_apart`` fired, ``_state_in``, the full test) for one pair and tolerance."""
+    """(``_apart`` fired, ``state_in``, the full test) for one pair and tolerance."""
     na, nb = sa[-1], sb[-1]
     ba, bb = kprim.bbox(xa, na), kprim.bbox(xb, nb)
     scratch = kpack.state_scratch(na + nb)
-    fast = kr.state_in(xa, sa, 1.0, xb, sb, 1.0, eps, *scratch)
-    full = kr._overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, *scratch)
+    fast = kr.state_in(xa, sa, 1.0, xb, sb, 1.0, eps, scratch)
+    full = kr._overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, scratch)
     return bool(kr._apart(xa, na, xb, nb, ba, bb, eps)), fast, full
 
 

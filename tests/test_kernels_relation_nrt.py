@@ -3,10 +3,10 @@ they share with reference-counted kernels.
 
 A helper called from an ``_nrt=False`` kernel before anything else compiled it is
 compiled (and cached) without reference counting; if it returns new views, every
-reference-counted caller that uses it afterwards (``_scratch``, hence ``relate_state``,
-the World's kernels, ...) drops the views' buffer too early and frees it while in use.
-Such helpers are inlined (``_scratch_views``). The test runs in a subprocess with an
-empty cache of its own, so the compile order is the one it sets.
+reference-counted caller that uses it afterwards (``state_scratch``, hence
+``relate_state``, the World's kernels, ...) drops the views' buffer too early and frees
+it while in use. Such helpers are inlined (``state_scratch_views``). The test runs in a
+subprocess with an empty cache of its own, so the compile order is the one it sets.
 """
 
 from __future__ import annotations

@@ -78,8 +78,8 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
             return fast[0], fast[1], fast[2]
     bxy, bst = pieces_packed(xb, sb)
     axy, ast = pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
-                            MAX_SUM_VERTICES)
+    got = depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), first_escape(xa, xb),
+                            eps, MAX_SUM_VERTICES)
     if np.isnan(got[0]):
         raise _too_large(len(xa), len(xb))
     return cast("tuple[float, float, float]", got)
@@ -124,11 +124,10 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     one = order[new]  # the first of each group of equal pairs
     group = np.empty(len(pairs), np.int64)
     group[order] = np.cumsum(new) - 1
-    out = contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one])
+    out = contact_depths(batch, pairs[one], eps[one])
     rest = np.flatnonzero(np.isnan(out[:, 0]))  # (large bodies, or undecided)
     if rest.size:
-        out[rest] = _depths_by_pieces(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one[rest]],
-                                      eps[one[rest]])
+        out[rest] = _depths_by_pieces(batch, pairs[one[rest]], eps[one[rest]])
     bad = np.flatnonzero(np.isnan(out[:, 0]))
     if bad.size:
         p = pairs[one[bad[0]]]
@@ -172,16 +171,16 @@ def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
     return np.concatenate(more_xy), np.concatenate(more_st), first, count
 
 
-def _depths_by_pieces(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
-                      xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
-                      pairs: np.ndarray, eps: np.ndarray) -> Any:
-    """:func:`polycontact._kernels.depth.depths_of_pairs` of the pairs ``pairs``, each
-    distinct body decomposed once (NaN rows as there)."""
+def _depths_by_pieces(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
+                      eps: np.ndarray) -> Any:
+    """:func:`polycontact._kernels.depth.depths_of_pairs` of the pairs ``pairs`` of
+    ``batch`` (as for :func:`penetrations`), each distinct body decomposed once (NaN
+    rows as there)."""
     from ._kernels.depth import depths_of_pairs, distinct_bodies
 
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
     ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
     ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
     rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    return depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, *ra,
-                           slot_b, *rb, MAX_SUM_VERTICES)
+    return depths_of_pairs(batch, pairs, eps, slot_a, ra, slot_b, rb, MAX_SUM_VERTICES)

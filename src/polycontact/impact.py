@@ -275,9 +275,9 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
         return t_lo, t_hi
     (ra, ea, *_), (rb, eb, *_) = body_frame(a), body_frame(b)
     code, hi, lo, *_ = ki.exact_search_tables(
-        ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
-        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, ROUNDING_FACTOR, lam,
-        MAX_ITERATIONS)
+        (ra, a.packed[1], a.centroid, la), ea, ma.array, (rb, b.packed[1], b.centroid, lb), eb,
+        mb.array, np.array([[t_lo, t_hi]]),
+        (2.0 * lam / speed, eps_rel, ROUNDING_FACTOR, lam, MAX_ITERATIONS))
     return (lo, hi) if code == ki.HIT else (t_lo, t_hi)
 
 
@@ -534,15 +534,15 @@ def time_of_impact(
         cap, work = _grow_work(0)
     if size > cap:
         cap, work = _grow_work(size)
+    # the query's settings, as the kernels take them (see _kernels.impact.exact_query)
+    query = (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR,
+             CONTACT_RESOLUTION * (la + lb), int(max_iterations), int(samples))
     args: tuple[Any, ...]
     if exact:
-        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, t_max, BROAD_PHASE_INFLATION,
-                tol, eps_rel, ROUNDING_FACTOR, CONTACT_RESOLUTION * (la + lb), int(max_iterations),
-                work)
+        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, query, work)
     else:
-        args = (ra, a._starts, a._centroid, ma._array, la, rb, b._starts, b._centroid,
-                mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR, int(samples),
-                work)
+        args = ((ra, a._starts, a._centroid, la), ma._array, (rb, b._starts, b._centroid, lb),
+                mb._array, query, work)
     # the compiled code called directly when every argument has the type it always has
     # (Shapes and Motions), else through the dispatcher
     run = _ENTRY.get(method) if fixed else None

@@ -177,9 +177,12 @@ def search_pairs(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.nda
     iv = np.empty((p_count, MAX_INTERVALS, 2))
     out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
 
+    pairs = (sa, sb, ma, mb, eps_rel)
+    settings = (t_max, BROAD_PHASE_INFLATION, tol, ROUNDING_FACTOR, CONTACT_RESOLUTION,
+                max_iterations, exact, samples)
+
     def run(todo: np.ndarray) -> None:
-        impacts_chunk(todo, sa, sb, ma, mb, eps_rel, *tables, t_max, BROAD_PHASE_INFLATION,
-                      tol, ROUNDING_FACTOR, CONTACT_RESOLUTION, max_iterations, exact, samples, *out)
+        impacts_chunk(todo, pairs, tables, settings, out)
 
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
@@ -203,9 +206,10 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
         b, mb = shape_of(p, 1), motion_of(p, 1)
         # (the intervals copied: the result keeps them, not the whole batch's array)
         return impact_from_kernel(a, ma, b, mb, method,
-                       (int(n_iv[p]), int(code[p]), float(t_hi[p]), float(t_lo[p]),
-                        float(contact[p]), int(iters[p]), float(reached[p])),
-                       t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
+                                  (int(n_iv[p]), int(code[p]), float(t_hi[p]),
+                                   float(t_lo[p]), float(contact[p]), int(iters[p]),
+                                   float(reached[p])),
+                                  t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
 
     return make
 

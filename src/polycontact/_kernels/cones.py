@@ -25,9 +25,7 @@ def pair_point(g, xa, xb, na):
 # reference counting) that call cost about as much as the test; measured 50 -> 45 ms per
 # 100 000 pairs of 12-gons (one thread), single pairs within noise (+0.1 us).
 @njit(cache=True, nogil=True, inline="always")
-def cones_overlap(
-    px, py, xa, fa, xb, fb, na, box, ids, order, cnt, swept, maxw, eps, rays, rord
-):
+def cones_overlap(px, py, xa, fa, xb, fb, na, edges, eps, ray_scratch):
     """Whether the open interior cones of A and B at the touch point p overlap.
 
     Every edge of either body within eps of p gives rays leaving p: along the edge from
@@ -35,12 +33,15 @@ def cones_overlap(
     counter-clockwise of it is "opening"; sorted by angle, the interior of a body in a
     direction d is decided by the body's nearest ray clockwise of d (rays of one body
     alternate opening/closing around p, so holes touching the outer loop work too).
-    If ``swept``, the edge rows are ordered by ``order`` (xmin ascending; ``maxw`` the
-    widest edge) and only the rows near p are read; otherwise every row is read.
-    ``rays`` (at least 2 cnt rows of 6) and ``rord`` (as many ints) are scratch: rows
+    ``edges`` is the state kernel's edge table ``(box, ids, order, cnt, swept, maxw)``:
+    ``cnt`` rows of edge boxes and vertex ids; if ``swept``, ordered by ``order`` (xmin
+    ascending; ``maxw`` the widest edge) and only the rows near p are read; otherwise
+    every row is read. ``ray_scratch`` is ``(rays, rord)``: at least 2 cnt rows of 6,
     ``(pseudo-angle, length of the edge left from p, opening, of A, unit direction)``,
-    and their order.
+    and as many ints, their order.
     """
+    box, ids, order, cnt, swept, maxw = edges
+    rays, rord = ray_scratch
     lo = 0
     if swept:
         hi = cnt

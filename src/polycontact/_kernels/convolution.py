@@ -210,9 +210,8 @@ def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
     for i in range(xa.shape[0]):
         moved[i, 0] = xa[i, 0] + dx
         moved[i, 1] = xa[i, 1] + dy
-    box, ids, touch, rays, rord = state_scratch_views(scratch, xa.shape[0] + xb.shape[0])
-    return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays,
-                     rord) == PENETRATING
+    views = state_scratch_views(scratch, xa.shape[0] + xb.shape[0])
+    return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, views) == PENETRATING
 
 
 @njit(cache=True, nogil=True)

@@ -132,14 +132,15 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
 
 
 @njit(cache=True, nogil=True)
-def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                      max_vertices, grid_from=GRID_MIN_SUMS):
+def depth_from_pieces(a, b, pieces_b, pieces_r, escape, eps, max_vertices,
+                      grid_from=GRID_MIN_SUMS):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
-    ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
-    bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
-    ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap
-    (:func:`first_escape`, or :func:`box_escape`).
+    ``a`` = ``(xa, sa)``, ``b`` = ``(xb, sb)``: the packed bodies (interior on the left);
+    ``pieces_b`` = ``(bxy, bstarts)``: convex CCW pieces of B; ``pieces_r`` = ``(rxy,
+    rstarts)``: convex CCW pieces of −A; ``escape`` = ``(bound, bdx, bdy)``: a
+    translation of A, of length ``bound``, that ends the overlap (:func:`first_escape`,
+    or :func:`box_escape`).
     Returns ``(bound, bdx, bdy)`` when nothing nearer ends it (confirmed by the state
     kernel; if rounding left it penetrating, the search is made again from the box's
     escape), NaNs when the sums would hold more than ``max_vertices`` vertices (none
@@ -154,31 +155,38 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     usually: the sum that covered the previous edge is tried first) and one state check,
     O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
     """
+    xa, sa = a
+    xb, sb = b
     moved = np.empty_like(xa)
     scratch = np.empty(scratch_floats(xa.shape[0] + xb.shape[0]))
-    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from, moved, scratch)
-    if got[3] or np.isnan(got[0]) or not penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    got = _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_from,
+                          moved, scratch)
+    if got[3] or np.isnan(got[0]) or not penetrates(xa, sa, xb, sb, escape[1], escape[2], eps,
+                                                    moved, scratch):
         return got[0], got[1], got[2]
     # (a normal's escape left touching within rounding, yet penetrating: the box's)
-    bound, bdx, bdy = box_escape(xa, xb)
-    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from, moved, scratch)
+    got = _nearest_escape(a, b, pieces_b, pieces_r, box_escape(xa, xb), eps, max_vertices,
+                          grid_from, moved, scratch)
     return got[0], got[1], got[2]
 
 
 @njit(cache=True, nogil=True)
-def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                    max_vertices, grid_from, moved, scratch):
+def _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_from, moved,
+                    scratch):
     """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
-    when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
-    confirmed); ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution.penetrates`.
+    when nothing nearer than ``bound`` was found (then ``escape``, not confirmed);
+    ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution.penetrates`.
 
     The origin's distance to the outline of a sum that holds it is a lower bound of the
     depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
     the search stops there: the depth is ``bound`` within ``eps``; when the origin's
     foot on that outline escapes, it is the depth.
     """
+    xa, sa = a
+    xb, sb = b
+    bxy, bstarts = pieces_b
+    rxy, rstarts = pieces_r
+    bound, bdx, bdy = escape
     best = bound
     pairs = _select_pairs(boxes(bxy, bstarts), boxes(rxy, rstarts), bound,
                           bstarts, rstarts, max_vertices)
@@ -229,7 +237,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
     near = np.flatnonzero(dist < best * best)  # (only these are visited: sorted alone)
     by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
-    index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / GRID, grid_from)
+    sums = (xy, starts, bb, fr)
+    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = deepest
     found = False
@@ -247,8 +256,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
         tlo, thi = _in_disk(ax, ay, bx, by, best)
         if tlo >= thi:
             continue
-        n1, n0, hint = clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, tlo, thi, eps,
-                                 hint)
+        n1, n0, hint = clip_edge(sums, index, p, ax, ay, bx, by, tlo, thi, eps, hint)
         if n1 == 0 and n0 == 0:
             continue
         dx = bx - ax
@@ -494,13 +502,17 @@ def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy, rst,
-                    rfirst, rcount, slot_b, bxy, bst, bfirst, bcount, max_vertices):
+def depths_of_pairs(batch, pairs, eps, slot_a, pieces_a, slot_b, pieces_b, max_vertices):
     """Penetration depths ``(P, 3)`` (depth, dx, dy; NaNs as in
-    :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, in
-    parallel: pair k's A has the pieces of −A number ``slot_a[k]`` of
-    ``(rxy, rst, rfirst, rcount)`` (see :func:`pieces_of_bodies`), its B those number
-    ``slot_b[k]`` of ``(bxy, bst, bfirst, bcount)``; ``eps`` per pair."""
+    :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, ``batch`` =
+    ``(xa, lsa, bsa, fa, xb, lsb, bsb, fb)`` (the form of
+    :mod:`polycontact._kernels.relation_many`), in parallel: pair k's A has the pieces
+    of −A number ``slot_a[k]`` of ``pieces_a`` = ``(rxy, rst, rfirst, rcount)`` (see
+    :func:`pieces_of_bodies`), its B those number ``slot_b[k]`` of ``pieces_b``;
+    ``eps`` per pair."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
+    rxy, rst, rfirst, rcount = pieces_a
+    bxy, bst, bfirst, bcount = pieces_b
     n = pairs.shape[0]
     out = np.empty((n, 3))
     for k in prange(n):
@@ -511,20 +523,22 @@ def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy,
         yb = oriented(yb, sb, fb[p])
         ra = rfirst[slot_a[k]]
         rb = bfirst[slot_b[k]]
-        bound, bdx, bdy = first_escape(ya, yb)
         out[k, 0], out[k, 1], out[k, 2] = depth_from_pieces(
-            ya, sa, yb, sb, bxy, bst[rb : rb + bcount[slot_b[k]] + 1], rxy,
-            rst[ra : ra + rcount[slot_a[k]] + 1], bound, bdx, bdy, eps[k], max_vertices)
+            (ya, sa), (yb, sb), (bxy, bst[rb : rb + bcount[slot_b[k]] + 1]),
+            (rxy, rst[ra : ra + rcount[slot_a[k]] + 1]), first_escape(ya, yb), eps[k],
+            max_vertices)
     return out
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
-    """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches by
+def contact_depths(batch, pairs, eps):
+    """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches
+    (``batch``: as for :func:`depths_of_pairs`) by
     :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
     segments are split lazily: a nearer start saves less than it costs), in parallel; a
     row of NaNs where that kernel does not decide (the caller takes
     :func:`depths_of_pairs`); ``eps`` per pair."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     n = pairs.shape[0]
     out = np.full((n, 3), np.nan)
     for k in prange(n):

@@ -299,14 +299,15 @@ GRID_MIN_SUMS = 256
 
 
 @njit(cache=True, nogil=True)
-def sum_index(xy, starts, bb, fr, gx0, gy0, h, grid_from=GRID_MIN_SUMS):
-    """What :func:`clip_edge` reads to clip edges by the convex sums ``(xy, starts)``
-    (boxes ``bb``, edge frames ``fr``): the sums sorted by their smallest x (``by_x``,
-    ``xs``) and their widest box (``wmax``); a ``GRID`` x ``GRID`` grid of cells of
-    side ``h`` from ``(gx0, gy0)`` with the sums containing each cell whole
-    (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``grid_from`` sums (the
-    same clips, found by the scan alone), and a buffer of the sums tried on an edge;
-    the four interval buffers of the clipped parts."""
+def sum_index(sums, gx0, gy0, h, grid_from=GRID_MIN_SUMS):
+    """What :func:`clip_edge` reads to clip edges by the convex ``sums``, ``(xy, starts,
+    bb, fr)`` (the packed sums, their boxes and edge frames): the sums sorted by their
+    smallest x (``by_x``, ``xs``) and their widest box (``wmax``); a ``GRID`` x ``GRID``
+    grid of cells of side ``h`` from ``(gx0, gy0)`` with the sums containing each cell
+    whole (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``grid_from`` sums
+    (the same clips, found by the scan alone), and a buffer of the sums tried on an
+    edge; the four interval buffers of the clipped parts."""
+    xy, starts, bb, fr = sums
     k = starts.shape[0] - 1
     by_x = np.argsort(bb[:, 0])
     xs = bb[by_x, 0]
@@ -322,10 +323,12 @@ def sum_index(xy, starts, bb, fr, gx0, gy0, h, grid_from=GRID_MIN_SUMS):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0):
-    """Take from the parts of edge (a, b) of sum p what sum q covers: from
-    ``lo1[:n1], hi1[:n1]`` its closed interior shrunk by eps, from ``lo0[:n0],
-    hi0[:n0]`` its open interior (see :func:`_clip`); returns the new ``(n1, n0)``."""
+def _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0):
+    """Take from the parts of edge (a, b) of sum p what sum q covers: of ``parts`` =
+    ``(lo1, hi1, lo0, hi0)``, from ``lo1[:n1], hi1[:n1]`` its closed interior shrunk by
+    eps, from ``lo0[:n0], hi0[:n0]`` its open interior (see :func:`_clip`); returns the
+    new ``(n1, n0)``."""
+    lo1, hi1, lo0, hi0 = parts
     a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
     if a1 < b1 and n1 > 0:
         n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
@@ -335,9 +338,9 @@ def _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
-    """Clip the part [t0, t1] of edge (a, b) of sum p by the other sums
-    (:func:`sum_index`), until nothing is left. Returns ``(n1, n0, hint)``: the parts
+def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
+    """Clip the part [t0, t1] of edge (a, b) of sum p by the other ``sums`` (``(xy,
+    starts, boxes, frames)``: see :func:`sum_index`), until nothing is left. Returns ``(n1, n0, hint)``: the parts
     outside every closed sum shrunk by eps (``lo1[:n1], hi1[:n1]`` of the index) and
     outside every open sum (``lo0[:n0], hi0[:n0]``), as parameters along the edge, and
     the sum that covered the edge whole (else ``hint`` unchanged).
@@ -347,7 +350,9 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
     after one test), then the others by their smallest x, from the first that can reach
     the edge (none is wider than ``wmax``).
     """
+    _, starts, bb, fr = sums
     by_x, xs, wmax, cover, gx0, gy0, h, tried, lo1, hi1, lo0, hi0 = index
+    parts = (lo1, hi1, lo0, hi0)
     k = starts.shape[0] - 1
     lo1[0] = t0
     hi1[0] = t1
@@ -378,7 +383,7 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
                 continue
             tried[nt] = q
             nt += 1
-            n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0)
+            n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0)
             if n1 == 0 and n0 == 0:
                 return n1, n0, hint
     x0 = min(ax, bx) - eps
@@ -394,7 +399,7 @@ def clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, t0, t1, eps, hint):
             continue
         if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
             continue
-        n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, lo1, hi1, n1, lo0, hi0, n0)
+        n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0)
         if n1 == 0 and n0 == 0:
             return n1, n0, q
     return n1, n0, hint

@@ -36,7 +36,8 @@ def edge_cover(xy, starts, bb, fr, eps):
     gx0 = bb[:, 0].min()
     gy0 = bb[:, 1].min()
     h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / GRID
-    index = sum_index(xy, starts, bb, fr, gx0, gy0, h)
+    sums = (xy, starts, bb, fr)
+    index = sum_index(sums, gx0, gy0, h)
     lo1, hi1, lo0, hi0 = index[-4:]
     for p in range(k):
         s = starts[p]
@@ -47,8 +48,7 @@ def edge_cover(xy, starts, bb, fr, eps):
             bx, by = xy[j, 0], xy[j, 1]
             if ax == bx and ay == by:
                 continue
-            n1, n0, hint = clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, 0.0, 1.0,
-                                     eps, hint)
+            n1, n0, hint = clip_edge(sums, index, p, ax, ay, bx, by, 0.0, 1.0, eps, hint)
             dx = bx - ax
             dy = by - ay
             for r in range(n0):

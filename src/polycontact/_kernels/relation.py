@@ -134,8 +134,7 @@ def oriented_state(xa, sa, fa, xb, sb, fb, eps):
     apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
     if apart:
         return SEPARATE
-    box, ids, touch, rays, rord = state_scratch(na + nb)
-    return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, rord)
+    return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, state_scratch(na + nb))
 
 
 # Inlined: as a call (a tuple of tuples returned) it made the World's pairs ~25 ns slower.
@@ -164,9 +163,10 @@ def _window(ba, bb, eps):
 # Inlined into its callers: a call that passes a dozen arrays cost about 50 ns (more
 # than the early exits it makes), measured on the World's candidate pairs.
 @njit(cache=True, nogil=True, inline="always")
-def state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch, rays, rord):
-    """:func:`oriented_state` with the scratch buffers of :func:`state_scratch` (sized for at least
-    the vertices of both bodies), so a loop over many pairs allocates nothing per pair.
+def state_in(xa, sa, fa, xb, sb, fb, eps, scratch):
+    """:func:`oriented_state` with the state kernel's ``scratch`` (the buffers of
+    :func:`polycontact._kernels.packs.state_scratch`, sized for at least the vertices of
+    both bodies), so a loop over many pairs allocates nothing per pair.
 
     Pairs whose boxes are more than eps apart, or that :func:`_apart` proves farther
     apart than eps, are separate at once; the others take :func:`_overlap_state`.
@@ -176,7 +176,7 @@ def state_in(xa, sa, fa, xb, sb, fb, eps, box, ids, touch, rays, rord):
     apart, ba, bb = _early_exit(xa, na, xb, nb, eps)
     if apart:
         return SEPARATE
-    return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, rord)
+    return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, scratch)
 
 
 #: Rounding allowance of :func:`_apart`, in units of the larger of eps and the largest
@@ -227,9 +227,10 @@ def _apart(xa, na, xb, nb, ba, bb, eps):
     return True
 
 
-def _overlap_test(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, rord):
+def _overlap_test(xa, sa, fa, xb, sb, fb, eps, ba, bb, scratch):
     """The full test of :func:`state_in` (no early exit) for bodies with bounding boxes
     ``ba``, ``bb`` (``(xmin, xmax, ymin, ymax)``) that come within eps of each other."""
+    box, ids, touch, rays, rord = scratch
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
     ax0, ax1, ay0, ay1 = ba
@@ -288,10 +289,8 @@ def _overlap_test(xa, sa, fa, xb, sb, fb, eps, ba, bb, box, ids, touch, rays, ro
         for g in range(tot):
             if touch[g]:
                 px, py = pair_point(g, xa, xb, na)
-                if cones_overlap(
-                    px, py, xa, fa, xb, fb, na, box, ids, order, cnt, swept, maxw, eps, rays,
-                    rord,
-                ):
+                if cones_overlap(px, py, xa, fa, xb, fb, na,
+                                 (box, ids, order, cnt, swept, maxw), eps, (rays, rord)):
                     return PENETRATING
     # (2) one untouched vertex per loop, strictly inside the other body
     if _untouched_inside(xa, sa, touch, 0, xb, sb, bx0, bx1, by0, by1):
@@ -378,6 +377,5 @@ def relate_shapes_into(pa, pb, eps):
         return SEPARATE
     if na + nb > STACK_VERTICES:
         return -1
-    box, ids, touch, rays, rord = state_scratch_views(stack_floats(STACK_FLOATS), na + nb)
-    return _overlap_state_inlined(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, box, ids, touch, rays,
-                                  rord)
+    scratch = state_scratch_views(stack_floats(STACK_FLOATS), na + nb)
+    return _overlap_state_inlined(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, scratch)

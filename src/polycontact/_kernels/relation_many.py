@@ -71,21 +71,18 @@ def raw_states(xa, xb, tol, rel, ulps, limit, floor, out):
     leaves undecided (long rings that need a sorted sweep) are finished by
     :func:`_finish_undecided`.
     """
-    states, eps, used_a, sign_a, used_b, sign_b = out
-    box, ids, touch, rays, rord = state_scratch(xa.shape[1] + xb.shape[1])
+    scratch = state_scratch(xa.shape[1] + xb.shape[1])
     sa = np.zeros(2, np.int64)
     sb = np.zeros(2, np.int64)
-    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                        used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
-        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                          used_b, sign_b, box, ids, touch, rays, rord, sa, sb)
+    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
+        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                      used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
+def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
     """Validate (with the sorted sweep) and classify the pairs marked ``_UNDECIDED``."""
+    states, eps, used_a, sign_a, used_b, sign_b = out
     for p in range(xa.shape[0]):
         if states[p] != _UNDECIDED:
             continue
@@ -98,8 +95,8 @@ def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a,
         if na < 0 or nb < 0:
             states[p] = -1
             continue
-        states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel, ulps,
-                                        sa, sb, box, ids, touch, rays, rord)
+        states[p], eps[p] = _pair_state((xa[p], na, fa, ba), (xb[p], nb, fb, bb), tol, rel,
+                                        ulps, sa, sb, scratch)
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the pass creates a view
@@ -107,10 +104,10 @@ def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a,
 # updates of those cost about as much as classifying a pair of 12-gons (measured 0.27
 # against 0.16 us per pair). Nothing in it may allocate (the compiler refuses if it does).
 @njit(cache=True, nogil=True, _nrt=False)
-def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                     used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
-    """:func:`raw_states`' pass over the pairs, into its arrays; a pair with a ring that
-    needs the sorted sweep is marked ``_UNDECIDED`` (returns whether any is)."""
+def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
+    """:func:`raw_states`' pass over the pairs, into its arrays ``out``; a pair with a
+    ring that needs the sorted sweep is marked ``_UNDECIDED`` (returns whether any is)."""
+    states, eps, used_a, sign_a, used_b, sign_b = out
     undecided = False
     for p in range(xa.shape[0]):
         na, fa, ea, ba = ring_summary(xa[p], rel, ulps, limit, floor)
@@ -127,21 +124,24 @@ def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, 
             states[p] = _UNDECIDED
             undecided = True
         else:
-            states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel,
-                                            ulps, sa, sb, box, ids, touch, rays, rord)
+            states[p], eps[p] = _pair_state((xa[p], na, fa, ba), (xb[p], nb, fb, bb), tol,
+                                            rel, ulps, sa, sb, scratch)
     return undecided
 
 
 @njit(cache=True, nogil=True)
-def _pair_state(ya, na, fa, ba, yb, nb, fb, bb, tol, rel, ulps, sa, sb, box, ids, touch,
-                rays, rord):
-    """``(state, eps)`` of two valid raw rings (their :func:`ring_summary` values)."""
+def _pair_state(ring_a, ring_b, tol, rel, ulps, sa, sb, scratch):
+    """``(state, eps)`` of two valid raw rings, each ``(rows, n, sign, box)`` (its rows
+    and its :func:`polycontact._kernels.rings.ring_summary` values); ``sa``, ``sb``: two
+    loop-start arrays of 2 to write into."""
+    ya, na, fa, ba = ring_a
+    yb, nb, fb, bb = ring_b
     e = tol if tol >= 0.0 else pair_tolerance(ba, bb, rel, ulps)
     if ba[0] > bb[1] + e or bb[0] > ba[1] + e or ba[2] > bb[3] + e or bb[2] > ba[3] + e:
         return SEPARATE, e  # boxes apart: no call into the state kernel
     sa[1] = na
     sb[1] = nb
-    return state_in(ya[:na], sa, fa, yb[:nb], sb, fb, e, box, ids, touch, rays, rord), e
+    return state_in(ya[:na], sa, fa, yb[:nb], sb, fb, e, scratch), e
 
 
 @njit(cache=True, nogil=True)
@@ -187,7 +187,7 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel, ulps):
     eps = np.empty(p_count)
     va, ma = _largest(lsa, bsa)
     vb, mb = _largest(lsb, bsb)
-    box, ids, touch, rays, rord = state_scratch(va + vb)
+    scratch = state_scratch(va + vb)
     buf_a = np.empty(ma, np.int64)
     buf_b = np.empty(mb, np.int64)
     for p in range(p_count):
@@ -200,7 +200,7 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel, ulps):
             eb, mb = extent_magnitude(yb)
             e = tolerance_for(max(ea, eb), max(ma, mb), rel, ulps)
         eps[p] = e
-        states[p] = state_in(ya, sa, fa[p], yb, sb, fb[p], e, box, ids, touch, rays, rord)
+        states[p] = state_in(ya, sa, fa[p], yb, sb, fb[p], e, scratch)
     return states, eps
 
 
