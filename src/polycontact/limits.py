@@ -51,13 +51,13 @@ __all__ = [
 #: coordinates of that size.
 RELATIVE_TOLERANCE = 1e-12
 
-#: Ulps of the largest |coordinate| (64 × 2**-52 ≈ 1.4e-14 of it): the tolerance never
+#: Ulps of the largest absolute coordinate (64 × 2**-52 ≈ 1.4e-14 of it): the tolerance never
 #: falls below this. A translation or rotation of a small body far from the origin
 #: moves its vertices by rounding errors of a few ulps of its coordinates; 64 is well
 #: above that and still resolves 1e-4 at 1e9.
 ROUNDING_ULPS = 64.0
 
-#: Ulps of a polygon's largest |coordinate|: two features of one polygon closer than
+#: Ulps of a polygon's largest absolute coordinate: two features of one polygon closer than
 #: this cannot be told apart in float64 (about the rounding of a distance computed from
 #: such coordinates), so the polygon is refused as invalid only then. Far below the
 #: classification tolerance on purpose: a valid polygon (GEOS's "very skinny polygon",
@@ -65,7 +65,7 @@ ROUNDING_ULPS = 64.0
 #: then decided as touching.
 VALIDATION_ULPS = 4.0
 
-#: Largest |coordinate| accepted (length). The kernels form products of up to three
+#: Largest absolute coordinate accepted (length). The kernels form products of up to three
 #: coordinate differences (areas, centroids, Minkowski sums): (2e100)**3 = 8e300 stays
 #: finite in float64 (max ~1.8e308).
 COORDINATE_LIMIT = 1e100
@@ -108,10 +108,10 @@ BROAD_PHASE_INFLATION = 1e-12
 MAX_SLICES = 16
 
 #: Growth of the swept boxes beyond each body's bounding radius (ulps of the body's
-#: reach: its radius plus the |terms| of its centroid's path over [0, t_max]). 16 of
+#: reach: its radius plus the absolute terms of its centroid's path over [0, t_max]). 16 of
 #: them are the pairwise broad phase's own widening
 #: (``_kernels.broad_phase.rounding_allowance``, which sums the same terms of both
-#: bodies); the rest cover the rounding of |c_A(t) − c_B(t)| there and of the boxes
+#: bodies); the rest cover the rounding of the centroids' distance there and of the boxes
 #: (a few each), so the boxes never leave out a pair the pairwise call would search.
 #: Far from the origin this is the float spacing of the positions, not a fraction of
 #: them: a unit body at 1e9 is grown by ~3e-5.

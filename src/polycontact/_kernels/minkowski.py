@@ -340,10 +340,11 @@ def _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0):
 @njit(cache=True, nogil=True, inline="always")
 def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
     """Clip the part [t0, t1] of edge (a, b) of sum p by the other ``sums`` (``(xy,
-    starts, boxes, frames)``: see :func:`sum_index`), until nothing is left. Returns ``(n1, n0, hint)``: the parts
-    outside every closed sum shrunk by eps (``lo1[:n1], hi1[:n1]`` of the index) and
-    outside every open sum (``lo0[:n0], hi0[:n0]``), as parameters along the edge, and
-    the sum that covered the edge whole (else ``hint`` unchanged).
+    starts, boxes, frames)``: see :func:`sum_index`), until nothing is left. Returns
+    ``(n1, n0, hint)``: the parts outside every closed sum shrunk by eps (``lo1[:n1],
+    hi1[:n1]`` of the index) and outside every open sum (``lo0[:n0], hi0[:n0]``), as
+    parameters along the edge, and the sum that covered the edge whole (else ``hint``
+    unchanged).
 
     The sums covering whole cells along the edge are tried first, then ``hint`` (the
     sum that covered the previous edge: an edge inside the union is then usually done

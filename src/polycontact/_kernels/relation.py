@@ -304,7 +304,7 @@ _overlap_state = njit(cache=True, nogil=True, _nrt=False)(_overlap_test)
 
 
 # The same test inlined, for the state kernel of one pair of Shapes
-# (:func:`relate_shapes_into`): a call that passes fourteen arguments cost 0.03-0.1 us
+# (:func:`relate_shapes_into`): a call with its arguments cost 0.03-0.1 us
 # of the 0.3-0.7 us a pair of 12-gons takes (contact and penetrating pairs; one process,
 # three classes of 200 pairs). The kernels that loop over many pairs call it: inlined
 # into each of them it would multiply their compile time.
