@@ -11,8 +11,7 @@ pass. Printed, in one run:
 
 - ``first_impacts`` (swept bounds + exact search on threads), its candidate pairs and
   the events found;
-- ``Scene(...).first_impact()``, which before issue 11 was the all-pairs loop
-  (N(N − 1)/2 ``time_of_impact`` calls) and now goes through the same World, and the
+- ``Scene(...).first_impact()``, which goes through the same World, and the
   all-pairs baseline: a plain double loop of ``time_of_impact`` whose events must equal
   those of ``first_impacts`` (same pairs, equal ``Impact`` objects);
 - medians over R rounds (each: ``first_impacts`` and ``first_impact``, median of 5

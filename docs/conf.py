@@ -30,7 +30,12 @@ numpydoc_validation_checks: set[str] = set()
 intersphinx_mapping: dict[str, tuple[str, None]] = {}
 exclude_patterns = ["_build"]
 html_theme = "alabaster"
-html_static_path: list[str] = []
+# A wider page and text column than alabaster's defaults (940 and 800 px), so that code
+# and figures are readable; _static/custom.css (loaded by alabaster) styles the links,
+# wraps long code lines and fits the figures to the text.
+html_theme_options = {"page_width": "1180px", "body_max_width": "none",
+                      "sidebar_width": "230px"}
+html_static_path = ["_static"]
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 

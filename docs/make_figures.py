@@ -20,7 +20,17 @@ FIGURES = [
     ("nfp-cavity.png", "nfp", ["nfp-square.json", "nfp-cavity.json"], []),
     ("nfp-slot.png", "nfp", ["nfp-square.json", "nfp-slot.json"], []),
     ("nfp-dovetail.png", "nfp", ["nfp-dovetail-a.json", "nfp-dovetail-b.json"], []),
+    ("contacts-layout.png", "contacts", ["layout.json"], []),
 ]
+
+
+#: Text sizes for figures shown at the width of a page's text column (about 900 px,
+#: where the command line's own figures are 1100-1350 px wide): larger than
+#: matplotlib's defaults, so that legends and labels stay readable once scaled down;
+#: saved with a tight bounding box, so that no legend or label is cut at the edge.
+READABLE = {"font.size": 15, "axes.titlesize": 16, "axes.labelsize": 15,
+            "xtick.labelsize": 13, "ytick.labelsize": 13, "savefig.bbox": "tight",
+            "savefig.pad_inches": 0.1}
 
 
 def main(out: Path) -> None:
@@ -28,12 +38,14 @@ def main(out: Path) -> None:
     import contextlib
     import io
 
+    import matplotlib
+
     from polycontact.cli import main as cli
 
     out.mkdir(parents=True, exist_ok=True)
     for name, command, files, options in FIGURES:
         args = [command, *(str(EXAMPLES / f) for f in files), *options, "--plot", str(out / name)]
-        with contextlib.redirect_stdout(io.StringIO()):
+        with contextlib.redirect_stdout(io.StringIO()), matplotlib.rc_context(READABLE):
             status = cli(args)
         if status != 0:
             raise RuntimeError(f"polycontact {' '.join(args)} exited with {status}")

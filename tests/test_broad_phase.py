@@ -91,7 +91,7 @@ def test_intervals_match_dense_sampling(va, aa, vb, ab, offset):
             assert not covered(out, t)
 
 
-def test_defect4_intervals_stay_right_at_long_travel():
+def test_intervals_stay_right_at_long_travel():
     # a unit square 1e9 away (0.3 off the line) closing at 1 unit/s: the expanded
     # quartic (|d0|² = 1e18 swallowing R² = 2) gave the single instant (1e9, 1e9)
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])

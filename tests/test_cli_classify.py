@@ -110,7 +110,7 @@ def test_command_line_no_traceback(tmp_path):
     assert run.stderr.startswith(f"polycontact classify: error: {bad}: ")
 
 
-def test_defect7_separate_bodies_skip_the_feature_search(tmp_path, capsys, monkeypatch):
+def test_separate_bodies_skip_the_feature_search(tmp_path, capsys, monkeypatch):
     # Before: the features (empty for separate bodies) were always searched: 55 s on two
     # 200 000-vertex bodies. The CLI now computes only what it prints.
     from polycontact._kernels import features as kfeat

@@ -1,5 +1,5 @@
-"""``--plot`` to a file matplotlib cannot write (issue 13: ``--plot x.txt`` ended in a
-traceback) is one line of error naming the file, exit status 2, for every command."""
+"""``--plot`` to a file matplotlib cannot write (``--plot x.txt``) is one line of
+error naming the file, exit status 2, for every command, never a traceback."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ def _layout(tmp_path: Path) -> str:
 
 @pytest.mark.parametrize("command", ["entrance-block", "nfp", "collide", "contacts"])
 @pytest.mark.parametrize("target", ["x.txt", "missing-dir/x.png"])
-def test_defect_plot_to_a_bad_file_is_one_line_not_a_traceback(tmp_path, capsys, command,
+def test_plot_to_a_bad_file_is_one_line_not_a_traceback(tmp_path, capsys, command,
                                                                 target):
     pytest.importorskip("matplotlib")
     out = str(tmp_path / target)

@@ -1,5 +1,5 @@
 """The penetration depth of small bodies from their vertex-edge contact segments
-(:mod:`polycontact._kernels.convolution`, issue 10: distances of distinct pairs).
+(:mod:`polycontact._kernels.convolution`).
 
 Oracles: the search over the convex sums of the pieces (the path before it, and its
 fallback), pyclipper's and Shapely's Minkowski sums (``test_depth.py``), and the state

@@ -1,4 +1,4 @@
-"""Penetration depth (defect 7 of issue 14): exact, and no longer exploding with size.
+"""Penetration depth: exact, and not exploding with size.
 
 Oracles written apart from the library: the depth is the distance from the origin to the
 boundary of ``B ⊕ (−A)``; Shapely builds that region from a triangulation of B summed
@@ -92,7 +92,7 @@ def test_clipper_oracle_counts_the_positions_with_b_inside_a():
     assert _clipper_depth(a, b) == pytest.approx(0.862605, abs=1e-6)  # (not 0.475)
 
 
-def test_defect7_depth_of_star_around_square_finishes_and_is_exact():
+def test_depth_of_star_around_square_finishes_and_is_exact():
     # The issue's case: a unit square inside a 16 000-vertex star took 127 s.
     rng = np.random.default_rng(7)
     n = 16000
@@ -125,7 +125,7 @@ _STARS = textwrap.dedent(
 
 
 @pytest.mark.parametrize("n", [400, 1000])
-def test_defect7_depth_of_overlapping_stars_finishes(n):
+def test_depth_of_overlapping_stars_finishes(n):
     # Before: 4.8 s at 400 vertices, over 350 s at 1000 (quadratic in the m n segments).
     # The limit is far above the time now and far below the time before: it turns a
     # hang into a failure without timing the code.
@@ -196,7 +196,7 @@ def test_depth_scales_with_the_bodies(scale, offset):
     assert -rel.distance == pytest.approx(0.2 * scale, abs=2 * rel.tolerance)
 
 
-def test_defect7_depth_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
+def test_depth_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
     # Two 50 000-vertex stars overlapping at the rim needed more memory than the machine
     # had (the process was killed). Past its budget the depth now raises a clear error;
     # the budget is lowered here to reach it with small stars.

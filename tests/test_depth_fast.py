@@ -1,4 +1,4 @@
-"""The depth's shortcuts (issue 10, distances in the batch): the first escape along the
+"""The depth's shortcuts (distances in the batch): the first escape along the
 edge normals, its confirmation (and the box's escape when rounding leaves it short), the
 stop when a sum holding the origin proves the bound, and the origin's foot on that sum's
 outline when no other sum covers it.

@@ -1,4 +1,4 @@
-"""Penetration depths of many pairs (``classify_many(...).distances``, issue 10).
+"""Penetration depths of many pairs (``classify_many(...).distances``).
 
 The batch computes each distinct body's convex pieces once and each distinct pair once,
 in compiled code, and clips the sums' edges without the grid of cells when there are

@@ -1,4 +1,4 @@
-"""Docstrings of the public API in one order (issue 13): summary, Parameters, Returns,
+"""Docstrings of the public API in one order: summary, Parameters, Returns,
 Raises, Examples, then Notes (proofs and derivations) last, so that ``help()`` shows
 how to call a function before why it works."""
 

@@ -295,7 +295,7 @@ def _edge(s: pc.Shape, el: Element) -> shapely.LineString:
 
 
 @pytest.mark.parametrize("side", [1e105, 1e154])
-def test_defect7_entrance_block_of_huge_squares_says_why(side):
+def test_entrance_block_of_huge_squares_says_why(side):
     # Before: a bare "ValueError: max() arg is an empty sequence".
     import warnings
 

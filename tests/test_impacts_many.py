@@ -433,26 +433,26 @@ def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset)
     assert any(e.impact.collides for e in events)
 
 
-# the cases of issue 14's defects 3-6 (time of impact), through the batched calls: each
+# the time-of-impact regression cases, through the batched calls: each
 # answer (time, time_tolerance, bracket, features) is the pairwise call's
-DEFECT_CASES = {
-    "defect3_fast_flush": (SQ, Motion(velocity=(2e6, 0)), SQ.moved((3, 0)), Motion(), 5.0, 1e-4),
-    "defect4_long_travel": (SQ, Motion(velocity=(1, 0)), SQ.moved((1e9, 0.3)), Motion(), 2e9,
+REGRESSION_CASES = {
+    "fast_flush": (SQ, Motion(velocity=(2e6, 0)), SQ.moved((3, 0)), Motion(), 5.0, 1e-4),
+    "long_travel": (SQ, Motion(velocity=(1, 0)), SQ.moved((1e9, 0.3)), Motion(), 2e9,
                             1e-4),
-    "defect5_far_away": (SQ.moved((1e9, 0)), Motion(velocity=(1, 0)), SQ.moved((1e9 + 3, 0)),
+    "far_away": (SQ.moved((1e9, 0)), Motion(velocity=(1, 0)), SQ.moved((1e9 + 3, 0)),
                          Motion(), 5.0, 1e-4),
-    "defect5_large_t_max": (SQ, Motion(velocity=(1, 0), angular_velocity=0.5),
+    "large_t_max": (SQ, Motion(velocity=(1, 0), angular_velocity=0.5),
                             SQ.moved((3, 0)), Motion(), 1e13, 1e-4),
-    "defect6_tiny_time_tolerance": (SQ, Motion(velocity=(1, 0)), SQ.moved((3, 0)), Motion(),
+    "tiny_time_tolerance": (SQ, Motion(velocity=(1, 0)), SQ.moved((3, 0)), Motion(),
                                     5.0, 1e-300),
-    "defect6_slow_long_window": (SQ, Motion(velocity=(1e-5, 0)), SQ.moved((3, 0)), Motion(),
+    "slow_long_window": (SQ, Motion(velocity=(1e-5, 0)), SQ.moved((3, 0)), Motion(),
                                  1e6, 1e-12),
 }
 
 
-@pytest.mark.parametrize("case", sorted(DEFECT_CASES))
-def test_defects3_to_6_batched_answers_equal_the_pairwise_ones(case):
-    a, ma, b, mb, t_max, tol = DEFECT_CASES[case]
+@pytest.mark.parametrize("case", sorted(REGRESSION_CASES))
+def test_regression_cases_batched_answers_equal_the_pairwise_ones(case):
+    a, ma, b, mb, t_max, tol = REGRESSION_CASES[case]
     want = pc.time_of_impact(a, ma, b, mb, t_max=t_max, time_tolerance=tol)
     back = pc.time_of_impact(b, mb, a, ma, t_max=t_max, time_tolerance=tol)
     assert want.collides and back.collides

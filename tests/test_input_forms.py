@@ -1,4 +1,4 @@
-"""One way in (issue 13): every accepted form of a body gives the same answer at every
+"""One way in: every accepted form of a body gives the same answer at every
 public entry point, and every bad argument the right exception naming the argument."""
 
 from __future__ import annotations
@@ -204,7 +204,7 @@ def test_wrong_value_is_value_error_naming_the_argument(entry, kind):
 @pytest.mark.parametrize("form", ["shapely", "geo_interface", "geojson", "body-dict", "wkt",
                                   "wkb", "Shape"])
 def test_shape_constructor_points_to_as_shape(form):
-    # Shape() takes arrays; another form is a TypeError that says where to go (issue 13:
-    # Shape(shapely_polygon) failed with "coordinates are not numbers")
+    # Shape() takes arrays; another form is a TypeError that says where to go (not
+    # "coordinates are not numbers" for a Shapely polygon)
     with pytest.raises(TypeError, match="^vertices: .*bodies.as_shape"):
         pc.Shape(forms(B_OUTER, [])[form])

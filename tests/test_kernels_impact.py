@@ -100,7 +100,7 @@ def test_no_relative_motion():
     assert kb.nonpositive_intervals(p, 0.5, 0.0, 2.0).shape == (0, 2)
 
 
-def test_defect4_intervals_stay_right_at_long_travel():
+def test_intervals_stay_right_at_long_travel():
     # unit circles 1e9 apart (0.3 off the line), closing at 1 unit/s: the expanded
     # quartic (d0² = 1e18) lost R² and gave a single instant; relative coordinates keep
     # the roots to the float spacing of the positions (1.2e-7 at 1e9)

@@ -152,7 +152,7 @@ def test_region_is_valid_and_closed_under_swapping():
      ([["x", 1]], "reference")],
 )
 def test_bad_reference(reference, message):
-    # a bad reference point is a bad argument, not an invalid shape (issue 13)
+    # a bad reference point is a bad argument, not an invalid shape
     with pytest.raises((ValueError, TypeError), match=message) as err:
         pc.no_fit_polygon(SQ, SQ, reference=reference)
     assert not isinstance(err.value, pc.InvalidShapeError)
@@ -407,13 +407,13 @@ def test_inner_fit_against_brute_force(a, container):
             assert inside == shapely.intersects_xy(ifp, x, y), (x, y)
 
 
-# -- defect 7 of issue 14: no crash at any finite input ----------------------------------
+# -- no crash at any finite input --------------------------------------------------------
 
 HUGE = [1e105, 1e120, 1e140, 1e154]
 
 
 @pytest.mark.parametrize("side", HUGE)
-def test_defect7_huge_squares_are_refused_not_a_segfault(side):
+def test_huge_squares_are_refused_not_a_segfault(side):
     # Before: the centroid overflowed to inf, the sums to NaN, and the sum kernel's
     # merge never advanced: out-of-bounds writes, a segmentation fault.
     sq = np.array(SQ, dtype=float) * side
@@ -426,7 +426,7 @@ def test_defect7_huge_squares_are_refused_not_a_segfault(side):
 
 
 @pytest.mark.parametrize("side", [1e105, 1e154])
-def test_defect7_huge_squares_time_of_impact_is_refused_not_no_hit(side):
+def test_huge_squares_time_of_impact_is_refused_not_no_hit(side):
     # Before: "no hit" where there is one (the same squares as the NFP crash above).
     sq = np.array(SQ, dtype=float) * side
     with pytest.raises(pc.InvalidShapeError, match="overflow float64"):
@@ -434,7 +434,7 @@ def test_defect7_huge_squares_time_of_impact_is_refused_not_no_hit(side):
                           pc.Motion(), t_max=5.0)
 
 
-def test_defect7_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
+def test_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
     # Two large concave bodies make a sum per pair of pieces (1000 x 100 000 vertices:
     # hundreds of millions of vertices); past its budget the NFP raises a clear error.
     # The budget is lowered here to reach it with small shapes.
@@ -446,7 +446,7 @@ def test_defect7_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch)
 
 
 @pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
-def test_defect7_reference_too_far_for_the_region_is_refused(far):
+def test_reference_too_far_for_the_region_is_refused(far):
     # Before: an empty region (the unit squares' sums vanish in the rounding at 1e17 and
     # beyond), silently wrong.
     with pytest.raises(ValueError, match="reference"):
@@ -461,7 +461,7 @@ def test_far_reference_that_float64_resolves_is_answered():
     assert nfp.region.area == pytest.approx(4.0, rel=1e-4)
 
 
-def test_defect7_nfp_kernel_reports_non_finite_sums_instead_of_crashing():
+def test_nfp_kernel_reports_non_finite_sums_instead_of_crashing():
     # The kernel itself is safe: run apart, so that a crash fails this test only.
     code = (
         "import numpy as np\n"

@@ -199,7 +199,7 @@ def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
 
 
 def _former_selection(pts, pts_ok, segs, segs_ok, near):
-    """The Python steps select_contacts replaced (nfp._clean_degenerate until session 9)."""
+    """The Python steps select_contacts replaced (the former nfp._clean_degenerate)."""
     slides = segs[segs_ok].reshape(-1, 2, 2)
     on_slide = (kfit.distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
                 else np.zeros(len(pts), dtype=bool))
@@ -267,7 +267,7 @@ def test_no_fit_polygon_selects_its_candidates_in_one_kernel_call(monkeypatch, b
 
 
 def _former_assembly(segs, tol):
-    """assemble_rings until session 9: every end linked by the clockwise rule
+    """The former assemble_rings: every end linked by the clockwise rule
     (_first_clockwise), also where a single start is there."""
     seg = segs[np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1]) > tol]
     n = len(seg)

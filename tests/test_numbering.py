@@ -1,4 +1,4 @@
-"""Vertex and edge indices leave the library in the caller's numbering (defect 9).
+"""Vertex and edge indices leave the library in the caller's numbering.
 
 Whatever orientation a ring is given in, closed or not, with repeated points or not,
 a feature's ``vertex`` indexes the caller's own array, and its ``edge`` k is the segment
@@ -64,7 +64,7 @@ def _check(features, rings: dict, tol: float) -> None:
 
 
 # -- the paper's case 2 ----------------------------------------------------------------
-def test_defect9_paper_case_2_reports_the_files_vertex():
+def test_paper_case_2_reports_the_files_vertex():
     """The red vertex that meets blue is the file's vertex 17 (the paper's 18, from 1),
     on blue's edge 30 (the paper's 31-32); it was reported as 23, its place in the
     stored (repaired and reversed) loop. Checked with the file's coordinates: the contact
@@ -98,7 +98,7 @@ def test_defect9_paper_case_2_reports_the_files_vertex():
     assert int(np.argmin(dist)) == f.edge and dist[f.edge] < 0.05
 
 
-def test_defect9_clockwise_closed_ring_with_repeats_keeps_the_callers_numbers():
+def test_clockwise_closed_ring_with_repeats_keeps_the_callers_numbers():
     cw = np.array([[0, 0], [0, 0], [0, 1], [1, 1], [1, 1], [1, 0], [0, 0]], dtype=float)
     tri = np.array([[1, 0.5], [2, 0], [2, 1]], dtype=float)
     for a in (cw, pc.Shape(cw), shapely.Polygon(cw), cw.tolist()):

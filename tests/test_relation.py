@@ -245,7 +245,7 @@ def test_sliver_tip_into_an_edge_is_penetrating(d):
     assert classify(Shape(kite), Shape(sq)).state is State.PENETRATING
 
 
-def test_defect2_small_shapes_keep_resolution():
+def test_small_shapes_keep_resolution():
     # A shift of 1e-9 of the size is seen at every scale: 1e-5 squares 1e-14 apart.
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]) * 1e-5
     b = sq + [1e-5 * (1 + 1e-9), 0.0]
@@ -272,7 +272,7 @@ def test_defect2_small_shapes_keep_resolution():
         (lambda sq: Shape(sq, [[("1", "1"), ("2", "1"), ("1", "2")]]), "hole 0", "<U"),
     ],
 )
-def test_defect8_strings_complex_and_bool_are_refused(call, what, given_type):
+def test_strings_complex_and_bool_are_refused(call, what, given_type):
     sq = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
     with pytest.raises(TypeError, match=f"^{what}: .*expected (a )?real numbers?.*{given_type}"):
         call(sq)

@@ -1,4 +1,4 @@
-"""Results as data (issue 13): ``to_dict()`` is JSON-ready and is what the CLI's
+"""Results as data: ``to_dict()`` is JSON-ready and is what the CLI's
 ``--json`` prints; geometric results have ``__geo_interface__``; every result plots
 itself into a matplotlib Axes."""
 

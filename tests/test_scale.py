@@ -95,7 +95,7 @@ def test_the_tolerance_follows_the_bodies():
             assert r.tolerance == classify(Shape(a), Shape(a + [scale, 0.0])).tolerance
 
 
-def test_defect1_tiny_huge_and_far_shapes_are_accepted():
+def test_tiny_huge_and_far_shapes_are_accepted():
     # Refused before: "zero area" for a micrometre square, a self-intersection that
     # does not exist at offset 1e9, "all vertices on one line" for GEOS's skinny case.
     for scale in SCALES:
@@ -120,7 +120,7 @@ def test_defect1_tiny_huge_and_far_shapes_are_accepted():
         assert classify(shapely.from_wkt(wkt), skinny).state is State.CONTACT
 
 
-def test_defect1_out_of_range_is_refused_clearly():
+def test_out_of_range_is_refused_clearly():
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no overflow warning on the way
         for scale, message in ((1e200, "beyond"), (1e-300, "below 1e-100")):

@@ -11,8 +11,9 @@ Conventions shared by every kernel:
 - Kernels are compiled on first use (``cache=True``), never at import; the cache
   locator (:mod:`.cache`) is installed here, before any kernel module is loaded.
 - This package imports NumPy, Numba and itself only (and ``platformdirs`` for the
-  cache's directory): a kernel reports a status code, the public function that called
-  it raises the error.
+  cache's directory). A kernel reports what it finds (a status code, NaNs); the public
+  function that called it raises the error. (A kernel raises only when its caller gave
+  it a scratch buffer too short.)
 """
 
 from .cache import install_cache_locator

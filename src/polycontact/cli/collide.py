@@ -7,6 +7,7 @@ import json
 import sys
 from typing import Any
 
+from .. import datasets
 from ..limits import SAMPLES, TIME_TOLERANCE
 from ._io import CommandError, index_text, integer_at_least, positive_number
 
@@ -19,7 +20,9 @@ def add_parser(subparsers: Any) -> None:
         "(the first impact among all pairs). Vertex and edge numbers are 0-based, in "
         "the order of each body's vertices in the file (edge k joins vertex k and k + 1).",
     )
-    p.add_argument("scene", metavar="SCENE.json", help="scene file (see the README)")
+    p.add_argument("scene", metavar="SCENE.json",
+                   help="scene file, or a shipped scene's name: "
+                   + ", ".join(datasets.names("scenes")))
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
     p.add_argument("--samples", type=integer_at_least(2), default=SAMPLES,
@@ -69,7 +72,7 @@ def _text(rep: dict[str, Any]) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..scene import load_scene
 
-    scene = load_scene(args.scene, repair=args.repair)
+    scene = load_scene(datasets.locate(args.scene, "scenes"), repair=args.repair)
     for body in scene.bodies:
         for note in body.shape.repairs:
             print(f"polycontact collide: repaired {body.name}: {note}",

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .. import datasets
 from ..errors import InvalidShapeError
 from ._io import CommandError, non_negative_number
 
@@ -22,7 +23,9 @@ def add_parser(subparsers: Any) -> None:
         "(the form of the published layouts; the container is optional), or "
         '{"container": ..., "bodies": [{"name": ..., "vertices": ..., "holes": ...}]}.',
     )
-    p.add_argument("layout", metavar="LAYOUT.json", help="the bodies (and container)")
+    p.add_argument("layout", metavar="LAYOUT.json",
+                   help="the bodies (and container), or a shipped published layout's name: "
+                   + ", ".join(datasets.names("layouts")))
     p.add_argument("--tolerance", type=non_negative_number, default=None, metavar="T",
                    help="absolute distance that counts as touching (default: per pair, "
                    "from the bodies' size and coordinates, as classify)")
@@ -126,7 +129,8 @@ def save_plot(contacts: Any, path: str) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..world import World
 
-    container, bodies, names = read_layout(args.layout, progress=not args.no_progress)
+    container, bodies, names = read_layout(datasets.locate(args.layout, "layouts"),
+                                           progress=not args.no_progress)
     world = World(container)
     world.add_many(bodies, names=names)
     try:

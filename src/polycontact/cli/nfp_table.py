@@ -8,6 +8,7 @@ import math
 import sys
 from typing import Any
 
+from .. import datasets
 from ._io import CommandError, integer_at_least
 
 
@@ -31,7 +32,9 @@ def add_parser(subparsers: Any) -> None:
         "cached in DIR: a rerun computes only the entries DIR lacks, and Ctrl-C never "
         "leaves a damaged cache. Prints a summary: entries, holes, exact fits, seconds.",
     )
-    p.add_argument("instance", metavar="INSTANCE.json", help="ESICUP instance")
+    p.add_argument("instance", metavar="INSTANCE.json",
+                   help="ESICUP instance file, or a shipped instance's name: "
+                   + ", ".join(datasets.names("esicup")))
     p.add_argument("--out", required=True, metavar="DIR", help="cache directory")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--workers", type=integer_at_least(1), default=None, metavar="N",
@@ -51,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     from ..esicup import read_esicup
     from ..nfp_tables import nfp_table
 
-    instance = read_esicup(args.instance)
+    instance = read_esicup(datasets.locate(args.instance, "esicup"))
     client: Any = None
     if args.scheduler is not None:
         try:
