@@ -407,17 +407,33 @@ def query_container(query, tol, hazards):
 
 @njit(cache=True, nogil=True)
 def _query_range(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out):
-    """:func:`query_many` for the poses ``p0:p1``, into ``out``."""
+    """:func:`query_many` for the poses ``p0:p1``, into ``out``: the buffers, then
+    :func:`_query_into`."""
+    ss = shape[1]
+    n_ids, vmax, lmax, hmax = settings[4], settings[5], settings[6], settings[8]
+    hnl = hazards[3]
+    n = ss[ss.shape[0] - 1]
+    buffers = (np.empty((n, 2)), np.empty(n_ids, np.int64), state_scratch(n + max(vmax, hmax)),
+               np.empty(lmax + 1, np.int64),
+               np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64))
+    _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers)
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): per placement and
+# candidate body it reads the records' arrays and makes views of the body, and their
+# atomic reference counts cost as much as the test of a separate pair. Nothing in it may
+# allocate: the buffers are passed in.
+@njit(cache=True, nogil=True, _nrt=False)
+def _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers):
+    """The loop of :func:`_query_range` with its ``buffers``: ``(qxy, cand, scratch, buf,
+    hbuf)``, the placed shape, the grid's candidates, the state kernel's scratch and the
+    loop starts of a body and of a hazard."""
     sxy, ss, cx, cy = shape
     px, py, angles = poses
-    rel, ulp_factor, tol, emax, n_ids, vmax, lmax, has_container, hmax = settings
-    hnl, cbox, ceps = hazards[3], hazards[4], hazards[5]
+    rel, ulp_factor, tol, emax, n_ids, _, _, has_container, _ = settings
+    cbox, ceps = hazards[4], hazards[5]
+    qxy, cand, scratch, buf, hb = buffers
     n = ss[ss.shape[0] - 1]
-    qxy = np.empty((n, 2))
-    cand = np.empty(n_ids, np.int64)
-    scratch = state_scratch(n + max(vmax, hmax))
-    buf = np.empty(lmax + 1, np.int64)
-    hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
     for p in range(p0, p1):
         place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
         qbox = bbox(qxy, n)
