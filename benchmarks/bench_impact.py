@@ -111,14 +111,15 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False
     la, lb = a.bounding_radius, b.bounding_radius
     work = np.empty(ki.work_floats(len(ra) + len(rb)))  # (the API's is kept per thread)
 
-    query = (t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR, lam, 1_000_000, samples)
     if method == "exact":
         kernel = ki.exact_call
-        args = (*pa, va, *pb, vb, query, work)
+        args = (*pa, va, *pb, vb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR,
+                lam, 1_000_000, work)
     else:
         kernel = ki.sampled_query
         args = ((ra, a.packed[1], a.centroid, la), va, (rb, b.packed[1], b.centroid, lb), vb,
-                query, work)
+                (t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR, 0.0, 0, samples),
+                work)
     if compiled:
         kernel = entry_point(kernel, args)
     return lambda: kernel(*args)

@@ -287,7 +287,7 @@ def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float
     from ._kernels.impact import tolerance_at
 
     return float(tolerance_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
-                        b.bounding_radius, t, eps_rel, ROUNDING_FACTOR))
+                              b.bounding_radius, t, eps_rel, ROUNDING_FACTOR))
 
 
 def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
@@ -534,15 +534,15 @@ def time_of_impact(
         cap, work = _grow_work(0)
     if size > cap:
         cap, work = _grow_work(size)
-    # the query's settings, as the kernels take them (see _kernels.impact.exact_query)
-    query = (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR,
-             CONTACT_RESOLUTION * (la + lb), int(max_iterations), int(samples))
     args: tuple[Any, ...]
     if exact:
-        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, query, work)
-    else:
+        args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, t_max, BROAD_PHASE_INFLATION,
+                tol, eps_rel, ROUNDING_FACTOR, CONTACT_RESOLUTION * (la + lb), int(max_iterations),
+                work)
+    else:  # (the query's record, see _kernels.impact.exact_query: the exact method's at 0)
         args = ((ra, a._starts, a._centroid, la), ma._array, (rb, b._starts, b._centroid, lb),
-                mb._array, query, work)
+                mb._array, (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR, 0.0, 0,
+                            int(samples)), work)
     # the compiled code called directly when every argument has the type it always has
     # (Shapes and Motions), else through the dispatcher
     run = _ENTRY.get(method) if fixed else None

@@ -324,14 +324,12 @@ def _node_time(qa, ka, fa, qb, kb, fb, kin, lam, cap):
 def _leaf_pair(way, i, j, v, e, kin, lam, step, dmin2, crit, touch):
     """Vertex i of one body (``v``) against edge j of the other (``e``): ``(dmin2,
     step)`` updated, and ``crit`` set to ``(way, i, j)`` when the pair shortens the
-    step. Each body is ``(r, table, frame)``: its vertices in the body frame, its
-    :func:`edge_table` and its frame at t0 (see :func:`_node_time`); the three points
-    are placed from the body frame, each body turned about its centroid."""
-    rv, tv, (cv, csv, snv, vvx, vvy, wv) = v
-    re, te, (ce, cse, sne, uex, uey, we) = e
-    rv_len = tv[3]
-    nxt_e = te[0]
-    re_len = te[3]
+    step. Each body is ``(r, nxt, r_len, frame)``: its vertices in the body frame, the
+    next vertex and the distance from the centroid of each (:func:`edge_table`), and its
+    frame at t0 (see :func:`_node_time`); the three points are placed from the body
+    frame, each body turned about its centroid."""
+    rv, _, rv_len, (cv, csv, snv, vvx, vvy, wv) = v
+    re, nxt_e, re_len, (ce, cse, sne, uex, uey, we) = e
     j1 = nxt_e[j]
     px = cv[0] + csv * rv[i, 0] - snv * rv[i, 1]
     py = cv[1] + snv * rv[i, 0] + csv * rv[i, 1]
@@ -422,8 +420,8 @@ def pair_step(a, ca, ma, b, cb, mb, window, gaps, crit, traversal):
     (vax, vay, wa), (vbx, vby, wb), kin_ab, kin_ba = window_kinematics(ma, mb, t0, t1)
     fa = (ca, np.cos(tha), np.sin(tha), vax, vay, wa)
     fb = (cb, np.cos(thb), np.sin(thb), vbx, vby, wb)
-    va = (ra, ea, fa)
-    vb = (rb, eb, fb)
+    va = (ra, ea[0], ea[3], fa)
+    vb = (rb, eb[0], eb[3], fb)
     la, qa = ea[1], ea[2]
     lb, qb = eb[1], eb[2]
     step = h
