@@ -1,10 +1,14 @@
-"""Shared pytest setup: hypothesis profiles and the non-interactive matplotlib backend."""
+"""Shared pytest setup: hypothesis profiles, the non-interactive matplotlib backend, no
+command-line notices of long steps unless a test asks."""
 
 import os
 
 from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+# The command line says on stderr when a step runs long; a loaded test machine would make
+# that depend on timing: tests that check those notices ask for them (0 s).
+os.environ.setdefault("POLYCONTACT_NOTICE_AFTER", "inf")
 
 # "default" for local runs (fresh random examples each run); "ci" is selected by .ci/run,
 # which passes --hypothesis-seed derived from the commit: the same commit replays the same

@@ -69,7 +69,7 @@ def test_bad_file_is_one_line_naming_it(tmp_path, capsys):
     captured = capsys.readouterr()
     assert captured.out == ""
     assert captured.err == (f"polycontact entrance-block: error: {bad}: hole 0 lies outside "
-                            "the outer loop (its vertex 0 is at (6, 6))\n")
+                            "the outer loop (its vertex 0 is at (5, 5))\n")
 
 
 @pytest.mark.parametrize("value", ["1", "1,2,3", "a,b", "nan,0"])

@@ -4,6 +4,7 @@ public entry point, and every bad argument the right exception naming the argume
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -201,10 +202,39 @@ def test_wrong_value_is_value_error_naming_the_argument(entry, kind):
     assert not isinstance(err.value, TypeError)
 
 
-@pytest.mark.parametrize("form", ["shapely", "geo_interface", "geojson", "body-dict", "wkt",
-                                  "wkb", "Shape"])
-def test_shape_constructor_points_to_as_shape(form):
-    # Shape() takes arrays; another form is a TypeError that says where to go (not
-    # "coordinates are not numbers" for a Shapely polygon)
-    with pytest.raises(TypeError, match="^vertices: .*bodies.as_shape"):
-        pc.Shape(forms(B_OUTER, [])[form])
+@pytest.mark.parametrize("form", list(forms(A_OUTER, A_HOLES)))
+def test_shape_constructor_takes_every_form(form):
+    shape = pc.Shape(forms(A_OUTER, A_HOLES)[form])
+    ref = pc.Shape(A_OUTER, A_HOLES)
+    assert [x.tolist() for x in shape.loops] == [x.tolist() for x in ref.loops]
+    assert shape.input_vertex(1, 0) == ref.input_vertex(1, 0)
+
+
+@pytest.mark.parametrize("form", ["shapely", "geojson", "body-dict", "wkt", "wkb", "Shape"])
+def test_shape_constructor_refuses_holes_beside_a_body_that_carries_its_own(form):
+    with pytest.raises(TypeError, match="^holes: .*carries its own holes"):
+        pc.Shape(forms(B_OUTER, [])[form], B_HOLES)
+
+
+def test_shape_constructor_names_the_argument_of_an_invalid_body_form():
+    with pytest.raises(pc.InvalidShapeError, match="^vertices: outer loop: self-intersection"):
+        pc.Shape("POLYGON ((0 0, 1 1, 1 0, 0 1, 0 0))")
+    with pytest.raises(pc.InvalidShapeError, match="^vertices: not valid WKT"):
+        pc.Shape("0 0, 1 0, 0 1")
+    assert pc.Shape("POLYGON ((0 0, 2 0, 2 2, 1 2, 1 3, 1 2, 0 2, 0 0))", repair=True).repairs
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [("", "empty text"), ("  \n\t", "empty text"), (b"", "empty WKB"),
+     ("[[0, 0], [1, 0", "not valid JSON"), ('"a string"', "not valid WKT"),
+     ("[]", "outer loop: expected an array of shape (N, 2)")],
+)
+def test_text_with_no_body_says_what_it_is(text, message):
+    with pytest.raises(pc.InvalidShapeError, match=f"^a: {re.escape(message)}"):
+        as_shape(text, "a")
+
+
+def test_json_text_of_a_list_of_vertices_is_a_body():
+    shape = as_shape("[[0, 0], [2, 0], [2, 1]]", "a")
+    assert shape.area == 1.0 and pc.Shape(" [[0, 0], [2, 0], [2, 1]]\n").area == 1.0

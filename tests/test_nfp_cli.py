@@ -52,7 +52,7 @@ def test_plot_is_written(tmp_path, capsys):
 
 
 def test_inner_fit(capsys):
-    assert main(["nfp", SQUARE, CAVITY, "--inner", "--reference", "origin"]) == 0
+    assert main(["nfp", SQUARE, CAVITY, "--inner", "--reference", "origin", "--wkt"]) == 0
     geom = shapely.from_wkt(capsys.readouterr().out)
     assert geom.geom_type == "MultiPolygon" and len(geom.geoms) == 2
     assert shapely.intersects_xy(geom, 0.25, 4.0)
@@ -64,7 +64,6 @@ def test_inner_fit(capsys):
     [
         (["nfp", "missing.json", SQUARE], "missing.json: cannot read"),
         (["nfp", SQUARE, CAVITY, "--plot", "/nonexistent/dir/x.png"], "cannot write the plot"),
-        (["nfp", SQUARE, CAVITY, "--inner", "--plot", "x.png"], "--plot draws no-fit"),
     ],
 )
 def test_user_errors_are_one_line(argv, message, capsys):
@@ -94,3 +93,47 @@ def test_invalid_shape_file(tmp_path, capsys):
     assert main(["nfp", str(spike), SQUARE]) == 2
     assert "spike" in capsys.readouterr().err
     assert main(["nfp", str(spike), SQUARE, "--repair"]) == 0
+
+
+def test_inner_fit_prints_a_summary_like_nfp(capsys):
+    assert main(["nfp", SQUARE, CAVITY, "--inner", "--reference", "origin"]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "reference point of A: (0, 0)",
+        "inner-fit region: 2 polygon(s), area 17, 0 hole(s)",
+        "exact fits: 0",
+        "slides: 0",
+    ]
+    assert main(["nfp", SQUARE, SLOT, "--inner", "--reference", "origin"]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        "reference point of A: (0, 0)",
+        "inner-fit region: 0 polygon(s), area 0, 0 hole(s)",
+        "exact fits: 0",
+        "slides: 2",
+        "  (0, 0) to (0, 2.5)",
+        "  (3, 0) to (3, 2.5)",
+    ]
+
+
+def test_inner_fit_of_a_body_too_big_says_it_does_not_fit(capsys):
+    assert main(["nfp", CAVITY, SQUARE, "--inner"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[1:] == ["inner-fit region: 0 polygon(s), area 0, 0 hole(s)", "exact fits: 0",
+                       "slides: 0", "A does not fit inside B"]
+
+
+def test_inner_fit_json_holds_the_geometry_and_the_summary(capsys):
+    assert main(["nfp", SQUARE, SLOT, "--inner", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["reference"] == [0.75, 0.75]
+    assert shapely.geometry.shape(data["inner_fit"]).equals(
+        shapely.MultiLineString([[(0.75, 0.75), (0.75, 3.25)], [(3.75, 0.75), (3.75, 3.25)]]))
+    assert data["area"] == 0.0 and data["holes"] == 0 and data["exact_fits"] == []
+    assert data["slides"] == [[[0.75, 0.75], [0.75, 3.25]], [[3.75, 0.75], [3.75, 3.25]]]
+
+
+def test_inner_fit_plot_is_written(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "inner.png"
+    assert main(["nfp", SQUARE, CAVITY, "--inner", "--plot", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert capsys.readouterr().out.startswith("reference point of A: (0.75, 0.75)\n")

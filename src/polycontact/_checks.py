@@ -20,9 +20,12 @@ from __future__ import annotations
 import decimal
 import math
 import numbers
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+
+from .tolerances import COORDINATE_LIMIT
 
 
 def is_real(x: Any) -> bool:
@@ -52,39 +55,119 @@ def finite_number(
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
         value = value[()]
     if not is_real(value):
-        raise TypeError(f"{what}: expected a real number, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what}: expected a real number, got {type(value).__name__} "
+                        f"{shown(value)}")
     try:
         x = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise error(f"{what}: expected a finite number, got {value!r}") from None
+        raise error(f"{what}: expected a finite number, got {shown(value)}") from None
     bound = " > 0" if positive else (f" >= {minimum:g}" if minimum is not None else "")
     if not math.isfinite(x) or (positive and x <= 0.0) or (minimum is not None and x < minimum):
         raise error(f"{what}: expected a finite number{bound}, got {x!r}")
     return x
 
 
-def point(value: Any, what: str, *, error: type[ValueError] = ValueError) -> np.ndarray:
-    """``value`` as a float64 array of shape (2,) with finite entries, else ``error``
-    naming ``what``; ``TypeError`` if the entries are not real numbers (strings,
-    booleans, complex numbers)."""
+def real_array(value: Any, what: str, error: type[ValueError] = ValueError) -> np.ndarray:
+    """``value`` as a new float64 array, if it holds real numbers only.
+
+    Integers and floats are converted; strings, booleans, complex numbers, sets,
+    mappings and other objects raise ``TypeError`` naming ``what`` and the type given (a
+    string such as ``"1.5"`` is not parsed, an imaginary part not dropped, a set has no
+    order); a ragged nesting or a number beyond float64 raises ``error``.
+    """
+    if isinstance(value, (str, bytes, set, frozenset, Mapping)):
+        raise TypeError(f"{what}: expected real numbers, got {type(value).__name__}")
     try:
-        raw = np.asarray(value)
-    except (TypeError, ValueError):
-        raise error(f"{what}: expected two numbers (x, y), got {value!r}") from None
-    if raw.shape != (2,):
-        raise error(f"{what}: expected two numbers (x, y), got {value!r}")
-    if raw.dtype.kind == "O" or isinstance(value, (list, tuple)):
-        for x in value if isinstance(value, (list, tuple)) else raw.ravel():
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{what}: not an array of numbers ({exc})") from None
+    kind = arr.dtype.kind
+    if isinstance(value, (list, tuple)) and kind in "iu":  # NumPy made ints of any bools
+        if _holds_bool(value):
+            raise TypeError(f"{what}: expected real numbers, got an element of type bool")
+    if kind == "O":
+        for x in arr.ravel():
             if not is_real(x):
-                raise TypeError(f"{what}: expected two real numbers, got a {type(x).__name__}")
-    elif raw.dtype.kind not in "fiu":
-        raise TypeError(
-            f"{what}: expected two real numbers, got {type(value).__name__} {value!r}"
-        )
+                raise TypeError(
+                    f"{what}: expected real numbers, got an element of type {type(x).__name__}"
+                )
+    elif kind not in "fiu":
+        raise TypeError(f"{what}: expected real numbers, got an array of dtype {arr.dtype}")
     try:
-        arr = np.array(raw, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise error(f"{what}: expected two numbers (x, y), got {value!r}") from None
-    if arr.shape != (2,) or not np.isfinite(arr).all():
-        raise error(f"{what}: expected two finite numbers (x, y), got {value!r}")
+        return np.array(arr, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise error(f"{what}: not an array of numbers ({exc})") from None
+
+
+def _holds_bool(value: Any) -> bool:
+    """Whether a (nested) list or tuple holds a bool (NumPy would make it 0 or 1)."""
+    items = [value]
+    while items:
+        item = items.pop()
+        if isinstance(item, (bool, np.bool_)):
+            return True
+        if isinstance(item, (list, tuple)):
+            items.extend(item)
+    return False
+
+
+def points(value: Any, what: str, shape: tuple[int, ...] = (-1, 2)) -> np.ndarray:
+    """``value`` as a new float64 array of ``shape`` (-1: any length) whose entries are
+    finite and within ±:data:`~polycontact.tolerances.COORDINATE_LIMIT` (products of
+    coordinates must not overflow), else an error naming ``what``: ``TypeError`` for
+    entries that are not real numbers (see :func:`real_array`), ``ValueError``
+    otherwise, with the index of the first bad entry.
+
+    >>> points([(0, 1), (2, 3)], "positions").tolist()
+    [[0.0, 1.0], [2.0, 3.0]]
+    >>> points([(0, 1), (2, 1e200)], "positions")
+    Traceback (most recent call last):
+    ...
+    ValueError: positions[1]: 1e+200 is beyond ±1e+100: products of coordinates would overflow float64
+    """
+    arr = real_array(value, what)
+    if arr.ndim != len(shape) or any(n not in (-1, m) for n, m in zip(shape, arr.shape)):
+        want = ", ".join("N" if n < 0 else str(n) for n in shape)
+        raise ValueError(f"{what}: expected an array of shape ({want}), got shape {arr.shape}")
+    bad = ~np.isfinite(arr) | (np.abs(arr) > COORDINATE_LIMIT)
+    if bad.any():
+        at = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"{what}[{at[0]}]" if len(at) > 1 else what
+        x = float(arr[at])
+        if not math.isfinite(x):
+            raise ValueError(f"{where}: expected finite numbers, got {x!r}")
+        raise ValueError(f"{where}: {x:g} is beyond ±{COORDINATE_LIMIT:g}: products of "
+                         "coordinates would overflow float64")
     return arr
+
+
+def point(value: Any, what: str, *, error: type[ValueError] = ValueError,
+          limit: float | None = COORDINATE_LIMIT) -> np.ndarray:
+    """``value`` as a new float64 array of shape (2,) with finite entries within
+    ±``limit`` (None: any), else ``error`` naming ``what``; ``TypeError`` if the entries
+    are not real numbers (strings, booleans, complex numbers) or ``value`` is a string,
+    a set or a mapping."""
+    arr = real_array(value, what, error)
+    if arr.shape != (2,):
+        raise error(f"{what}: expected two numbers (x, y), got {shown(value)}")
+    if not np.isfinite(arr).all():
+        raise error(f"{what}: expected two finite numbers (x, y), got {shown(value)}")
+    if limit is not None and np.abs(arr).max() > limit:
+        raise error(f"{what}: {shown(value)} is beyond ±{limit:g}: products of "
+                    "coordinates would overflow float64")
+    return arr
+
+
+def shown(value: Any) -> str:
+    """``value`` as an error message shows it: its repr cut to 60 characters, an
+    integer too long for that by its number of digits.
+
+    >>> shown(10**400), shown([1.5, 2])
+    ('an integer of 401 digits', '[1.5, 2]')
+    """
+    text = repr(value)
+    if len(text) <= 60:
+        return text
+    if isinstance(value, int) and not isinstance(value, bool):
+        return f"an integer of {len(text.lstrip('-'))} digits"
+    return text[:57] + "..."

@@ -264,13 +264,14 @@ def classify_many(
     if len(shapes_a) != len(shapes_b):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(shapes_a)} and {len(shapes_b)})")
+    # packed now (a copy): the distances, computed locally on first access, are those of
+    # the bodies as they were at the call, whatever the caller does with its arrays since
+    packed = (*pack_bodies(shapes_a, "shapes_a"), *pack_bodies(shapes_b, "shapes_b"))
     parts = map_batches(_states, shapes_a, shapes_b, client=client, chunk_size=chunk_size,
                         families=["classification"], tolerance=tolerance)
     states = np.concatenate([p[0] for p in parts]) if parts else np.empty(0, np.int8)
     tols = np.concatenate([p[1] for p in parts]) if parts else np.empty(0)
-    return RelationBatch(states, tols,
-                         lambda: (*pack_bodies(shapes_a, "shapes_a"),
-                                  *pack_bodies(shapes_b, "shapes_b")))
+    return RelationBatch(states, tols, lambda: packed)
 
 
 def _states(a: Any, b: Any, tolerance: float | None) -> tuple[np.ndarray, np.ndarray]:

@@ -28,7 +28,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from os import PathLike
@@ -36,6 +35,8 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import finite_number, shown
+from ._json import load_json
 from .errors import InvalidShapeError, PolycontactError
 from .shape import Shape
 
@@ -87,9 +88,7 @@ def turned(shape: Shape, degrees: float) -> Shape:
     >>> turned(sq, 180).exterior.tolist()
     [[-1.0, 0.0], [-2.0, 0.0], [-2.0, -1.0], [-1.0, -1.0]]
     """
-    deg = float(degrees)
-    if not math.isfinite(deg):
-        raise InvalidShapeError(f"degrees: expected a finite angle, got {degrees!r}")
+    deg = finite_number(degrees, "degrees", error=InvalidShapeError)
     quarter = deg / 90.0
     if quarter == round(quarter):
         c, s = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][int(round(quarter)) % 4]
@@ -127,22 +126,20 @@ def read_esicup(path: str | PathLike[str]) -> Instance:
     """
     where = str(path)
     try:
-        with open(path, encoding="utf-8") as f:
-            doc = json.load(f)
+        with open(path, "rb") as f:
+            doc = load_json(f.read())
     except OSError as exc:
         raise InvalidInstanceError(f"{where}: cannot read: {exc.strerror or exc}") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except ValueError as exc:  # (a UnicodeDecodeError too)
         raise InvalidInstanceError(f"{where}: not JSON: {exc}") from None
     if not isinstance(doc, dict) or not isinstance(doc.get("items"), list):
         raise InvalidInstanceError(f"{where}: expected an object with a list 'items'")
     if not doc["items"]:
         raise InvalidInstanceError(f"{where}: 'items' is empty")
-    height = doc.get("strip_height")
-    if isinstance(height, bool) or not isinstance(height, int | float) or not (
-        math.isfinite(height) and height > 0
-    ):
-        raise InvalidInstanceError(
-            f"{where}: 'strip_height': expected a positive number, got {height!r}")
+    height = _finite(doc.get("strip_height"))
+    if height is None or height <= 0:
+        raise InvalidInstanceError(f"{where}: 'strip_height': expected a positive number, "
+                                   f"got {shown(doc.get('strip_height'))}")
     ids, pieces, orientations, demand = [], [], [], []
     for k, item in enumerate(doc["items"]):
         here = f"{where}: items[{k}]"
@@ -154,16 +151,16 @@ def read_esicup(path: str | PathLike[str]) -> Instance:
             raise InvalidInstanceError(f"{here}: 'demand': expected an integer >= 0, got {n!r}")
         demand.append(n)
         angles = item.get("allowed_orientations", [0.0])
-        if not isinstance(angles, list) or not angles or not all(
-            isinstance(a, int | float) and not isinstance(a, bool) and math.isfinite(a)
-            for a in angles
-        ):
+        if not isinstance(angles, list) or not angles or any(_finite(a) is None for a in angles):
             raise InvalidInstanceError(
                 f"{here}: 'allowed_orientations': expected a non-empty list of finite "
-                f"angles in degrees, got {angles!r}")
-        if len(set(float(a) for a in angles)) != len(angles):
-            raise InvalidInstanceError(
-                f"{here}: 'allowed_orientations': an angle is repeated in {angles!r}")
+                f"angles in degrees, got {shown(angles)}")
+        for m, a in enumerate(angles):
+            if any(abs(math.remainder(float(a) - float(b), 360.0)) <= 1e-9
+                   for b in angles[:m]):
+                raise InvalidInstanceError(
+                    f"{here}: 'allowed_orientations': angle {a} is repeated (modulo 360) in "
+                    f"{shown(angles)}")
         orientations.append(tuple(float(a) for a in angles))
         shape = item.get("shape")
         if not isinstance(shape, dict) or shape.get("type") != "simple_polygon":
@@ -181,4 +178,16 @@ def read_esicup(path: str | PathLike[str]) -> Instance:
     if not isinstance(name, str):
         name = str(getattr(path, "stem", "")) or where.rsplit("/", 1)[-1].removesuffix(".json")
     return Instance(name, tuple(ids), tuple(pieces), tuple(orientations), tuple(demand),
-                    float(height))
+                    height)
+
+
+def _finite(x: Any) -> float | None:
+    """``x`` as a float if it is a JSON number (not a boolean) that is a finite float64,
+    else None."""
+    if isinstance(x, bool) or not isinstance(x, int | float):
+        return None
+    try:
+        value = float(x)
+    except OverflowError:  # an integer beyond float64
+        return None
+    return value if math.isfinite(value) else None

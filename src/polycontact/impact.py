@@ -500,8 +500,8 @@ def time_of_impact(
         ma, mb = check_motion(motion_a, "motion_a"), check_motion(motion_b, "motion_b")
     if (type(t_max) is float and type(time_tolerance) is float and type(samples) is int
             and type(max_iterations) is int and 0.0 <= t_max < _INF
-            and 0.0 < time_tolerance < _INF and samples >= 2 and max_iterations >= 1
-            and method in _METHODS):
+            and 0.0 < time_tolerance < _INF and 2 <= samples <= _INT64_MAX
+            and 1 <= max_iterations <= _INT64_MAX and method in _METHODS):
         tol = time_tolerance  # the common case, checked in one expression
     else:
         t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
@@ -593,18 +593,19 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
     tol = finite_number(time_tolerance, "time_tolerance", positive=True)
     if method not in _METHODS:
         raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
-    if type(samples) is not int and (
-            isinstance(samples, bool) or not isinstance(samples, (int, np.integer))) \
-            or samples < 2:
-        raise ValueError(f"samples: expected an integer >= 2, got {samples!r}")
-    if type(max_iterations) is not int and (
-            isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))) \
-            or max_iterations < 1:
-        raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
+    for name, value, least in (("samples", samples, 2), ("max_iterations", max_iterations, 1)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise TypeError(f"{name}: expected an integer, got {type(value).__name__} "
+                            f"{value!r}")
+        if not least <= value <= _INT64_MAX:
+            raise ValueError(f"{name}: expected an integer from {least} to 2**63 - 1, got "
+                             f"{value!r}")
     return t_max, tol
 
 
 _INF = float("inf")
+#: The largest count the kernels take (an int64).
+_INT64_MAX = 2**63 - 1
 #: When the body's reach at rest (``body_frame``'s ``base``, which is at least its
 #: bounding radius), its motion's norms (``Motion._largest``) and t_max are all at most
 #: this, the reach check passes

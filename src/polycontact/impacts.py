@@ -64,6 +64,10 @@ class ImpactBatch:
     first_contacts: np.ndarray
     _make: Callable[[int], Impact] = field(repr=False, compare=False)
 
+    def __post_init__(self) -> None:
+        for array in (self.status, self.collides, self.times, self.first_contacts):
+            array.flags.writeable = False  # a result cannot be changed
+
     def __len__(self) -> int:
         return int(self.status.shape[0])
 

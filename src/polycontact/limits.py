@@ -41,6 +41,8 @@ __all__ = [
     "PIECES_CACHE_SIZE",
     "DEFAULT_BATCH",
     "DEFAULT_IMPACT_BATCH",
+    "JSON_MAX_DEPTH",
+    "NOTICE_AFTER",
 ]
 
 # -- distances (see polycontact.tolerances) ------------------------------------------
@@ -164,3 +166,16 @@ DEFAULT_BATCH = 20_000
 #: pair's search costs ten to a thousand times a classification, so a task of this
 #: many is still well above Dask's overhead.
 DEFAULT_IMPACT_BATCH = 2_000
+
+# -- files and the command line ------------------------------------------------------
+
+#: Deepest nesting of arrays and objects accepted in a JSON file or text (levels): the
+#: structures polycontact reads (bodies, scenes, layouts, instances, cache indexes) are
+#: a few levels deep (a GeoJSON polygon is 4), and anything deeper is refused before it
+#: is walked, not left to Python's recursion limit.
+JSON_MAX_DEPTH = 32
+
+#: Seconds a step of a command may run before it says so on stderr (the environment
+#: variable ``POLYCONTACT_NOTICE_AFTER`` overrides it): a few seconds is past any step
+#: of an ordinary call, so a notice means large input.
+NOTICE_AFTER = 3.0

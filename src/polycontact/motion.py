@@ -17,24 +17,26 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import finite_number
+from ._checks import finite_number, point
+from .tolerances import COORDINATE_LIMIT
 
 __all__ = ["Motion"]
 
 
 def _pair(value: Any, what: str) -> tuple[float, float]:
-    try:
-        x, y = (float(c) for c in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected two numbers, got {value!r}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise ValueError(f"{what}: expected finite numbers, got {[x, y]}")
+    # (no range: the queries refuse a motion whose products would overflow, naming it)
+    x, y = point(value, what, limit=None).tolist()
     return x, y
 
 
 @dataclass(frozen=True)
 class Motion:
     """Constant-acceleration rigid motion about the body's area centroid.
+
+    Every component is a real number (not a string, a boolean or a complex number) and
+    finite, else ``TypeError`` or ``ValueError`` naming the parameter. A motion that
+    would carry a body's coordinates, speeds or accelerations beyond ±1e100 within a
+    query's window is refused by that query, naming the motion.
 
     Parameters
     ----------
@@ -92,11 +94,15 @@ class Motion:
         The placed body is the body at t = 0 rotated by ``angle`` about its centroid,
         then translated by ``translation`` (what :meth:`polycontact.Shape.moved` does).
         """
-        t = float(t)
+        t = finite_number(t, "t")
         v = np.asarray(self.velocity)
         a = np.asarray(self.acceleration)
         translation = v * t + 0.5 * a * t * t
         angle = self.angular_velocity * t + 0.5 * self.angular_acceleration * t * t
+        if not (np.abs(translation).max() <= COORDINATE_LIMIT and abs(angle) < math.inf):
+            raise ValueError(f"t: at t = {t:g} the motion carries the body beyond "
+                             f"±{COORDINATE_LIMIT:g}: products of coordinates would overflow "
+                             "float64")
         return translation, float(angle)
 
     @property

@@ -129,7 +129,8 @@ class NoFitPolygon:
         of A, without touching), and no holes narrower than the tolerance.
     exact_fits : ndarray of shape (P, 2), float64
         Isolated reference positions inside ``region`` where A touches B without
-        overlapping (every small move makes them overlap).
+        overlapping (every small move makes them overlap). Read-only, as every array
+        of the result.
     slides : ndarray of shape (S, 2, 2), float64
         Segments inside ``region`` along which A touches B without overlapping, each
         as its two end points.
@@ -168,6 +169,12 @@ class NoFitPolygon:
         state = dict(self.__dict__, region=self.region)
         state.pop("_rings", None)
         return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # (unpickled arrays are writable: a result's are not)
+        for key in ("exact_fits", "slides", "reference"):
+            state[key].flags.writeable = False
+        self.__dict__.update(state)
 
     @property
     def rings(self) -> tuple[np.ndarray, ...]:
@@ -338,6 +345,9 @@ def no_fit_polygon(
         out = _entrance_kernel(*pieces(), tolerance)
     region, pts, segs, eps = _entrance_result(out, pieces)
     fits, slides = _clean_degenerate(pts, segs, eps, lambda: _touching(a, b, a0, eps))
+    for array in (fits, slides, a0):
+        if array is not _NO_FITS and array is not _NO_SLIDES and array is not _ORIGIN:
+            array.flags.writeable = False  # a result cannot be changed (shared ones are not)
     # Built as the frozen dataclass's __init__ would, at a fraction of its cost; with
     # the kernel's rings, ``region`` is made on first access (NoFitPolygon.__getattr__)
     nfp = _new(NoFitPolygon)

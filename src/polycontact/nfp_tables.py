@@ -9,13 +9,14 @@ coordinates, as ESICUP defines it (:func:`polycontact.esicup.turned`).
 **Cache.** With ``cache=DIR`` the table is read from and written to a directory:
 
 - ``DIR/table.json``: the last build's pieces, orientations and reference (so
-  :meth:`NfpTable.load` needs nothing else);
+  :meth:`NfpTable.load` needs nothing else), with a checksum of them;
 - ``DIR/shards/NAME.wkb``: the regions of a batch of entries, as ISO WKB
   (little-endian, float64: exact), one after the other;
 - ``DIR/shards/NAME.json``: that batch's index: for each entry its key, the byte range
   of its region in the ``.wkb`` file, the reference point, the tolerance, the exact fits
-  and the slides (JSON numbers, which round-trip float64 exactly), and a BLAKE2 checksum
-  of the ``.wkb`` file.
+  and the slides (JSON numbers, which round-trip float64 exactly), and one BLAKE2
+  checksum of the ``.wkb`` file and of every value of the index: every byte that
+  decides an answer is checked.
 
 An entry's key is a hash of the two turned pieces' coordinates, the reference, this
 format's version and polycontact's version, so the cache is shared by every table
@@ -24,8 +25,9 @@ own entries, and entries of another polycontact version are never reused. Every 
 is written to a temporary name and renamed (atomic on POSIX and Windows); a shard's
 ``.json`` is written after its ``.wkb`` and is what makes the shard exist, so a build
 interrupted at any point (Ctrl-C, a killed process or worker) leaves only complete
-shards, and the next build computes only the entries the cache lacks. A shard whose
-checksum does not match is ignored with a warning and its entries are recomputed.
+shards, and the next build computes only the entries the cache lacks. A shard that
+cannot be read or does not match its checksum is ignored with a warning and its entries
+are recomputed.
 
 **Parallel runs.** With ``client=`` (a ``dask.distributed.Client``), or when called where
 a Dask client is the default, the missing entries are split into tasks of
@@ -53,10 +55,12 @@ import hashlib
 import json
 import math
 import multiprocessing
+import multiprocessing.connection
 import operator
 import os
 import signal
 import sys
+import threading
 import time
 import uuid
 import warnings
@@ -73,6 +77,7 @@ import numpy as np
 import shapely
 
 from . import __version__
+from ._json import load_json
 from .esicup import Instance, turned
 from .nfp import NoFitPolygon, no_fit_polygon
 from .bodies import as_shape
@@ -82,7 +87,7 @@ __all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_POOL_MIN_ENTRIES"]
 
 #: Name and version of the on-disk format.
 FORMAT = "polycontact-nfp-table"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 MANIFEST = "table.json"
 SHARDS = "shards"
 
@@ -115,6 +120,11 @@ class _Record:
     slides: np.ndarray
     reference: np.ndarray
     tolerance: float
+
+    def __post_init__(self) -> None:
+        # the arrays go out as they are in each NoFitPolygon of the table: read-only
+        for array in (self.exact_fits, self.slides, self.reference):
+            array.flags.writeable = False
 
 
 class NfpTable:
@@ -185,22 +195,22 @@ class NfpTable:
         region = self._regions.get(key)
         if region is None:
             region = self._regions[key] = shapely.from_wkb(rec.wkb)
-        return NoFitPolygon(region, rec.exact_fits.copy(), rec.slides.copy(),
-                            rec.reference.copy(), self._shapes[sa], self._shapes[sb],
-                            rec.tolerance)
+        return NoFitPolygon(region, rec.exact_fits, rec.slides, rec.reference,
+                            self._shapes[sa], self._shapes[sb], rec.tolerance)
 
     def _slot(self, piece: Any, angle: Any, what: str) -> tuple[int, int]:
         try:
             k = operator.index(piece)
         except TypeError:
             raise KeyError(f"{what}: expected a piece index, got {piece!r}") from None
+        if isinstance(piece, bool):
+            raise KeyError(f"{what}: expected a piece index, got {piece!r}")
         if not 0 <= k < len(self.pieces):
             raise KeyError(f"{what}: piece {k} out of range (the table has "
                            f"{len(self.pieces)} pieces)")
-        try:
-            deg = float(angle)
-        except (TypeError, ValueError):
-            raise KeyError(f"angle of piece {k}: expected degrees, got {angle!r}") from None
+        if not _is_number(angle):  # (a string is not parsed, a bool is no angle)
+            raise KeyError(f"angle of piece {k}: expected degrees, got {angle!r}")
+        deg = float(angle)
         for n, a in enumerate(self.orientations[k]):
             if abs(math.remainder(deg - a, 360.0)) <= ANGLE_MATCH:
                 return k, n
@@ -265,7 +275,9 @@ class NfpTable:
         """
         cache = Path(directory)
         try:
-            doc = json.loads((cache / MANIFEST).read_text(encoding="utf-8"))
+            doc = load_json((cache / MANIFEST).read_bytes())
+            if not isinstance(doc, dict) or _checksum(doc) != doc.get("blake2b"):
+                raise ValueError("it does not match its checksum")
             pieces = tuple(Shape(p["vertices"], p["holes"]) for p in doc["pieces"])
             orientations = tuple(tuple(float(a) for a in o) for o in doc["orientations"])
             reference = doc["reference"]
@@ -403,8 +415,12 @@ def _pieces_and_orientations(
 
 
 def _is_number(a: Any) -> bool:
-    return isinstance(a, int | float | np.integer | np.floating) and not isinstance(
-        a, bool) and math.isfinite(float(a))
+    if isinstance(a, bool) or not isinstance(a, int | float | np.integer | np.floating):
+        return False
+    try:
+        return math.isfinite(float(a))
+    except OverflowError:  # an integer beyond float64
+        return False
 
 
 def _prepare(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],
@@ -534,12 +550,29 @@ _WORKER_SHAPES: list[Shape] = []
 
 
 def _init_process(shapes: list[Shape]) -> None:
-    """A local worker process: Ctrl-C is the parent's to handle; kernels loaded once."""
+    """A local worker process: Ctrl-C is the parent's to handle; it ends when its parent
+    does (:func:`_exit_with_parent`); kernels loaded once."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with_parent, args=(parent.sentinel,), daemon=True,
+                         name="polycontact-parent-watch").start()
     from .compiling import warmup
 
     warmup(["no-fit polygon"])
     _WORKER_SHAPES[:] = shapes
+
+
+def _exit_with_parent(sentinel: int) -> None:
+    """Wait until the parent process is gone, then end this worker at once.
+
+    A worker blocked on its task queue never learns that the parent was killed (the
+    queue's pipe stays open: the worker holds both of its ends), and neither does the
+    resource tracker the workers keep alive; the parent's sentinel, which the spawned
+    process holds, becomes ready when the parent dies however it dies (SIGKILL
+    included)."""
+    multiprocessing.connection.wait([sentinel])
+    os._exit(1)
 
 
 def _process_task(pairs: np.ndarray, reference: str) -> Packed:
@@ -588,15 +621,44 @@ def _atomic_write(path: Path, data: bytes) -> None:
             tmp.unlink()
 
 
+def _manifest(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],
+              reference: str) -> bytes:
+    """The bytes of ``table.json``: the build's pieces, orientations and reference, and a
+    checksum of them (:func:`_checksum`)."""
+    doc: dict[str, Any] = {
+        "format": FORMAT, "format_version": FORMAT_VERSION, "polycontact": __version__,
+        "reference": reference,
+        "pieces": [{"vertices": p.exterior.tolist(), "holes": [h.tolist() for h in p.holes]}
+                   for p in pieces],
+        "orientations": [list(o) for o in orientations]}
+    doc["blake2b"] = _checksum(doc)
+    return json.dumps(doc).encode()
+
+
 def _write_manifest(cache: Path, pieces: tuple[Shape, ...],
                     orientations: tuple[tuple[float, ...], ...], reference: str) -> None:
+    """Write ``table.json`` (and make the folders), unless it holds these bytes already:
+    a build that finds every entry in a read-only cache writes nothing."""
+    if cache.exists() and not cache.is_dir():
+        raise ValueError(f"cache: {cache} is not a directory")
+    data = _manifest(pieces, orientations, reference)
+    try:
+        if (cache / MANIFEST).read_bytes() == data and (cache / SHARDS).is_dir():
+            return
+    except OSError:
+        pass
     (cache / SHARDS).mkdir(parents=True, exist_ok=True)
-    doc = {"format": FORMAT, "format_version": FORMAT_VERSION, "polycontact": __version__,
-           "reference": reference,
-           "pieces": [{"vertices": p.exterior.tolist(), "holes": [h.tolist() for h in p.holes]}
-                      for p in pieces],
-           "orientations": [list(o) for o in orientations]}
-    _atomic_write(cache / MANIFEST, json.dumps(doc).encode())
+    _atomic_write(cache / MANIFEST, data)
+
+
+def _checksum(doc: dict[str, Any], blob: bytes = b"") -> str:
+    """BLAKE2 of ``blob`` and of ``doc``'s JSON without its ``blake2b`` key, keys sorted:
+    every value of the document (numbers round-trip exactly), so that a changed byte of
+    either, a swapped byte range or an edited number included, is a mismatch."""
+    h = hashlib.blake2b(blob)
+    h.update(json.dumps({k: v for k, v in doc.items() if k != "blake2b"},
+                        sort_keys=True).encode())
+    return h.hexdigest()
 
 
 def _write_shard(cache: Path, records: list[tuple[str, _Record]]) -> None:
@@ -612,35 +674,63 @@ def _write_shard(cache: Path, records: list[tuple[str, _Record]]) -> None:
                         "reference": r.reference.tolist(), "tolerance": r.tolerance,
                         "exact_fits": r.exact_fits.tolist(), "slides": r.slides.tolist()})
         offset += len(r.wkb)
-    index = {"format": FORMAT, "format_version": FORMAT_VERSION, "wkb": f"{stem}.wkb",
-             "wkb_bytes": len(blob), "blake2b": hashlib.blake2b(blob).hexdigest(),
-             "entries": entries}
+    index: dict[str, Any] = {"format": FORMAT, "format_version": FORMAT_VERSION,
+                             "wkb": f"{stem}.wkb", "wkb_bytes": len(blob), "entries": entries}
+    index["blake2b"] = _checksum(index, blob)
     _atomic_write(folder / f"{stem}.wkb", blob)
     _atomic_write(folder / f"{stem}.json", json.dumps(index).encode())
 
 
 def _read_cache(cache: Path) -> dict[str, _Record]:
-    """Every entry of the committed shards of ``cache`` (empty if there is none)."""
+    """Every entry of the committed shards of ``cache`` (empty if there is none). A
+    shard that cannot be read, or whose index or regions do not match its checksum, is
+    skipped with a :class:`CacheWarning` (its entries are recomputed)."""
     folder = cache / SHARDS
     if not folder.is_dir():
         return {}
     out: dict[str, _Record] = {}
     for index_path in sorted(folder.glob("[!.]*.json")):
         try:
-            index = json.loads(index_path.read_text(encoding="utf-8"))
-            if index.get("format") != FORMAT or index.get("format_version") != FORMAT_VERSION:
-                continue  # another format: not ours to read
-            blob = (folder / index["wkb"]).read_bytes()
-            if len(blob) != index["wkb_bytes"] or (
-                    hashlib.blake2b(blob).hexdigest() != index["blake2b"]):
-                raise ValueError("the .wkb file does not match its checksum")
-            for e in index["entries"]:
-                wkb = blob[e["offset"]: e["offset"] + e["length"]]
-                out[e["key"]] = _Record(
-                    wkb, np.array(e["exact_fits"], dtype=np.float64).reshape(-1, 2),
-                    np.array(e["slides"], dtype=np.float64).reshape(-1, 2, 2),
-                    np.array(e["reference"], dtype=np.float64), float(e["tolerance"]))
-        except (OSError, ValueError, KeyError, TypeError) as exc:
+            out.update(_read_shard(folder, index_path))
+        except Exception as exc:  # noqa: BLE001 - whatever is wrong, the shard is damaged
             warnings.warn(f"NFP cache: ignoring shard {index_path} ({exc}); its entries are "
                           "recomputed", CacheWarning, stacklevel=3)
     return out
+
+
+def _read_shard(folder: Path, index_path: Path) -> list[tuple[str, _Record]]:
+    """The entries of one shard; a ValueError (or OSError) saying why it is refused.
+    Another format's shard (not ours to read) has none."""
+    index = load_json(index_path.read_bytes())
+    if not isinstance(index, dict):
+        raise ValueError("the index is not a JSON object")
+    if index.get("format") != FORMAT or index.get("format_version") != FORMAT_VERSION:
+        return []
+    name = index.get("wkb")
+    if not isinstance(name, str) or Path(name).name != name or not name.endswith(".wkb"):
+        raise ValueError(f"the index names no .wkb file of this folder ({name!r})")
+    blob = (folder / name).read_bytes()
+    if index.get("wkb_bytes") != len(blob) or _checksum(index, blob) != index.get("blake2b"):
+        raise ValueError("the shard does not match its checksum")
+    entries = index.get("entries")
+    if not isinstance(entries, list):
+        raise ValueError("'entries' is not a list")
+    return [_entry(e, blob) for e in entries]
+
+
+def _entry(e: Any, blob: bytes) -> tuple[str, _Record]:
+    """One entry of a shard's index (checked: the checksum passed, but nothing of it may
+    crash a build), as ``(key, record)``."""
+    if not isinstance(e, dict):
+        raise ValueError("an entry is not a JSON object")
+    key, offset, length = e.get("key"), e.get("offset"), e.get("length")
+    if not (isinstance(key, str) and isinstance(offset, int) and isinstance(length, int)
+            and 0 <= offset <= offset + length <= len(blob)):
+        raise ValueError(f"entry {key!r}: bad key or byte range")
+    fits = np.array(e.get("exact_fits"), dtype=np.float64).reshape(-1, 2)
+    slides = np.array(e.get("slides"), dtype=np.float64).reshape(-1, 2, 2)
+    reference = np.array(e.get("reference"), dtype=np.float64)
+    tolerance = float(e["tolerance"])
+    if reference.shape != (2,) or not (np.isfinite(reference).all() and tolerance > 0.0):
+        raise ValueError(f"entry {key!r}: bad reference or tolerance")
+    return key, _Record(blob[offset:offset + length], fits, slides, reference, tolerance)

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import enum
 import os
+import threading
+import weakref
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -324,7 +326,7 @@ class Relation:
         """Smallest translation of A that ends the overlap (penetrating only)."""
         if self.state is not State.PENETRATING:
             return None
-        return np.array(self._penetration[1:])
+        return _read_only(np.array(self._penetration[1:]))
 
     @_cached
     def _raw_features(self) -> tuple[Any, ...]:
@@ -354,7 +356,11 @@ class Relation:
 
     @_cached
     def point(self) -> np.ndarray | None:
-        """Witness point (see the class docstring)."""
+        """Witness point (see the class docstring), a read-only array."""
+        p = self._witness()
+        return None if p is None else _read_only(p)
+
+    def _witness(self) -> np.ndarray | None:
         if self.state is State.SEPARATE:
             _, px, py, qx, qy = self._closest
             return np.array([0.5 * (px + qx), 0.5 * (py + qy)])
@@ -375,7 +381,11 @@ class Relation:
 
     @_cached
     def normal(self) -> np.ndarray | None:
-        """Unit normal from A towards B (see the class docstring)."""
+        """Unit normal from A towards B (see the class docstring), a read-only array."""
+        n = self._unit_normal()
+        return None if n is None else _read_only(n)
+
+    def _unit_normal(self) -> np.ndarray | None:
         if self.state is State.SEPARATE:
             return None
         if self.state is State.PENETRATING:
@@ -408,6 +418,12 @@ class Relation:
         return None if best is None else best[1]
 
 
+def _read_only(arr: np.ndarray) -> np.ndarray:
+    """``arr`` (a result's own array) made read-only: a result cannot be changed."""
+    arr.flags.writeable = False
+    return arr
+
+
 def _xy(p: np.ndarray | None) -> list[float] | None:
     """A point or vector as a JSON-ready ``[x, y]`` (None stays None)."""
     return None if p is None else [float(v) for v in p]
@@ -424,13 +440,18 @@ def _to_shape(src: Any) -> Shape:
     raw, n, sign = src  # the bytes of a C-contiguous float64 (N, 2) ring, copied at call
     arr = np.frombuffer(raw, dtype=np.float64).reshape(-1, 2)
     ring = arr[:n] if sign > 0 else arr[:n][::-1]
-    # The caller's numbering: only a closing point was dropped (it is the caller's
-    # vertex n, so edge n - 1 ends there), and the ring was reversed if clockwise.
+    return Shape._trusted([np.array(ring, dtype=np.float64)], inputs=raw_ring_inputs(n, sign))
+
+
+def raw_ring_inputs(n: int, sign: float) -> tuple[np.ndarray, np.ndarray]:
+    """The map to the caller's numbering (``Shape._input``) of a raw ring that the ring
+    kernels accepted with ``n`` vertices, stored reversed when ``sign`` < 0 (clockwise):
+    only a closing point was dropped (it is the caller's vertex n, so edge n - 1 ends
+    there)."""
     index = np.arange(n, dtype=np.int64)
     edge = index if sign > 0 else np.roll(index[::-1], -1)
     vertex = index if sign > 0 else index[::-1]
-    inputs = (np.zeros(1, dtype=np.int64), np.ascontiguousarray(np.stack([vertex, edge], axis=1)))
-    return Shape._trusted([np.array(ring, dtype=np.float64)], inputs=inputs)
+    return (np.zeros(1, dtype=np.int64), np.ascontiguousarray(np.stack([vertex, edge], axis=1)))
 
 
 def _check_tolerance(tolerance: Any) -> float:
@@ -602,9 +623,13 @@ class RelationBatch:
         """The :class:`State` of pair ``i``."""
         return _STATES[int(self.states[i])]
 
+    def __post_init__(self) -> None:
+        self.states.flags.writeable = False
+        self.tolerances.flags.writeable = False
+
     @cached_property
     def distances(self) -> np.ndarray:
-        """Signed distance of every pair (gap, 0 at contact, minus the depth)."""
+        """Signed distance of every pair (gap, 0 at contact, minus the depth), read-only."""
         from ._depth import penetrations
         from ._kernels import relation_many as km
 
@@ -613,7 +638,7 @@ class RelationBatch:
         pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
         if pen.size:
             out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
-        return cast("np.ndarray", out)
+        return _read_only(out)
 
 
 def _split(count: int, fn: Any) -> list[Any]:
@@ -628,13 +653,12 @@ def _split(count: int, fn: Any) -> list[Any]:
 
 
 def _raw_array(arr: Any) -> np.ndarray | None:
-    """``arr`` as a C-contiguous float64 (P, N, 2) array of rings, or None if it is not
-    one (no copy when it already is)."""
+    """``arr`` if it is a (P, N, 2) array of real rings, else None."""
     if not (isinstance(arr, np.ndarray) and arr.ndim == 3 and arr.shape[2] == 2):
         return None
     if arr.dtype.kind not in "fiu":
         return None
-    return np.ascontiguousarray(arr, dtype=np.float64)
+    return arr
 
 
 def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any, ...]:
@@ -655,19 +679,84 @@ def _classify_arrays(
     from ._kernels import relation_many as km
 
     out = km.raw_states_outputs(arr_a.shape[0])
-    _split(arr_a.shape[0], lambda p0, p1: km.raw_states(
-        arr_a[p0:p1], arr_b[p0:p1], tol, *_RING_ARGS, tuple(o[p0:p1] for o in out)))
+    # The rings are copied (float64, C order), each chunk by the thread that classifies
+    # it, just before (in parallel, and still in cache for the kernel): the distances,
+    # computed on first access, read the copies, never the caller's arrays, which the
+    # caller may have reused since. The copies live in buffers of _BUFFERS.
+    buf_a, buf_b = _BUFFERS.take(arr_a.size), _BUFFERS.take(arr_b.size)
+    copy_a = buf_a[: arr_a.size].reshape(arr_a.shape)
+    copy_b = buf_b[: arr_b.size].reshape(arr_b.shape)
+
+    def chunk(p0: int, p1: int) -> None:
+        copy_a[p0:p1] = arr_a[p0:p1]
+        copy_b[p0:p1] = arr_b[p0:p1]
+        km.raw_states(copy_a[p0:p1], copy_b[p0:p1], tol, *_RING_ARGS,
+                      tuple(o[p0:p1] for o in out))
+
+    try:
+        _split(arr_a.shape[0], chunk)
+    except BaseException:
+        _BUFFERS.give(buf_a, buf_b)
+        raise
     states, eps, used_a, sign_a, used_b, sign_b = out
     if (states < 0).any():
+        _BUFFERS.give(buf_a, buf_b)
         return None
-    return RelationBatch(
+    batch = RelationBatch(
         states, eps,
-        lambda: (*_ring_pack(arr_a, used_a, sign_a), *_ring_pack(arr_b, used_b, sign_b)),
+        lambda: (*_ring_pack(copy_a, used_a, sign_a), *_ring_pack(copy_b, used_b, sign_b)),
     )
+    weakref.finalize(batch, _BUFFERS.give, buf_a, buf_b)  # reused once the batch is gone
+    return batch
 
 
-def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, ...]:
-    """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel."""
+class _BufferPool:
+    """Float64 buffers for the copies of :func:`classify_many`'s ring arrays, reused once
+    the batch that held one is gone. A fresh array of tens of megabytes has its pages
+    mapped on first touch, which cost a fifth of a batch's classification (100 000 pairs
+    of 12-gons: 7 of 35 ms); a loop of batches reuses the same few buffers instead.
+
+    >>> pool = _BufferPool()
+    >>> b = pool.take(10); pool.give(b); pool.take(8) is b
+    True
+    """
+
+    #: Buffers kept for reuse at most (the largest are kept), and their floats at most
+    #: (64 MiB: a batch of 100 000 pairs of 12-gons needs 38 MB).
+    KEEP = 2
+    KEEP_FLOATS = 8 * 2**20
+
+    def __init__(self) -> None:
+        self._free: list[np.ndarray] = []
+        self._lock = threading.Lock()
+
+    def take(self, size: int) -> np.ndarray:
+        """A buffer of at least ``size`` floats (at most twice as many: a small batch
+        does not hold a large buffer)."""
+        with self._lock:  # (the free list is sorted by size)
+            for k, buf in enumerate(self._free):
+                if size <= buf.size <= 2 * size:
+                    return self._free.pop(k)
+        return np.empty(size)
+
+    def give(self, *buffers: np.ndarray) -> None:
+        """Take ``buffers`` back (no one reads them any more)."""
+        with self._lock:
+            self._free.extend(buffers)
+            self._free.sort(key=lambda b: b.size)
+            del self._free[: max(0, len(self._free) - self.KEEP)]
+            while sum(b.size for b in self._free) > self.KEEP_FLOATS:
+                del self._free[-1]
+
+
+_BUFFERS = _BufferPool()
+
+
+def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
+                   made: list[Any] | None = None) -> tuple[Any, ...]:
+    """Pack Shapes, polygons and raw (N, 2) rings; raw rings are checked in a kernel.
+    ``made``, if given, receives the Shape packed for each item (None for a raw ring
+    packed as it is, stored reversed where ``sign`` < 0)."""
     from ._kernels import relation_many as km
 
     bodies: list[Any] = []
@@ -696,6 +785,8 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, .
             else:
                 bodies[i] = bodies[i][: used[k]]
                 sign[i] = sg[k]
+    if made is not None:
+        made[:] = [body if isinstance(body, Shape) else None for body in bodies]
     chunks = []
     ls: list[int] = []
     bs = [0]
@@ -714,7 +805,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str) -> tuple[Any, .
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def pack_bodies(items: Any, what: str) -> tuple[Any, ...]:
+def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
@@ -722,7 +813,7 @@ def pack_bodies(items: Any, what: str) -> tuple[Any, ...]:
             f"{what}: expected a sequence of bodies or an array of shape (P, N, 2), "
             f"got {type(items).__name__}"
         )
-    return _pack_sequence(items, what)
+    return _pack_sequence(items, what, made)
 
 
 def classify_many(
@@ -739,7 +830,8 @@ def classify_many(
     shapes_a, shapes_b : sequence of bodies, or ndarray of shape (P, N, 2)
         Bodies as for :func:`classify` (Shape, shapely Polygon, (N, 2) array), or the
         packed form: a float64 array of P outer rings of N vertices each (closed or
-        not, either orientation), read in place without a copy.
+        not, either orientation), copied once (the distances, computed on first
+        access, are those of the rings as they were at the call).
     tolerance : float, optional
         Absolute tolerance for every pair; default per pair as in :func:`classify`.
 

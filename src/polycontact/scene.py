@@ -17,14 +17,16 @@ two bodies are refused with an :class:`~polycontact.InvalidSceneError` naming th
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from collections.abc import Mapping
 from typing import Any
 
+from ._checks import shown
+from ._json import load_json
 from .bodies import as_shape
+from .broad_phase import check_reach
 from .errors import InvalidSceneError, InvalidShapeError
 from .impact import Impact, ImpactStatus, time_of_impact
 from .limits import SAMPLES, TIME_TOLERANCE
@@ -92,7 +94,7 @@ class Scene:
             raise InvalidSceneError(f"bodies: expected a list, got {type(bodies).__name__}")
         if len(bodies) < 2:
             raise InvalidSceneError(f"bodies: expected at least two bodies, got {len(bodies)}")
-        parsed = tuple(_body(b, i, repair) for i, b in enumerate(bodies))
+        parsed = tuple(_body(b, i, repair, t_max) for i, b in enumerate(bodies))
         names = [b.name for b in parsed]
         for i, name in enumerate(names):
             if name in names[:i]:
@@ -216,12 +218,15 @@ def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) ->
         raise TypeError(f"path: expected a path or a mapping, got {type(path).__name__}")
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise InvalidSceneError(f"{path}: cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError as exc:
+        raise InvalidSceneError(f"{path}: not a JSON text ({exc.reason} at byte "
+                                f"{exc.start})") from None
     try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
+        data = load_json(text)
+    except ValueError as exc:
         raise InvalidSceneError(f"{path}: not valid JSON ({exc})") from None
     try:
         return Scene.from_dict(data, repair=repair)
@@ -243,16 +248,19 @@ def _no_unknown(data: dict[str, Any], allowed: set[str], where: str) -> None:
 
 def _number(value: Any, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InvalidSceneError(f"{what}: expected a number, got {json.dumps(value)}")
-    if not math.isfinite(value):
-        raise InvalidSceneError(f"{what}: expected a finite number, got {value}")
-    return float(value)
+        raise InvalidSceneError(f"{what}: expected a number, got {shown(value)}")
+    try:
+        x = float(value)  # (an integer beyond float64 overflows)
+    except OverflowError:
+        x = math.inf
+    if not math.isfinite(x):
+        raise InvalidSceneError(f"{what}: expected a finite number, got {shown(value)}")
+    return x
 
 
 def _vector(value: Any, what: str) -> tuple[float, float]:
     if not isinstance(value, (list, tuple)) or len(value) != 2:
-        got = json.dumps(value, default=repr)
-        raise InvalidSceneError(f"{what}: expected [x, y], got {got}")
+        raise InvalidSceneError(f"{what}: expected [x, y], got {shown(value)}")
     return _number(value[0], f"{what}[0]"), _number(value[1], f"{what}[1]")
 
 
@@ -273,7 +281,7 @@ def _angle(data: dict[str, Any], key: str, where: str) -> float:
     return 0.0
 
 
-def _body(data: Any, i: int, repair: bool) -> Body:
+def _body(data: Any, i: int, repair: bool, t_max: float) -> Body:
     where = f"bodies[{i}]"
     if not isinstance(data, dict):
         raise InvalidSceneError(f"{where}: expected an object, got {type(data).__name__}")
@@ -293,10 +301,16 @@ def _body(data: Any, i: int, repair: bool) -> Body:
     except InvalidShapeError as exc:
         hint = "" if repair else " (--repair / repair=True may fix it)"
         raise InvalidSceneError(f"{exc}{hint}") from None
-    motion = Motion(
-        velocity=_vector(data.get("velocity", [0, 0]), f"{where}velocity"),
-        acceleration=_vector(data.get("acceleration", [0, 0]), f"{where}acceleration"),
-        angular_velocity=_angle(data, "angular_velocity", where),
-        angular_acceleration=_angle(data, "angular_acceleration", where),
-    )
+    velocity = _vector(data.get("velocity", [0, 0]), f"{where}velocity")
+    acceleration = _vector(data.get("acceleration", [0, 0]), f"{where}acceleration")
+    turn = _angle(data, "angular_velocity", where)
+    turn_rate = _angle(data, "angular_acceleration", where)
+    try:
+        motion = Motion(velocity, acceleration, turn, turn_rate)
+    except ValueError as exc:  # a number beyond the range the kernels take
+        raise InvalidSceneError(f"{where}{exc}") from None
+    try:
+        check_reach(shape, motion, t_max, f"{where[:-1]} ({name!r})")
+    except ValueError as exc:  # its motion would overflow float64 within t_max
+        raise InvalidSceneError(str(exc)) from None
     return Body(name, shape, motion)

@@ -15,14 +15,16 @@ and with repeated or closing points counted; :meth:`Shape.input_vertex`,
 
 from __future__ import annotations
 
-import json
+import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from ._checks import is_real
+from ._checks import finite_number, is_real, point, real_array, shown
+from ._json import load_json
 from .errors import InvalidShapeError
+from .motion import Motion
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,
@@ -45,42 +47,20 @@ def _signed_area(ring: np.ndarray) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
-def _real_array(ring: ArrayLike, what: str) -> np.ndarray:
-    """``ring`` as a new float64 array, if it holds real numbers only.
-
-    Integers and floats are converted; strings, booleans, complex numbers and other
-    objects raise ``TypeError`` naming ``what`` and the type given (a string such as
-    ``"1.5"`` is not silently parsed, an imaginary part not silently dropped).
-    """
+def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
+    """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
     if isinstance(ring, (str, bytes)):
         raise TypeError(f"{what}: expected an array of real numbers, got {type(ring).__name__}")
     try:
-        arr = np.asarray(ring)
-    except (TypeError, ValueError) as exc:
-        raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
-    kind = arr.dtype.kind
-    if isinstance(ring, (list, tuple)) and kind in "iu":  # NumPy made ints of any bools
-        for row in ring:
-            for x in row if isinstance(row, (list, tuple)) else ():
-                if isinstance(x, (bool, np.bool_)):
-                    raise TypeError(f"{what}: expected real numbers, got an element of type bool")
-    if kind == "O":
-        for x in arr.ravel():
-            if not is_real(x):
-                raise TypeError(
-                    f"{what}: expected real numbers, got an element of type {type(x).__name__}"
-                )
-    elif kind not in "fiu":
-        raise TypeError(f"{what}: expected real numbers, got an array of dtype {arr.dtype}")
-    try:
-        return np.array(arr, dtype=np.float64)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise InvalidShapeError(f"{what}: coordinates are not numbers ({exc})") from None
-
-
-def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
-    """Float64 (N, 2) copy of a ring: closing point and consecutive repeats dropped."""
-    arr = _real_array(ring, what)
+        arr = real_array(ring, what, InvalidShapeError)
+    except TypeError:
+        where = _first_unreal(ring)
+        if where is None:
+            raise
+        i, x = where
+        value = x.item() if isinstance(x, np.generic) else x  # 0j, not np.complex128(0j)
+        raise TypeError(f"{what}: vertex {i}: expected real numbers, got {shown(value)} "
+                        f"({type(x).__name__})") from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidShapeError(
             f"{what}: expected an array of shape (N, 2), got shape {arr.shape}"
@@ -106,6 +86,147 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
+def _whole_body(obj: Any) -> bool:
+    """Whether ``obj`` is a body in a form other than an array of vertices: a Shape, a
+    Shapely geometry, anything with ``__geo_interface__``, a mapping, text or WKB."""
+    return (isinstance(obj, (Shape, str, bytes, bytearray, memoryview, Mapping))
+            or hasattr(obj, "__geo_interface__") or hasattr(obj, "geom_type"))
+
+
+def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
+    """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
+    through :func:`as_shape`; such a body carries its own holes."""
+    if len(list(holes)):
+        raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
+                        "holes only with an array of vertices")
+    return as_shape(obj, "vertices", repair=repair)
+
+
+#: The forms a body may take, as error messages list them.
+BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+
+_BODY_KEYS = {"vertices", "holes", "name"}
+_HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
+
+
+def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever accepted form it takes (the forms
+    :mod:`polycontact.bodies` lists; offered to the package from there).
+
+    Parameters
+    ----------
+    obj : body
+        One of the forms listed in :mod:`polycontact.bodies`.
+    what : str
+        The argument's name, put at the start of every error message.
+    repair : bool, default False
+        Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
+
+    Returns
+    -------
+    Shape
+        ``obj`` itself when it is already a Shape.
+
+    Raises
+    ------
+    TypeError
+        ``obj`` is of no accepted type.
+    InvalidShapeError
+        ``obj`` is of an accepted type but not a valid polygon.
+    """
+    if isinstance(obj, Shape):
+        return obj
+    try:
+        return _coerce(obj, repair)
+    except InvalidShapeError as exc:
+        raise InvalidShapeError(f"{what}: {exc}") from None
+    except TypeError as exc:
+        raise TypeError(f"{what}: {exc}") from None
+
+
+def _coerce(obj: Any, repair: bool) -> Shape:
+    if isinstance(obj, (bytes, bytearray, memoryview)):
+        return Shape.from_shapely(_from_wkb(bytes(obj)), repair=repair)
+    if isinstance(obj, str):
+        return _from_text(obj, repair)
+    if hasattr(obj, "geom_type") and hasattr(obj, "wkb"):  # a shapely geometry
+        return Shape.from_shapely(obj, repair=repair)
+    if isinstance(obj, Mapping):
+        return _from_mapping(obj, repair)
+    geo = getattr(obj, "__geo_interface__", None)
+    if isinstance(geo, Mapping):
+        return _from_mapping(geo, repair)
+    if isinstance(obj, (np.ndarray, list, tuple)):
+        return Shape(obj, repair=repair)
+    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+
+
+def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
+    if "vertices" in data:
+        unknown = sorted(set(data) - _BODY_KEYS)
+        if unknown:
+            raise InvalidShapeError(
+                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
+            )
+        holes = data.get("holes", ())
+        if holes is None or isinstance(holes, (str, bytes, Mapping)):
+            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+        return Shape(data["vertices"], holes, repair=repair)
+    if "type" in data:
+        return Shape.from_geojson(dict(data), repair=repair)
+    raise InvalidShapeError(
+        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        f"got keys {sorted(map(str, data))}"
+    )
+
+
+def _from_text(text: str, repair: bool) -> Shape:
+    stripped = text.strip()
+    if not stripped:
+        raise InvalidShapeError("empty text: no body in it")
+    if stripped.startswith(("{", "[")):
+        try:
+            data = load_json(text)
+        except ValueError as exc:
+            raise InvalidShapeError(f"not valid JSON ({exc})") from None
+        if isinstance(data, list):  # the vertices alone: [[x, y], ...]
+            return Shape(data, repair=repair)
+        if not isinstance(data, Mapping):
+            raise InvalidShapeError("JSON text: expected an object or a list of vertices")
+        return _from_mapping(data, repair)
+    if _HEX.fullmatch(stripped):  # hex WKB, as shapely's ``wkb_hex``
+        return Shape.from_shapely(_from_wkb(bytes.fromhex(stripped)), repair=repair)
+    return Shape.from_wkt(text, repair=repair)
+
+
+def _from_wkb(data: bytes) -> Any:
+    import shapely
+
+    if not data:
+        raise InvalidShapeError("empty WKB: no body in it")
+    try:
+        return shapely.from_wkb(data)
+    except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
+        raise InvalidShapeError(f"not valid WKB ({exc})") from None
+
+
+def _first_unreal(ring: ArrayLike) -> tuple[int, Any] | None:
+    """``(vertex, coordinate)``: the first coordinate of ``ring`` that is not a real number
+    (a string, a bool, a complex number, None...); None if no vertex holds one (for the
+    message of a ring refused for its type)."""
+    if not isinstance(ring, (list, tuple, np.ndarray)):  # (a set or a mapping has no order)
+        return None
+    for i, row in enumerate(ring):
+        if isinstance(row, (str, bytes)) or not hasattr(row, "__iter__"):
+            if not is_real(row):
+                return i, row
+            continue
+        for x in row:
+            if not is_real(x):
+                return i, x
+    return None
+
+
 def _loop_name(k: int) -> str:
     return "outer loop" if k == 0 else f"hole {k - 1}"
 
@@ -115,10 +236,14 @@ class Shape:
 
     Parameters
     ----------
-    vertices : array_like of shape (N, 2)
-        The outer loop, closed or not, in either orientation.
-    holes : sequence of array_like of shape (M, 2)
-        Hole loops, closed or not, in either orientation.
+    vertices : array_like of shape (N, 2), or a whole body
+        The outer loop, closed or not, in either orientation. Or a body in any other
+        form polycontact takes (:mod:`polycontact.bodies`), holes included: a Shape, a
+        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or body
+        mapping ``{"vertices": ..., "holes": ...}``, WKT or JSON text, WKB.
+    holes : sequence of array_like of shape (M, 2), optional
+        Hole loops, closed or not, in either orientation (None or empty: no holes).
+        Only with an array of vertices: the other forms carry their own holes.
     repair : bool, default False
         If the loops are invalid, try ``shapely.make_valid`` and keep the result when it
         is a single polygon; :attr:`repairs` then says what changed. Indices still
@@ -136,9 +261,9 @@ class Shape:
         shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
         message then says which, how far apart, and the float spacing.
     TypeError
-        Coordinates that are not real numbers (strings, booleans, complex numbers), or
-        a body in another form (a Shapely polygon, a mapping, text): pass those to
-        :func:`polycontact.bodies.as_shape`, which takes every form.
+        Coordinates that are not real numbers (strings, booleans, complex numbers: the
+        message names the loop and the vertex), or ``holes`` with a body that carries
+        its own.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
 
@@ -147,6 +272,9 @@ class Shape:
     >>> sq = Shape([(0, 0), (0, 2), (2, 2), (2, 0)])    # clockwise: stored reversed
     >>> sq.area, sq.centroid.tolist(), sq.exterior[1].tolist()
     (4.0, [1.0, 1.0], [2.0, 2.0])
+    >>> import shapely
+    >>> Shape(shapely.box(0, 0, 2, 2)).area, Shape("POLYGON ((0 0, 2 0, 0 2, 0 0))").area
+    (4.0, 2.0)
     >>> Shape([(0, 0), (2, 2), (2, 0), (0, 2)])
     Traceback (most recent call last):
     ...
@@ -167,14 +295,14 @@ class Shape:
         raise AttributeError(f"Shape is immutable: cannot delete {name!r}")
 
     def __init__(
-        self, vertices: ArrayLike, holes: Sequence[ArrayLike] = (), *, repair: bool = False
+        self, vertices: ArrayLike, holes: Sequence[ArrayLike] | None = (), *,
+        repair: bool = False
     ) -> None:
-        if isinstance(vertices, (str, bytes, Mapping)) or hasattr(vertices, "__geo_interface__"):
-            raise TypeError(
-                f"vertices: expected an (N, 2) array-like, got {type(vertices).__name__}; "
-                "polycontact.bodies.as_shape takes every form of a body (Shape, Shapely, "
-                "GeoJSON, body mapping, WKT, WKB)"
-            )
+        if holes is None:
+            holes = ()
+        if _whole_body(vertices):
+            self._adopt(_other_form(vertices, holes, repair))
+            return
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
             raise InvalidShapeError(
                 "holes: expected a sequence of (M, 2) loops, got a single (M, 2) array; "
@@ -184,7 +312,7 @@ class Shape:
             loops = [_clean_ring(vertices, "outer loop")]
             loops += [_clean_ring(h, f"hole {i}") for i, h in enumerate(holes)]
             given = list(loops)
-            self._init_from_loops(loops, repairs=())
+            self._init_from_loops(loops, repairs=(), rings=[vertices, *holes])
         except InvalidShapeError as exc:
             if not repair:
                 raise
@@ -193,6 +321,12 @@ class Shape:
         self._input = _input_maps([vertices, *holes], given, self._loops)
 
     # -- construction -------------------------------------------------------------
+    def _adopt(self, other: Shape) -> None:
+        """Take the state of ``other`` (immutable, so its arrays are shared)."""
+        for name in Shape.__slots__:
+            if _bound(other, name):
+                object.__setattr__(self, name, object.__getattribute__(other, name))
+
     @classmethod
     def _trusted(
         cls,
@@ -244,6 +378,13 @@ class Shape:
             nxt[s:e] = np.roll(np.arange(s, e), -1)
         cross = x * y[nxt] - x[nxt] * y
         a2 = float(cross.sum())
+        if not (a2 > 0.0 and extent > validation_tolerance(magnitude)):
+            # (a rigid motion far from the origin rounded the body away)
+            raise InvalidShapeError(
+                f"shape: coordinates up to {magnitude:g} cannot carry a body of size "
+                f"{extent:g}: float64's spacing there ({validation_tolerance(magnitude):.3g}) "
+                "is not below it"
+            )
         self._area = 0.5 * a2
         self._centroid = np.array(
             [origin[0] + float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
@@ -261,7 +402,10 @@ class Shape:
         self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
         self.repairs = repairs
 
-    def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...]) -> None:
+    def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],
+                         rings: Sequence[ArrayLike] | None = None) -> None:
+        # ``rings``: the loops as the caller passed them (messages use their numbering);
+        # None when ``loops`` are already in the numbering to report
         # Features meet only when float64 cannot tell them apart: a length compared with
         # a few float spacings of the coordinates, an area with that length times the
         # loop's extent. Nothing depends on where the origin is or on the unit.
@@ -284,7 +428,7 @@ class Shape:
             if (k == 0) != (area > 0):
                 loops[k] = ring[::-1].copy()
         if len(loops) > 1:
-            _check_hole_placement(loops)
+            _check_hole_placement(loops, loops if rings is None else rings)
         self._set(loops, repairs)
 
     def _init_repaired(self, vertices: ArrayLike, holes: Sequence[ArrayLike], why: str) -> None:
@@ -430,24 +574,35 @@ class Shape:
     def moved(self, translation: ArrayLike = (0.0, 0.0), angle: float = 0.0) -> Shape:
         """This shape rotated by ``angle`` (radians, CCW) about its centroid, then translated.
 
+        ``translation`` is two real numbers and ``angle`` one, finite (strings, booleans
+        and complex numbers raise ``TypeError``, other bad values ``ValueError``, naming
+        the argument), and the moved coordinates must stay within ±1e100.
+
         Examples
         --------
         >>> Shape([(0, 0), (2, 0), (2, 2), (0, 2)]).moved((1, 0)).centroid.tolist()
         [2.0, 1.0]
         """
         c = self._centroid
-        t = np.asarray(translation, dtype=np.float64)
+        t = point(translation, "translation", error=InvalidShapeError)
+        angle = finite_number(angle, "angle")
         cs, sn = np.cos(angle), np.sin(angle)
         rot = np.array([[cs, sn], [-sn, cs]])  # row-vector form of R(angle)
         xy = (self._xy - c) @ rot + c + t
-        return Shape._trusted(
-            [xy[self._starts[k] : self._starts[k + 1]] for k in range(len(self._loops))],
-            self.repairs,
-            self._input,
-        )
+        try:
+            return Shape._trusted(
+                [xy[self._starts[k] : self._starts[k + 1]] for k in range(len(self._loops))],
+                self.repairs,
+                self._input,
+            )
+        except InvalidShapeError as exc:  # moved beyond the range of coordinates
+            raise InvalidShapeError(f"translation: the moved {exc}") from None
 
-    def at(self, motion: Any, t: float) -> Shape:
+    def at(self, motion: Motion, t: float) -> Shape:
         """The shape placed by ``motion`` at time ``t`` (see :class:`polycontact.Motion`)."""
+        if not isinstance(motion, Motion):
+            raise TypeError(f"motion: expected a polycontact.Motion, got "
+                            f"{type(motion).__name__}")
         translation, angle = motion.pose(t)
         return self.moved(translation, angle)
 
@@ -492,7 +647,10 @@ class Shape:
         try:
             geom = shapely.from_wkt(text)
         except Exception as exc:
-            raise InvalidShapeError(f"not valid WKT: {exc}") from None
+            reason = " ".join(str(exc).split())  # (GEOS quotes the text: cut it short)
+            raise InvalidShapeError(
+                f"not valid WKT: {reason if len(reason) <= 120 else reason[:117] + '...'}"
+            ) from None
         return cls.from_shapely(geom, repair=repair)
 
     def to_wkt(self) -> str:
@@ -504,8 +662,8 @@ class Shape:
         """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
         if isinstance(data, str):
             try:
-                data = json.loads(data)
-            except json.JSONDecodeError as exc:
+                data = load_json(data)
+            except ValueError as exc:
                 raise InvalidShapeError(f"not valid JSON: {exc}") from None
         if not isinstance(data, dict):
             raise InvalidShapeError("GeoJSON: expected an object")
@@ -529,6 +687,34 @@ class Shape:
         """The shape as a GeoJSON Polygon mapping with closed rings."""
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
+
+    def plot(self, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+        """Draw the shape (solid filled, holes open); returns the matplotlib Axes.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, imported only
+            here: ``pip install 'polycontact[plot]'``).
+        numbers : bool, default False
+            Write each vertex's number, as features report it (see
+            :func:`polycontact.plotting.plot_shape`).
+        **style
+            Passed to the matplotlib patch (``facecolor``, ``alpha``, ``label``...).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> ax = Shape([(0, 0), (2, 0), (2, 1), (0, 1)]).plot(numbers=True)
+        >>> ax.get_title(), len(ax.texts)
+        ('4 vertices, 0 holes, area 2', 4)
+        """
+        from .plotting.shape import plot_shape
+
+        return plot_shape(self, ax, numbers=numbers, **style)
 
     def __repr__(self) -> str:
         holes = f", {len(self.holes)} hole(s)" if self.holes else ""
@@ -731,8 +917,10 @@ def _collinear(ring: np.ndarray, eps: float) -> bool:
     return bool(np.all(np.abs(d[:, 0] * u[1] - d[:, 1] * u[0]) <= eps))
 
 
-def _check_hole_placement(loops: list[np.ndarray]) -> None:
-    """Loops no longer cross; holes must lie in the outer loop and not in each other."""
+def _check_hole_placement(loops: list[np.ndarray], rings: Sequence[ArrayLike]) -> None:
+    """Loops no longer cross; holes must lie in the outer loop and not in each other.
+    ``rings`` are the loops as the caller numbers them (a vertex is named by that
+    number)."""
     import shapely
 
     outer = shapely.Polygon(loops[0])
@@ -740,9 +928,13 @@ def _check_hole_placement(loops: list[np.ndarray]) -> None:
     inside = shapely.covers(outer, holes)
     if not inside.all():
         i = int(np.flatnonzero(~inside)[0])
-        p = loops[i + 1][0]
+        raw = np.asarray(rings[i + 1], dtype=np.float64).reshape(-1, 2)
+        out = np.flatnonzero(~shapely.covers(outer, shapely.points(raw)))
+        v = int(out[0]) if len(out) else 0
+        p = raw[v]
         raise InvalidShapeError(
-            f"hole {i} lies outside the outer loop (its vertex 0 is at ({_fmt(p[0])}, {_fmt(p[1])}))"
+            f"hole {i} lies outside the outer loop (its vertex {v} is at "
+            f"({_fmt(p[0])}, {_fmt(p[1])}))"
         )
     if len(holes) > 1:
         tree = shapely.STRtree(holes)

@@ -30,16 +30,17 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
 
-from ._checks import finite_number
+from ._checks import finite_number, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
-from .relation import Relation, classify
+from .relation import Relation, classify, raw_ring_inputs
 from .bodies import BodyLike, as_shape
 from .shape import Shape
 from .tolerances import RELATIVE_TOLERANCE, ROUNDING_FACTOR, check_range, default_tolerance
@@ -92,6 +93,9 @@ class WorldBody:
     angle: float
     motion: Motion | None = None
 
+    def __post_init__(self) -> None:
+        self.position.flags.writeable = False  # (the world's own record: read-only)
+
 
 @dataclass(frozen=True, eq=False)
 class Contacts:
@@ -124,6 +128,13 @@ class Contacts:
     _tolerance: float | None = field(repr=False)
     ids: np.ndarray = field(default_factory=lambda: np.empty(0, np.int64), repr=False)
     container: Shape | None = field(default=None, repr=False)
+    # each body's map to the caller's numbering (see World._inputs), by id
+    _inputs: dict[int, Any] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        for array in (self.pairs, self.states, self.tolerances, self.container_ids,
+                      self.container_states, self.ids):
+            array.flags.writeable = False  # a result cannot be changed
 
     def __len__(self) -> int:
         return len(self.states)
@@ -131,12 +142,13 @@ class Contacts:
     def relation(self, k: int) -> Relation:
         """The full :class:`~polycontact.Relation` of pair ``k`` (features, point,
         normal, depth), as :func:`polycontact.classify` gives it."""
+        k = _integer(k, "k")
         if not 0 <= k < len(self.states):
             raise IndexError(f"k: pair {k} out of range (0..{len(self.states) - 1})")
         i, j = (int(v) for v in self.pairs[k])
         xy, ls, lo, nl = self._store
-        a = _stored_shape(xy, ls, int(lo[i]), int(nl[i]))
-        b = _stored_shape(xy, ls, int(lo[j]), int(nl[j]))
+        a = _stored_shape(xy, ls, int(lo[i]), int(nl[i]), self._inputs.get(i))
+        b = _stored_shape(xy, ls, int(lo[j]), int(nl[j]), self._inputs.get(j))
         return classify(a, b, tolerance=self._tolerance)
 
     @property
@@ -146,10 +158,12 @@ class Contacts:
 
     def shape(self, id: int) -> Shape:
         """The Shape of body ``id`` as it was when the contacts were found."""
+        id = _integer(id, "id")
         _, _, lo, nl = self._store
         if id not in set(self.ids.tolist()):
             raise IndexError(f"id: no body {id} among the contacts' bodies")
-        return _stored_shape(self._store[0], self._store[1], int(lo[id]), int(nl[id]))
+        return _stored_shape(self._store[0], self._store[1], int(lo[id]), int(nl[id]),
+                             self._inputs.get(id))
 
     def to_dict(self, names: Any = None) -> dict[str, Any]:
         """The contacts as a JSON-ready dict: the object ``polycontact contacts --json``
@@ -228,6 +242,10 @@ class Query:
     container_state: int
     shape: Shape = field(repr=False)
 
+    def __post_init__(self) -> None:
+        self.ids.flags.writeable = False  # a result cannot be changed
+        self.states.flags.writeable = False
+
     @property
     def inside_container(self) -> bool:
         return self.container_state < 2
@@ -241,6 +259,14 @@ def _angle(angle: Any) -> float:
     return finite_number(angle, "angle")
 
 
+def _integer(value: Any, what: str) -> int:
+    """``value`` as an int, if it is an integer (Python or NumPy, not a bool), else a
+    TypeError naming ``what``: a float id is not rounded to a body."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what}: expected an integer, got {type(value).__name__} {value!r}")
+    return int(value)
+
+
 def _place(base: Shape, position: np.ndarray | None, angle: float, what: str) -> Shape:
     """``base`` turned by ``angle`` about its centroid, centroid moved to ``position``."""
     if position is None and angle == 0.0:
@@ -252,7 +278,8 @@ def _place(base: Shape, position: np.ndarray | None, angle: float, what: str) ->
     _k().place(xy, float(c[0]), float(c[1]), float(p[0]), float(p[1]), angle, out)
     check_range(out, what)
     return Shape._trusted(
-        [out[starts[k] : starts[k + 1]] for k in range(len(starts) - 1)], base.repairs
+        [out[starts[k] : starts[k + 1]] for k in range(len(starts) - 1)], base.repairs,
+        base._input,
     )
 
 
@@ -265,10 +292,15 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, ROUNDING_FACTOR * magnitude))
 
 
-def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int) -> Shape:
-    """The Shape of a body stored at loop-start row ``lo`` with ``nl`` loops (a copy)."""
+def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int,
+                  inputs: Any = None) -> Shape:
+    """The Shape of a body stored at loop-start row ``lo`` with ``nl`` loops (a copy),
+    numbered as the caller gave it: ``inputs`` is the body's entry of
+    ``World._inputs`` (None: the stored order is the caller's)."""
     st = ls[lo : lo + nl + 1]
-    return Shape._trusted([xy[st[k] : st[k + 1]].copy() for k in range(nl)])
+    if isinstance(inputs, int):  # a raw ring stored reversed, of that many vertices
+        inputs = raw_ring_inputs(inputs, -1.0)
+    return Shape._trusted([xy[st[k] : st[k + 1]].copy() for k in range(nl)], inputs=inputs)
 
 
 def _pow2(n: int) -> int:
@@ -299,6 +331,11 @@ class World:
         # id -> [name, base, position, angle, motion, shape]; base, position and shape
         # are None until asked for (bodies added by add_many are kept as coordinates).
         self._records: dict[int, list[Any]] = {}
+        # Each body's map to the caller's numbering, where the stored order is not the
+        # caller's: ``Shape._input`` of the shape as added, or the vertex count of a
+        # raw ring stored reversed (the map is made when asked for). Ids are never
+        # reused, so an entry stays right for the contacts found before a removal.
+        self._inputs: dict[int, Any] = {}
         self._shared = False  # a Contacts holds self._xy: copy it before writing in place
         self._next = 0
         cap = 64
@@ -382,12 +419,14 @@ class World:
 
     def body(self, id: int) -> WorldBody:
         """The body with this id (a read-only record)."""
+        id = _integer(id, "id")
         try:
             rec = self._records[id]
-        except (KeyError, TypeError):
+        except KeyError:
             raise KeyError(f"id: no body {id!r} in this world (never added, or removed)") from None
         if rec[5] is None:
-            rec[5] = _stored_shape(self._xy, self._ls, int(self._lo[id]), int(self._nl[id]))
+            rec[5] = _stored_shape(self._xy, self._ls, int(self._lo[id]), int(self._nl[id]),
+                                   self._inputs.get(id))
         if rec[1] is None:
             rec[1] = rec[5]
         if rec[2] is None:
@@ -423,6 +462,7 @@ class World:
         self._store_many(np.array([b]), [placed.packed])
         self._index(b)
         self._records[b] = [name, base, None if pos is None else pos.copy(), ang, motion, placed]
+        self._inputs[b] = base._input
         return b
 
     def add_many(self, shapes: Any, *, names: Any = None) -> np.ndarray:
@@ -451,9 +491,13 @@ class World:
         """
         from .relation import pack_bodies
 
-        xy, ls, bs, sign = pack_bodies(shapes, "shapes")
+        made: list[Any] = []
+        xy, ls, bs, sign = pack_bodies(shapes, "shapes", made)
         count = len(sign)
         if names is not None:
+            if isinstance(names, (str, bytes)) or not isinstance(names, (Sequence, np.ndarray)):
+                raise TypeError(f"names: expected a sequence of {count} strings, got "
+                                f"{type(names).__name__}")
             names = list(names)
             if len(names) != count or not all(isinstance(n, str) for n in names):
                 raise ValueError(f"names: expected {count} strings")
@@ -474,12 +518,17 @@ class World:
         for k, b in enumerate(ids.tolist()):
             self._records[b] = [None if names is None else names[k], None, None, 0.0, None,
                                 None]
+            if made[k] is not None:
+                self._inputs[b] = made[k]._input
+            elif sign[k] < 0:
+                self._inputs[b] = len(loops[k][0])
         self._index_many(ids)
         return ids
 
     def move(self, id: int, position: Any = None, angle: float | None = None) -> None:
         """Put body ``id`` at a new pose (None keeps the current position or angle); the
         pose applies to the shape as added."""
+        id = _integer(id, "id")
         rec = self.body(id)
         pos = rec.position if position is None else point_arg(position, "position")
         if self._shared:
@@ -498,6 +547,7 @@ class World:
 
     def remove(self, id: int) -> None:
         """Take body ``id`` out of the world."""
+        id = _integer(id, "id")
         self.body(id)
         self._unindex(id)
         lo, nl = self._lo[id], self._nl[id]
@@ -678,7 +728,8 @@ class World:
         self._shared = True
         store = (self._xy, self._ls, self._lo.copy(), self._nl.copy())
         return Contacts(pairs, states, used, c_ids, c_states, store,
-                        None if tolerance is None else tol, alive, self._container)
+                        None if tolerance is None else tol, alive, self._container,
+                        self._inputs)
 
     def query(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
@@ -716,7 +767,8 @@ class World:
         ----------
         shape : Shape, shapely Polygon or array_like of shape (N, 2)
         positions : array_like of shape (P, 2)
-            Where the shape's area centroid goes.
+            Where the shape's area centroid goes: real numbers (not strings, booleans
+            or complex numbers), finite and within ±1e100.
         angles : float or array_like of shape (P,)
             Radians, about the centroid.
 
@@ -725,18 +777,17 @@ class World:
         ndarray of shape (P,), int8
         """
         base = as_shape(shape, "shape")
-        pos = np.ascontiguousarray(positions, dtype=np.float64)
-        if pos.ndim != 2 or pos.shape[1] != 2:
-            raise ValueError(f"positions: expected an array of shape (P, 2), got {pos.shape}")
-        if np.ndim(angles) == 0:
+        pos = points(positions, "positions")
+        if np.ndim(angles) == 0 and not isinstance(angles, (str, bytes)):
             ang = np.full(len(pos), _angle(angles))
         else:
-            ang = np.ascontiguousarray(angles, dtype=np.float64)
+            ang = real_array(angles, "angles")
             if ang.shape != (len(pos),):
                 raise ValueError(f"angles: expected a number or {len(pos)} numbers, got "
                                  f"shape {ang.shape}")
-        if not (np.isfinite(pos).all() and np.isfinite(ang).all()):
-            raise ValueError("positions, angles: expected finite numbers")
+            if not np.isfinite(ang).all():
+                k = int(np.flatnonzero(~np.isfinite(ang))[0])
+                raise ValueError(f"angles[{k}]: expected a finite number, got {ang[k]!r}")
         tol = self._tol(tolerance)
         sxy, ss = base.packed
         c = base.centroid
@@ -795,6 +846,34 @@ class World:
         ids = sorted(self._records)
         bodies = [self.body(k) for k in ids]
         return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
+
+    def plot(self, ax: Any = None, *, labels: bool | None = None) -> Any:
+        """Draw the bodies where they stand, with their ids, and the container; returns
+        the matplotlib Axes. ``world.contacts().plot()`` draws the contacts too.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (matplotlib is needed, imported only
+            here: ``pip install 'polycontact[plot]'``).
+        labels : bool, optional
+            Write each body's id (and name) at its centroid; by default for up to 100
+            bodies (see :func:`polycontact.plotting.plot_world`).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)], name="plate")
+        >>> w.plot().get_title()
+        '1 body'
+        """
+        from .plotting.world import plot_world
+
+        return plot_world(self, ax, labels=labels)
 
     def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in

@@ -13,8 +13,11 @@ from D, D' = dv + 2 h t and D'' = 2 h, in coordinates relative to the bodies (f 
 through the sign of |D| − R). Expanded coefficients lose everything at long travel or
 far from the origin (|d0|² = 1e18 swallows R² = 2 when d0 = 1e9); these evaluations
 keep each root to the float spacing of the positions, and the radius is widened by a
-bound of that rounding (:func:`rounding_allowance`), so the intervals are never too
-short. The roots are polished by bisection to adjacent floats.
+bound of that rounding at each time (:func:`rounding_allowance`), so the intervals are
+never too short. The widening is local to the time: R(t) = R0 + R1 t + R2 t² grows as
+the positions' terms do (f stays a polynomial of degree at most 4), never by the
+rounding at ``t_max`` (a window of 1e27 would otherwise widen the circles by 1e12 from
+t = 0 on). The roots are polished by bisection to adjacent floats.
 """
 
 from __future__ import annotations
@@ -31,57 +34,64 @@ WORK_POINTS = 6
 MAX_INTERVALS = 3
 #: Scratch floats of :func:`overlap_intervals_into`: the motion ``p`` and two levels of
 #: breakpoints.
-BROAD_PHASE_FLOATS = 6 + 2 * WORK_POINTS
+BROAD_PHASE_FLOATS = 8 + 2 * WORK_POINTS
 
 
 @njit(cache=True, nogil=True)
 def relative_motion(ca, ma, cb, mb):
-    """``p`` of shape (3, 2): rows d0, dv, h of D(t) = d0 + dv t + h t², the centroid of
-    A relative to B's (``ma``, ``mb``: motion vectors ``[vx, vy, ax, ay, ω, α]``)."""
-    return _relative_motion_into(ca, ma, cb, mb, np.empty((3, 2)))
+    """``p`` of shape (4, 2): rows d0, dv, h of D(t) = d0 + dv t + h t², the centroid of
+    A relative to B's (``ma``, ``mb``: motion vectors ``[vx, vy, ax, ay, ω, α]``), and
+    the growth ``(R1, R2)`` of the radius R(t) = r + R1 t + R2 t² (zero here: a fixed
+    radius; :func:`overlap_intervals_into` sets it)."""
+    return _relative_motion_into(ca, ma, cb, mb, np.empty((4, 2)))
 
 
 @njit(cache=True, nogil=True)
 def _relative_motion_into(ca, ma, cb, mb, p):
-    """:func:`relative_motion` written into ``p`` (3, 2); returns ``p``."""
+    """:func:`relative_motion` written into ``p`` (4, 2); returns ``p``."""
     for k in range(2):
         p[0, k] = ca[k] - cb[k]
         p[1, k] = ma[k] - mb[k]
         p[2, k] = 0.5 * (ma[2 + k] - mb[2 + k])
+        p[3, k] = 0.0
     return p
 
 
 @njit(cache=True, nogil=True)
 def degree(p):
-    """Degree of f = |D|² − R²: 4 with relative acceleration, 2 with relative velocity
-    only, else 0."""
-    if p[2, 0] != 0.0 or p[2, 1] != 0.0:
+    """Degree of f = |D|² − R²: 4 with relative acceleration (or a radius growing with
+    t²), 2 with relative velocity only (or a radius growing with t), else 0."""
+    if p[2, 0] != 0.0 or p[2, 1] != 0.0 or p[3, 1] != 0.0:
         return 4
-    if p[1, 0] != 0.0 or p[1, 1] != 0.0:
+    if p[1, 0] != 0.0 or p[1, 1] != 0.0 or p[3, 0] != 0.0:
         return 2
     return 0
 
 
 @njit(cache=True, nogil=True)
 def derivative(p, r, k, t):
-    """The k-th derivative of f(t) = |D(t)|² − r² at t for k >= 1, evaluated from D and
-    its derivatives (no expanded coefficients); for k = 0, |D(t)| − r, which has the
-    sign of f and is monotone where f is."""
+    """The k-th derivative of f(t) = |D(t)|² − R(t)² at t for k >= 1, R(t) = r + R1 t +
+    R2 t² (``(R1, R2)`` = ``p[3]``), evaluated from D, R and their derivatives (no
+    expanded coefficients); for k = 0, |D(t)| − R(t), which has the sign of f (R >= 0
+    for t >= 0)."""
     dx = p[0, 0] + (p[1, 0] + p[2, 0] * t) * t
     dy = p[0, 1] + (p[1, 1] + p[2, 1] * t) * t
     d1x = p[1, 0] + 2.0 * p[2, 0] * t
     d1y = p[1, 1] + 2.0 * p[2, 1] * t
     d2x = 2.0 * p[2, 0]
     d2y = 2.0 * p[2, 1]
+    rho = r + (p[3, 0] + p[3, 1] * t) * t
+    rho1 = p[3, 0] + 2.0 * p[3, 1] * t
+    rho2 = 2.0 * p[3, 1]
     if k == 0:
-        return np.hypot(dx, dy) - r
+        return np.hypot(dx, dy) - rho
     if k == 1:
-        return 2.0 * (dx * d1x + dy * d1y)
+        return 2.0 * (dx * d1x + dy * d1y - rho * rho1)
     if k == 2:
-        return 2.0 * (d1x * d1x + d1y * d1y + dx * d2x + dy * d2y)
+        return 2.0 * (d1x * d1x + d1y * d1y + dx * d2x + dy * d2y - rho1 * rho1 - rho * rho2)
     if k == 3:
-        return 6.0 * (d1x * d2x + d1y * d2y)
-    return 6.0 * (d2x * d2x + d2y * d2y)
+        return 6.0 * (d1x * d2x + d1y * d2y - rho1 * rho2)
+    return 6.0 * (d2x * d2x + d2y * d2y - rho2 * rho2)
 
 
 @njit(cache=True, nogil=True)
@@ -123,16 +133,17 @@ def _bisect(p, r, k, a, b, fa):
 
 
 @njit(cache=True, nogil=True)
-def monotone_breakpoints(p, lo, hi):
+def monotone_breakpoints(p, lo, hi, r=0.0):
     """Sorted points from lo to hi between which f = |D|² − R² is monotone (``p`` from
-    :func:`relative_motion`)."""
+    :func:`relative_motion`; ``r`` the radius at t = 0, which matters only when the
+    radius grows)."""
     work = np.empty(2 * WORK_POINTS)
-    n = _breakpoints_into(p, lo, hi, work)
+    n = _breakpoints_into(p, r, lo, hi, work)
     return work[:n].copy()
 
 
 @njit(cache=True, nogil=True)
-def _breakpoints_into(p, lo, hi, work):
+def _breakpoints_into(p, r, lo, hi, work):
     """:func:`monotone_breakpoints` in ``work[:n]``; returns n. ``work``: at least
     2 :data:`WORK_POINTS` floats (the points of two levels, in turn)."""
     deg = degree(p)
@@ -149,12 +160,12 @@ def _breakpoints_into(p, lo, hi, work):
         for s in range(npts - 1):
             a = pts[s]
             b = pts[s + 1]
-            fa = derivative(p, 0.0, k, a)
-            fb = derivative(p, 0.0, k, b)
+            fa = derivative(p, r, k, a)
+            fb = derivative(p, r, k, b)
             if fa == 0.0:
                 x = a
             elif fb == 0.0 or (fa < 0.0) != (fb < 0.0):
-                x = b if fb == 0.0 else _bisect(p, 0.0, k, a, b, fa)
+                x = b if fb == 0.0 else _bisect(p, r, k, a, b, fa)
             else:
                 continue
             if lo < x < hi and x > new[nn - 1]:
@@ -182,7 +193,7 @@ def nonpositive_intervals(p, r, lo, hi):
 def _intervals_into(p, r, lo, hi, out, work):
     """:func:`nonpositive_intervals` in ``out[:n]`` ((:data:`MAX_INTERVALS`, 2)); returns
     n. ``work``: scratch of :func:`_breakpoints_into`."""
-    npts = _breakpoints_into(p, lo, hi, work)
+    npts = _breakpoints_into(p, r, lo, hi, work)
     n = 0
     for s in range(npts - 1):
         a = work[s]
@@ -209,14 +220,15 @@ def _intervals_into(p, r, lo, hi, out, work):
 
 
 @njit(cache=True, nogil=True)
-def rounding_allowance(ca, ma, cb, mb, t_max):
-    """A bound of the rounding in the centroids and in D(t) over [0, t_max]: 16 units of
-    2**-52 of the largest |term| of c_A(t) and c_B(t) (initial position, travel at the
-    initial speed, travel by the acceleration)."""
+def rounding_allowance(ca, ma, cb, mb, t):
+    """A bound of the rounding in the centroids and in D at time t: 16 units of 2**-52
+    of the largest |term| of c_A(t) and c_B(t) (initial position, travel at the initial
+    speed, travel by the acceleration). It grows with t, so its value at the end of a
+    window bounds it over the window."""
     big = 0.0
     for c, m in ((ca, ma), (cb, mb)):
         for k in range(2):
-            big += abs(c[k]) + abs(m[k]) * t_max + 0.5 * abs(m[2 + k]) * t_max * t_max
+            big += abs(c[k]) + abs(m[k]) * t + 0.5 * abs(m[2 + k]) * t * t
     return 16.0 * _ULP * big
 
 
@@ -224,8 +236,9 @@ def rounding_allowance(ca, ma, cb, mb, t_max):
 def overlap_intervals(ca, ma, ra, cb, mb, rb, t_max, inflate):
     """Closed sub-intervals of [0, t_max] where the bounding circles touch or overlap,
     the sum of their radii R enlarged by ``inflate`` (relative), or by the rounding of
-    the positions (:func:`rounding_allowance`) where that is larger (far from the
-    origin, at long travel), so that no instant of overlap is dropped."""
+    the positions at each time (:func:`rounding_allowance` at t, not at t_max) where
+    that is larger (far from the origin, at long travel), so that no instant of overlap
+    is dropped."""
     out = np.empty((MAX_INTERVALS, 2))
     n = overlap_intervals_into(ca, ma, ra, cb, mb, rb, t_max, inflate, out,
                                np.empty(BROAD_PHASE_FLOATS))
@@ -238,6 +251,16 @@ def overlap_intervals_into(ca, ma, ra, cb, mb, rb, t_max, inflate, out, work):
     returns n. ``work``: :data:`BROAD_PHASE_FLOATS` floats of scratch. Nothing is
     allocated (for callers that query many times)."""
     big = ra + rb
-    r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, t_max))
-    p = _relative_motion_into(ca, ma, cb, mb, work[:6].reshape(3, 2))
-    return _intervals_into(p, r, 0.0, t_max, out, work[6:])
+    r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, 0.0))
+    p = _relative_motion_into(ca, ma, cb, mb, work[:8].reshape(4, 2))
+    if big + rounding_allowance(ca, ma, cb, mb, t_max) > r:
+        # the radius grows with the terms of the positions, as the allowance at t does:
+        # R(t) = r + R1 t + R2 t² >= big + the allowance at t, whatever t_max is
+        grow1 = 0.0
+        grow2 = 0.0
+        for k in range(2):
+            grow1 += abs(ma[k]) + abs(mb[k])
+            grow2 += 0.5 * (abs(ma[2 + k]) + abs(mb[2 + k]))
+        p[3, 0] = 16.0 * _ULP * grow1
+        p[3, 1] = 16.0 * _ULP * grow2
+    return _intervals_into(p, r, 0.0, t_max, out, work[8:])

@@ -100,6 +100,32 @@ def local_tolerances(ca, ma, la, cb, mb, lb, t0, t1, eps_rel, ulps, lam0):
 
 
 @njit(cache=True, nogil=True)
+def local_end(ca, ma, la, cb, mb, lb, t):
+    """The end of the longest window from t over which :func:`local_tolerances` stays
+    local to t: no body's :func:`_reach` grows by more than M, the larger reach of the
+    two at t, so the distance tolerance over the window is at most twice its value at
+    t (t >= 0). Each |term| of a coordinate grows over [t, t + w] by at most
+    (|v| + |a| t) w + |a| w²/2 per component. The window spans at least a fixed
+    fraction of t (M includes the travel |v| t + |a| t²/2), so windows that keep doubling
+    cross any length in a number of steps logarithmic in it.
+
+    >>> import numpy as np
+    >>> m = np.array([1.0, 0, 0, 0, 0, 0])
+    >>> local_end(np.zeros(2), m, 1.0, np.array([3.0, 0]), np.zeros(6), 1.0, 0.0)
+    4.0
+    """
+    mag = max(_reach(ca, ma, la, t, t), _reach(cb, mb, lb, t, t))
+    w = np.inf
+    for m in (ma, mb):
+        for k in range(2):
+            acc = abs(m[2 + k])
+            lin = abs(m[k]) + acc * t
+            if lin > 0.0 or acc > 0.0:
+                w = min(w, 2.0 * mag / (lin + np.sqrt(lin * lin + 2.0 * acc * mag)))
+    return t + w
+
+
+@njit(cache=True, nogil=True)
 def centre(c0, m, t):
     """The centroid ``(cx, cy)`` at time t of a body whose centroid is ``c0`` at t = 0."""
     return c0[0] + m[0] * t + 0.5 * m[2] * t * t, c0[1] + m[1] * t + 0.5 * m[3] * t * t
@@ -271,7 +297,7 @@ def work_floats(size):
     :func:`_work_views`).
 
     >>> work_floats(16)
-    921
+    923
     """
     return (2 * MAX_INTERVALS + BROAD_PHASE_FLOATS + 4 + 3 * STACK_SIZE + 4 + 2 * size
             + scratch_floats(size))
@@ -326,10 +352,13 @@ def exact_search(a, ma, b, mb, intervals, search):
     penetration begins before ``t_lo``); ``first_contact`` is the first visited time
     with boundary distance <= the contact resolution (−1 if none); ``t_reached`` is
     how far the search got.
+
     The distance tolerance and the contact resolution are local (:func:`local_tolerances`
-    from ``eps_rel``, ``ulps`` and ``lam``, the resolution asked for); the resolution
-    also covers the float spacing of t: a probe moves t by at least a float, so λ is at
-    least S · ``TIME_ULPS`` · 2**-52 |t|.
+    from ``eps_rel``, ``ulps`` and ``lam``, the resolution asked for, over windows that
+    end where the reach at most doubles, :func:`local_end`, whatever the length of the
+    broad-phase interval: a window as long as ``t_max`` would scale them by it); the
+    resolution also covers the float spacing of t: a probe moves t by at least a float,
+    so λ is at least S · ``TIME_ULPS`` · 2**-52 |t|.
 
     Invariant: no penetration has been skipped before ``t`` (see
     :func:`polycontact.time_of_impact` for the argument). From a non-penetrating time
@@ -412,7 +441,8 @@ def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
             it += 1
             if it > max_iter:
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
-            t_end = min(t2, t + window)
+            # (never past where the tolerances would stop being those of t)
+            t_end = min(t2, t + window, local_end(ca, ma, la, cb, mb, lb, t))
             s = speed_bound(ma, la, mb, lb, t, t_end)
             tol = effective_time_tolerance(time_tol, t)
             # tolerances local to the window; a probe moves t by at least a float, which

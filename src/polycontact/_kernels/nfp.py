@@ -16,7 +16,8 @@ from numba import njit
 from .decompose import ring_pieces
 from .fits import degenerate_contacts, exact_candidates
 from .minkowski import boxes, convex_sums, frames
-from .outline import assemble_rings, closed_loops, edge_cover, ring_stats
+from .outline import (assemble_rings, closed_loops, edge_cover, ring_stats, tidy_rings,
+                      without_collinear)
 from .tolerance import tolerance_of
 
 
@@ -60,15 +61,17 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
         eps = tolerance_of(sums, rel_tol, ulps)
     meta = np.array([eps, 1.0, 0.0])
     if starts.shape[0] == 2:
-        rs = np.array([0, sums.shape[0]], np.int64)
-        area, length = ring_stats(sums, rs)
-        ring_xy, ring_starts = closed_loops(sums, rs)
+        # one sum: its vertices are the sums' (nothing to snap)
+        ring_xy, rs = without_collinear(sums, np.array([0, sums.shape[0]], np.int64), eps)
+        area, length = ring_stats(ring_xy, rs)
+        ring_xy, ring_starts = closed_loops(ring_xy, rs)
         return (sums, starts, ring_xy, ring_starts, np.column_stack((area, length)),
                 np.empty((0, 4)), meta)
     bb = boxes(sums, starts)
     fr = frames(sums, starts)
     outline, loose = edge_cover(sums, starts, bb, fr, eps)
     ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
+    ring_xy, ring_starts = tidy_rings(ring_xy, ring_starts, sums, eps)
     area, length = ring_stats(ring_xy, ring_starts)
     pts, segs = degenerate_contacts(sums, starts, bb, fr, loose, eps, ang_tol)
     cand = np.empty((pts.shape[0] + segs.shape[0], 4))

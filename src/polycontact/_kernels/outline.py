@@ -3,7 +3,9 @@ their edges.
 
 :func:`edge_cover` keeps the parts of the sums' edges that lie in no other sum (the
 outline, once each) and those in no other open sum shrunk by eps (where exact fits and
-slides lie); :func:`assemble_rings` links the outline's parts into closed rings.
+slides lie); :func:`assemble_rings` links the outline's parts into closed rings;
+:func:`tidy_rings` snaps their coordinates to the sums' and drops the vertices that
+change nothing.
 """
 
 from __future__ import annotations
@@ -12,7 +14,11 @@ import numpy as np
 from numba import njit
 
 from .minkowski import GRID, clip_edge, sum_index
-from .primitives import append_part
+from .primitives import append_part, closest_on_segment
+
+#: Outline coordinates within this many units of 2**-52 of the sums' largest
+#: |coordinate| of a sum vertex's coordinate are that coordinate (see :func:`tidy_rings`).
+SNAP_ULPS = 4.0
 
 
 @njit(cache=True, nogil=True)
@@ -243,3 +249,165 @@ def closed_loops(xy, starts):
         w += 1
         st[k + 1] = w
     return out, st
+
+
+@njit(cache=True, nogil=True)
+def tidy_rings(xy, starts, sums, eps):
+    """The outline's rings as they are reported: ``(xy, starts)``, open rings.
+
+    - A coordinate within the rounding of a sum vertex's coordinate on the same axis
+      (:data:`SNAP_ULPS` units of 2**-52 of the sums' largest |coordinate|) is that
+      coordinate (:func:`_snap_to_sums`, in place): a crossing computed as -2.2e-16 on
+      the line x = 0 is 0.
+    - A vertex within ``eps`` of the segment joining the vertices kept before and after
+      it (one that changes nothing) is dropped (:func:`without_collinear`).
+
+    >>> import numpy as np
+    >>> ring = np.array([[-1.5, -1.5], [-2.220446049250313e-16, -1.5], [3.0, -1.5],
+    ...                  [3.0, 4.0], [1.5, 4.0], [-1.5, 4.0]])
+    >>> xy, st = tidy_rings(ring.copy(), np.array([0, 6]), ring, 1e-12)
+    >>> xy.tolist(), st.tolist()
+    ([[-1.5, -1.5], [3.0, -1.5], [3.0, 4.0], [-1.5, 4.0]], [0, 4])
+    """
+    _snap_to_sums(xy, sums)
+    return without_collinear(xy, starts, eps)
+
+
+@njit(cache=True, nogil=True)
+def _snap_to_sums(xy, sums):
+    """Each coordinate of ``xy`` (in place) within :data:`SNAP_ULPS` units of 2**-52 of
+    the sums' largest |coordinate| of a coordinate of a sum vertex on the same axis
+    becomes the nearest such. Few vertices against few sums (the common case) are
+    compared directly; more against the sorted coordinates."""
+    if xy.shape[0] == 0:
+        return
+    mag = 0.0
+    for i in range(sums.shape[0]):
+        mag = max(mag, abs(sums[i, 0]), abs(sums[i, 1]))
+    near = SNAP_ULPS * 2.0**-52 * mag
+    direct = xy.shape[0] * sums.shape[0] <= 4096
+    for c in range(2):
+        values = sums[:, c] if direct else np.sort(sums[:, c])
+        for i in range(xy.shape[0]):
+            v = xy[i, c]
+            best = v
+            gap = near  # the nearest within it
+            lo, hi = 0, values.shape[0]
+            if not direct:
+                k = np.searchsorted(values, v)
+                lo, hi = max(k - 1, 0), min(k + 1, values.shape[0])
+            for m in range(lo, hi):
+                d = abs(values[m] - v)
+                if d <= gap:
+                    best = values[m]
+                    gap = d
+                    if d == 0.0:
+                        break  # (a sum vertex's own coordinate, the common case)
+            xy[i, c] = best
+
+
+@njit(cache=True, nogil=True)
+def without_collinear(xy, starts, eps):
+    """``(xy, starts)`` of the rings (open) without the vertices that lie within ``eps``
+    of the segment joining the vertices kept before and after them: every dropped vertex
+    stays within ``eps`` of the segment that replaces it, so the outline moves by at most
+    ``eps``. The arrays themselves when there is none (nothing is allocated then); a
+    ring with no vertex off its neighbours' segment (a sliver, dropped later) is kept as
+    it is.
+    """
+    some = False
+    for r in range(starts.shape[0] - 1):
+        s = starts[r]
+        n = starts[r + 1] - s
+        for i in range(n if n > 3 else 0):
+            if not _off_segment(xy, s + (i - 1) % n, s + i, s + (i + 1) % n, eps):
+                some = True
+                break
+    if not some:
+        return xy, starts
+    keep = np.ones(xy.shape[0], np.bool_)
+    for r in range(starts.shape[0] - 1):
+        # passes from the kept vertex farthest off its kept neighbours' segment (a
+        # corner, never dropped), until one drops nothing
+        while _drop_collinear(xy, starts[r], starts[r + 1] - starts[r], keep, eps):
+            pass
+    out = np.empty((int(keep.sum()), 2))
+    new_starts = np.empty_like(starts)
+    new_starts[0] = 0
+    w = 0
+    for r in range(starts.shape[0] - 1):
+        for i in range(starts[r], starts[r + 1]):
+            if keep[i]:
+                out[w] = xy[i]
+                w += 1
+        new_starts[r + 1] = w
+    return out, new_starts
+
+
+@njit(cache=True, nogil=True)
+def _drop_collinear(xy, s, n, keep, eps):
+    """One pass of :func:`without_collinear` over the ring of ``n`` vertices at row
+    ``s``: from its kept vertex farthest off the segment of its kept neighbours, each
+    kept vertex is dropped when every vertex between the anchor (the last one kept) and
+    the next kept one, dropped ones included, lies within ``eps`` of the segment joining
+    these two. Returns whether it dropped any (none when no vertex is more than ``eps`` off
+    its neighbours' segment: a sliver, left as it is); a ring keeps 3 vertices at
+    least."""
+    first = -1
+    far = eps * eps
+    for i in range(n):
+        if keep[s + i]:
+            d2 = closest_on_segment(xy[s + i, 0], xy[s + i, 1],
+                                    *_kept_neighbours(xy, s, n, keep, i))[2]
+            if d2 > far:
+                far = d2
+                first = i
+    if first < 0:
+        return False
+    count = 0
+    for i in range(n):
+        count += keep[s + i]
+    dropped = False
+    anchor = first
+    cand = _next_kept(keep, s, n, first)
+    while cand != first and count > 3:
+        after = _next_kept(keep, s, n, cand)
+        fine = True
+        m = (anchor + 1) % n
+        while fine and m != after:
+            fine = not _off_segment(xy, s + anchor, s + m, s + after, eps)
+            m = (m + 1) % n
+        if fine:
+            keep[s + cand] = False
+            count -= 1
+            dropped = True
+        else:
+            anchor = cand
+        cand = after
+    return dropped
+
+
+@njit(cache=True, nogil=True)
+def _next_kept(keep, s, n, i):
+    """The index (in the ring of ``n`` at row ``s``) of the first kept vertex after i."""
+    j = (i + 1) % n
+    while not keep[s + j]:
+        j = (j + 1) % n
+    return j
+
+
+@njit(cache=True, nogil=True)
+def _kept_neighbours(xy, s, n, keep, i):
+    """``(ax, ay, bx, by)``: the kept vertices before and after vertex i of a ring."""
+    j = (i - 1) % n
+    while not keep[s + j]:
+        j = (j - 1) % n
+    k = _next_kept(keep, s, n, i)
+    return xy[s + j, 0], xy[s + j, 1], xy[s + k, 0], xy[s + k, 1]
+
+
+@njit(cache=True, nogil=True)
+def _off_segment(xy, a, m, b, eps):
+    """Whether vertex m is farther than eps from the segment from vertex a to vertex b."""
+    return closest_on_segment(xy[m, 0], xy[m, 1], xy[a, 0], xy[a, 1], xy[b, 0],
+                              xy[b, 1])[2] > eps * eps

@@ -3,8 +3,10 @@
 Each subcommand lives in its own module of this package and provides
 ``add_parser(subparsers)``, which registers the subcommand and sets ``func`` to a
 function taking the parsed arguments and returning an exit status. Errors about the
-user's input are raised as :class:`CommandError` (or a :class:`PolycontactError`) and
-printed as one line on stderr with exit status 2, never as a traceback.
+user's input are raised as :class:`CommandError` (or a :class:`PolycontactError`, or
+the ``ValueError`` or ``TypeError`` with which the library refuses an argument: every
+argument comes from the user's files and options) and printed as one line on stderr
+with exit status 2, never as a traceback.
 
 Before a command whose kernels are not compiled yet (a first run), a notice and one line
 per kernel family go to stderr, never stdout, so ``--json`` output stays parseable.
@@ -18,7 +20,7 @@ import sys
 
 from .. import __version__
 from ..errors import PolycontactError
-from ._io import CommandError
+from ._errors import CommandError
 
 _SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "contacts",
                 "warmup")
@@ -52,8 +54,9 @@ def main(argv: list[str] | None = None) -> int:
     _compile_if_cold(_NEEDS.get(args.command, ()))
     try:
         return int(args.func(args) or 0)
-    except (CommandError, PolycontactError) as exc:
-        print(f"polycontact {args.command}: error: {exc}", file=sys.stderr)
+    except (CommandError, PolycontactError, ValueError, TypeError) as exc:
+        message = " ".join(str(exc).split())  # one line
+        print(f"polycontact {args.command}: error: {message}", file=sys.stderr)
         return 2
     except BrokenPipeError:
         return 0

@@ -4,28 +4,35 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ..bodies import as_shape
-from ..errors import InvalidShapeError, PolycontactError
+from ..errors import InvalidShapeError
 from ..shape import Shape
+from ._errors import CommandError
+from ._progress import announced
 
 
-class CommandError(PolycontactError):
-    """A problem with what the user gave the command (file, option); exit status 2."""
+#: The forms of a body file, as messages and help texts name them.
+BODY_FILE_FORMS = ('JSON {"vertices": [[x, y], ...], "holes": [...]}, a JSON list '
+                   "[[x, y], ...], GeoJSON, WKT or WKB")
 
 
 def read_shape(path: str, *, repair: bool = False) -> Shape:
     """Read one shape from ``path``.
 
-    Accepted: every text or binary form of :func:`polycontact.bodies.as_shape`: a JSON
-    body ``{"vertices": [[x, y], ...], "holes": [...]}``, a GeoJSON Polygon/Feature, WKT
-    text (``POLYGON ((...))``) or WKB (binary or hex). Any problem is raised as a
-    :class:`CommandError` whose message starts with the file name.
+    Accepted: every text or binary form of a body (:mod:`polycontact.bodies`): a JSON
+    body ``{"vertices": [[x, y], ...], "holes": [...]}``, a bare JSON list of vertices
+    ``[[x, y], ...]``, a GeoJSON Polygon/Feature, WKT text (``POLYGON ((...))``) or WKB
+    (binary or hex). Any problem is raised as a :class:`CommandError` whose message
+    starts with the file name.
     """
     try:
         raw = Path(path).read_bytes()
     except OSError as exc:
         raise CommandError(f"{path}: cannot read ({exc.strerror})") from None
+    if not raw.strip():
+        raise CommandError(f"{path}: empty file (expected a body: {BODY_FILE_FORMS})")
     data: str | bytes = raw  # binary WKB starts with its byte-order byte, 0 or 1
     if raw[:1] not in (b"\x00", b"\x01"):
         try:
@@ -33,9 +40,41 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
         except UnicodeDecodeError:
             pass
     try:
-        return as_shape(data, str(path), repair=repair)
+        with announced(f"reading {path} ({len(raw):,} bytes)"):
+            return as_shape(data, str(path), repair=repair)
     except (InvalidShapeError, TypeError) as exc:  # TypeError: coordinates not numbers
         raise CommandError(str(exc)) from None
+
+
+#: What ``--plot`` says when matplotlib is missing (it is the ``plot`` extra).
+NO_MATPLOTLIB = "--plot needs matplotlib: pip install 'polycontact[plot]'"
+
+
+def plotting() -> None:
+    """Make sure a ``--plot`` can be drawn, before anything is computed: matplotlib is
+    there (else a :class:`CommandError` that says how to install it), with the
+    non-interactive backend."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise CommandError(NO_MATPLOTLIB) from None
+    matplotlib.use("Agg")
+
+
+def save_figure(figure: Any, path: str, dpi: int = 120) -> None:
+    """Write a matplotlib ``figure`` to the image file ``path`` (the format from its
+    extension) and close it; a :class:`CommandError` naming the file if it cannot be
+    written."""
+    import matplotlib.pyplot as plt
+
+    try:
+        figure.savefig(path, dpi=dpi, bbox_inches="tight")
+    except OSError as exc:
+        raise CommandError(f"{path}: cannot write the plot ({exc.strerror or exc})") from None
+    except ValueError as exc:  # an image format matplotlib does not know
+        raise CommandError(f"{path}: cannot write the plot ({exc})") from None
+    finally:
+        plt.close(figure)
 
 
 def integer_at_least(minimum: int) -> Callable[[str], int]:

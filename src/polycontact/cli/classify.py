@@ -7,7 +7,8 @@ import json
 import sys
 from typing import Any
 
-from ._io import index_text, non_negative_number, read_shape
+from ._io import BODY_FILE_FORMS, index_text, non_negative_number, read_shape
+from ._progress import announced
 
 
 def add_parser(subparsers: Any) -> None:
@@ -15,8 +16,8 @@ def add_parser(subparsers: Any) -> None:
         "classify",
         help="whether two bodies are separate, in contact or penetrating",
         description="Classify two bodies where they stand: separate, contact (touching, "
-        "interiors disjoint) or penetrating (interiors overlap). Each file is a JSON "
-        'body {"vertices": [[x, y], ...], "holes": [...]}, a GeoJSON Polygon or WKT. '
+        "interiors disjoint) or penetrating (interiors overlap). Each file is a body: "
+        f"{BODY_FILE_FORMS}. "
         "Vertex and edge numbers are 0-based, in the order of the vertices in the file "
         "(edge k joins vertex k and k + 1), whatever their orientation.",
     )
@@ -28,6 +29,10 @@ def add_parser(subparsers: Any) -> None:
                    "the largest |coordinate|))")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
+    p.add_argument("--state-only", action="store_true",
+                   help="print the state alone (and the tolerance with --json): skips the "
+                   "distance, the features, the point and the normal, which can take long "
+                   "for large overlapping bodies")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
@@ -54,13 +59,25 @@ def relation_text(rep: dict[str, Any]) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..relation import classify
+    from ..relation import State, classify
 
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)
     for path, shape in ((args.a, a), (args.b, b)):
         for note in shape.repairs:
             print(f"polycontact classify: repaired {path}: {note}", file=sys.stderr)
-    rep = classify(a, b, tolerance=args.tolerance).to_dict()
+    bodies = f"{args.a} ({a.n_vertices} vertices) and {args.b} ({b.n_vertices} vertices)"
+    with announced(f"classifying {bodies}"):
+        relation = classify(a, b, tolerance=args.tolerance)
+    if args.state_only:
+        state = relation.state.value
+        print(json.dumps({"state": state, "tolerance": relation.tolerance}) if args.json
+              else f"state: {state}")
+        return 0
+    what = {State.SEPARATE: "the distance",
+            State.CONTACT: "the features",
+            State.PENETRATING: "the penetration depth and the features"}[relation.state]
+    with announced(f"computing {what} of {bodies} (--state-only skips this)"):
+        rep = relation.to_dict()
     print(json.dumps(rep) if args.json else "\n".join(relation_text(rep)))
     return 0

@@ -5,20 +5,59 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 from typing import Any
 
 from .. import datasets
+from .._json import load_json
+from ..errors import InvalidSceneError
 from ..limits import SAMPLES, TIME_TOLERANCE
-from ._io import CommandError, index_text, integer_at_least, positive_number
+from ._errors import CommandError
+from ._io import index_text, integer_at_least, plotting, positive_number, save_figure
+from ._progress import announced
+
+#: What a scene is, in one line (for the message about a body file given instead).
+SCENE_IN_A_LINE = ('a JSON object {"t_max": ..., "bodies": [...]}: two or more bodies, '
+                   "each with its vertices and motion; see polycontact collide --help")
+
+#: The scene format, as ``polycontact collide --help`` shows it.
+SCENE_FORMAT = """\
+scene format (JSON; lengths in any unit, times in any unit, used consistently):
+  {"t_max": 20,                   end of the time window searched, from t = 0
+   "time_tolerance": 1e-4,        optional: accuracy of the time (default %g)
+   "description": "...",          optional
+   "bodies": [                    two or more, each moving rigidly about its
+                                  area centroid:
+     {"name": "red",              optional (default body0, body1, ...)
+      "vertices": [[x, y], ...],  outer loop at t = 0, either orientation
+      "holes": [[[x, y], ...]],   optional
+      "velocity": [vx, vy],       optional: length per time (default [0, 0])
+      "acceleration": [ax, ay],   optional: length per time squared
+      "angular_velocity": w,      optional: radians per time, counter-clockwise
+      "angular_acceleration": al  optional: radians per time squared
+     }, ...]}
+  "angular_velocity_deg" and "angular_acceleration_deg" take degrees instead.
+  Unknown keys are refused. Vertex and edge numbers are 0-based, in the order of each
+  body's vertices in the file (edge k joins vertex k and k + 1).
+
+example:
+  {"t_max": 5, "bodies": [
+    {"name": "a", "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]], "velocity": [1, 0]},
+    {"name": "b", "vertices": [[3, 0], [4, 0], [4, 1], [3, 1]], "velocity": [-1, 0]}]}
+  answers "collision at t = 1.00..." (each closes half the gap of 2 at speed 1). The
+  paper's case 1 ships as the scene named paper-case-1 (examples/paper-case-1.json).
+""" % TIME_TOLERANCE
 
 
 def add_parser(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "collide",
         help="first time of impact among the bodies of a scene",
-        description="Find when and where the bodies of a scene first penetrate "
-        "(the first impact among all pairs). Vertex and edge numbers are 0-based, in "
-        "the order of each body's vertices in the file (edge k joins vertex k and k + 1).",
+        description="Find when and where the bodies of a scene first penetrate (the first\n"
+        "impact among all pairs), each body moving with constant linear and angular\n"
+        "acceleration. The scene file's format follows the options.",
+        epilog=SCENE_FORMAT,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("scene", metavar="SCENE.json",
                    help="scene file, or a shipped scene's name: "
@@ -72,15 +111,28 @@ def _text(rep: dict[str, Any]) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..scene import load_scene
 
-    scene = load_scene(datasets.locate(args.scene, "scenes"), repair=args.repair)
+    if args.plot:
+        plotting()
+    path = datasets.locate(args.scene, "scenes")
+    try:
+        with announced(f"reading {path}"):
+            scene = load_scene(path, repair=args.repair)
+    except InvalidSceneError:
+        if _holds_a_body(path):
+            raise CommandError(f"{path}: this is a body file, not a scene: collide takes "
+                               f"a scene ({SCENE_IN_A_LINE})") from None
+        raise
     for body in scene.bodies:
         for note in body.shape.repairs:
             print(f"polycontact collide: repaired {body.name}: {note}",
                   file=sys.stderr)
     options = {"method": args.method, "time_tolerance": args.time_tolerance,
                "samples": args.samples}
+    bodies = f"{len(scene.bodies)} bodies ({sum(b.shape.n_vertices for b in scene.bodies)} " \
+        f"vertices) over [0, {scene.t_max:g}]"
     if args.all:
-        events = scene.impacts(**options)
+        with announced(f"searching every impact of {bodies}"):
+            events = scene.impacts(**options)
         reps = [imp.to_dict((a.name, b.name)) for a, b, imp in events]
         if args.json:
             print(json.dumps({"events": reps}))
@@ -93,18 +145,32 @@ def run(args: argparse.Namespace) -> int:
             return 0
         body_a, body_b, impact = events[0]
     else:
-        body_a, body_b, impact = scene.first_impact(**options)
+        with announced(f"searching the first impact of {bodies}"):
+            body_a, body_b, impact = scene.first_impact(**options)
         rep = impact.to_dict((body_a.name, body_b.name))
         print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        ax = impact.plot(names=(body_a.name, body_b.name))
-        try:
-            ax.figure.savefig(args.plot, dpi=120, bbox_inches="tight")
-        except OSError as exc:
-            raise CommandError(f"{args.plot}: cannot write ({exc.strerror})") from None
-        except ValueError as exc:  # an image format matplotlib does not know
-            raise CommandError(f"{args.plot}: cannot write the plot ({exc})") from None
+        save_figure(impact.plot(names=(body_a.name, body_b.name)).figure, args.plot)
     return 0
+
+
+def _holds_a_body(path: str) -> bool:
+    """Whether the file ``path`` (not a valid scene) holds one body instead: a body
+    mapping, GeoJSON, a list of vertices, WKT or WKB."""
+    try:
+        raw = Path(path).read_bytes()
+    except OSError:
+        return False
+    if raw[:1] in (b"\x00", b"\x01"):  # binary WKB
+        return True
+    text = raw.decode("utf-8", errors="replace").strip()
+    if text.upper().startswith(("POLYGON", "MULTIPOLYGON")):
+        return True
+    try:
+        data = load_json(text)
+    except ValueError:
+        return False
+    if isinstance(data, list):
+        return True
+    return isinstance(data, dict) and "bodies" not in data and (
+        "vertices" in data or data.get("type") in ("Polygon", "MultiPolygon", "Feature"))

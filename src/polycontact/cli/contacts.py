@@ -9,8 +9,11 @@ from pathlib import Path
 from typing import Any
 
 from .. import datasets
+from .._json import load_json
 from ..errors import InvalidShapeError
-from ._io import CommandError, non_negative_number
+from ._errors import CommandError
+from ._io import non_negative_number, plotting, save_figure
+from ._progress import announced
 
 
 def add_parser(subparsers: Any) -> None:
@@ -61,10 +64,10 @@ def read_layout(path: str, progress: bool = False) -> tuple[Any, list[Any], list
     from ..bodies import as_shape
 
     try:
-        data = json.loads(Path(path).read_text())
+        data = load_json(Path(path).read_bytes())
     except OSError as exc:
         raise CommandError(f"{path}: cannot read ({exc.strerror})") from None
-    except json.JSONDecodeError as exc:
+    except ValueError as exc:
         raise CommandError(f"{path}: not valid JSON ({exc})") from None
     if not isinstance(data, dict) or not ("placed" in data or "bodies" in data):
         raise CommandError(f"{path}: expected an object with 'placed' or 'bodies'")
@@ -110,35 +113,22 @@ def text(rep: dict[str, Any]) -> list[str]:
     return lines
 
 
-def save_plot(contacts: Any, path: str) -> None:
-    """Draw the contacts (:meth:`Contacts.plot`) into the image file ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    ax = contacts.plot()
-    try:
-        ax.figure.savefig(path, dpi=110)
-    except (OSError, ValueError) as exc:
-        raise CommandError(f"{path}: cannot write the plot ({exc})") from None
-    finally:
-        plt.close(ax.figure)
-
-
 def run(args: argparse.Namespace) -> int:
     from ..world import World
 
+    if args.plot:
+        plotting()
     container, bodies, names = read_layout(datasets.locate(args.layout, "layouts"),
                                            progress=not args.no_progress)
     world = World(container)
-    world.add_many(bodies, names=names)
-    try:
-        contacts = world.contacts(args.tolerance)
-    except ValueError as exc:
-        raise CommandError(str(exc)) from None
-    rep = contacts.to_dict(names)
+    with announced(f"finding the contacts of {len(bodies)} bodies"):
+        world.add_many(bodies, names=names)
+        try:
+            contacts = world.contacts(args.tolerance)
+        except ValueError as exc:
+            raise CommandError(str(exc)) from None
+        rep = contacts.to_dict(names)
     print(json.dumps(rep) if args.json else "\n".join(text(rep)))
     if args.plot:
-        save_plot(contacts, args.plot)
+        save_figure(contacts.plot().figure, args.plot, dpi=110)
     return 0

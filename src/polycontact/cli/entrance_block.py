@@ -8,7 +8,8 @@ import math
 import sys
 from typing import Any
 
-from ._io import CommandError, read_shape
+from ._io import plotting, read_shape, save_figure
+from ._progress import announced
 from .classify import relation_text
 
 _FAMILIES = (("A2-B0", "E(A(2), B(0))"), ("A0-B2", "E(A(0), B(2))"), ("A1-B1", "E(A(1), B(1))"))
@@ -65,25 +66,20 @@ def _text(rep: dict[str, Any], a: str, b: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from ..entrance import entrance_block
 
+    if args.plot:
+        plotting()
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)
     for path, shape in ((args.a, a), (args.b, b)):
         for note in shape.repairs:
             print(f"polycontact entrance-block: repaired {path}: {note}", file=sys.stderr)
-    block = entrance_block(a, b, args.reference, method=args.method)
-    rep = block.to_dict()
+    with announced(f"building the entrance block of A {args.a} ({a.n_vertices} vertices) "
+                   f"to B {args.b} ({b.n_vertices} vertices)"):
+        block = entrance_block(a, b, args.reference, method=args.method)
+        rep = block.to_dict()
     print(json.dumps(rep) if args.json else _text(rep, args.a, args.b))
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
         from ..plotting.entrance_block import plot_entrance_block
 
-        fig = plot_entrance_block(block)
-        try:
-            fig.savefig(args.plot, dpi=110, bbox_inches="tight")
-        except OSError as exc:
-            raise CommandError(f"{args.plot}: cannot write ({exc.strerror})") from None
-        except ValueError as exc:  # an image format matplotlib does not know
-            raise CommandError(f"{args.plot}: cannot write the plot ({exc})") from None
+        save_figure(plot_entrance_block(block), args.plot, dpi=110)
     return 0

@@ -9,7 +9,8 @@ import sys
 from typing import Any
 
 from .. import datasets
-from ._io import CommandError, integer_at_least
+from ._errors import CommandError
+from ._io import integer_at_least
 
 
 def _angle(text: str) -> float:
@@ -77,6 +78,10 @@ def run(args: argparse.Namespace) -> int:
         print("polycontact nfp-table: interrupted; the entries computed so far are in "
               f"{args.out}, a rerun completes the table", file=sys.stderr)
         return 130
+    except OSError as exc:  # the cache cannot be written (a file, no permission, full)
+        where = f" ({exc.filename})" if exc.filename else ""
+        raise CommandError(f"--out {args.out}: cannot write the cache: "
+                           f"{exc.strerror or exc}{where}") from None
     finally:
         if client is not None:
             client.close()

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from ._style import LENGTH_LABEL, plural
+from ._style import LENGTH_LABEL, label_axes, legend_outside, plural, pyplot
 
 __all__ = ["plot_entrance_block", "plot_union"]
 
@@ -49,15 +49,13 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
     E(A(1), B(1)): an edge of A meets an edge of B | 4 components, swept
     E(A, B), the union of the three; area 4 | A and B at a0: separate
     """
-    import matplotlib.pyplot as plt
-
     if figure is None:
         import shapely
 
         x0, y0, x1, y1 = shapely.union_all(
             [block.to_shapely(), block.a.to_shapely(), block.b.to_shapely()]).bounds
         ratio = min(2.0, max(0.4, (y1 - y0) / max(x1 - x0, 1e-300)))
-        figure = plt.figure(figsize=(12, 11 * ratio + 2.2), layout="constrained")
+        figure = pyplot().figure(figsize=(12, 11 * ratio + 2.2), layout="constrained")
     axes = figure.subplots(2, 2, sharex=True, sharey=True).ravel()
     for ax, (family, (colour, text)) in zip(axes, FAMILY_STYLE.items()):
         _bodies(ax, block)
@@ -93,14 +91,11 @@ def plot_union(block: Any, ax: Any) -> Any:
     >>> ax.get_title().splitlines()[1]
     'A and B at a0: separate'
     """
-    from ._style import label_axes
-
     handles = _legend_handles(_union_panel(ax, block))[3:]  # no family in this panel
     label_axes(ax)
     ax.grid(True, linewidth=0.3, alpha=0.5)
     ax.autoscale_view()
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),
-              borderaxespad=0.0, fontsize="small", frameon=False)
+    legend_outside(ax, handles)
     return ax
 
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..motion import Motion
 from ..bodies import BodyLike, as_shape
-from ._style import draw_shape, label_axes, legend_outside
+from ._style import draw_shape, label_axes, legend_outside, new_axes
 
 if TYPE_CHECKING:  # (impact.py imports this module to plot: no cycle at run time)
     from ..impact import Impact
@@ -49,13 +49,12 @@ def plot_impact(
     >>> len(ax.patches), labels[0], labels[2], labels[-1]
     (4, 'A at t = 0', "A's centroid path", 'normal, A towards B')
     """
-    import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-
     a = as_shape(a, "a")
     b = as_shape(b, "b")
     if ax is None:
-        _, ax = plt.subplots(figsize=(11, 6), layout="constrained")
+        ax = new_axes((11, 6))
+    from matplotlib.lines import Line2D
+
     t_event = _event_time(impact)
     ts = np.linspace(0.0, t_event, 200)
     for shape, motion, color, name in ((a, motion_a, "tab:red", names[0]),

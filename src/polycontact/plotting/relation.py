@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._style import draw_shape, label_axes, legend_outside
+from ._style import draw_shape, label_axes, legend_outside, new_axes
 
 __all__ = ["plot_relation"]
 
@@ -31,11 +31,10 @@ def plot_relation(relation: Any, ax: Any = None) -> Any:
     >>> ax.get_title(), ax.get_legend_handles_labels()[1]
     ('penetrating, distance -1', ['A', 'B', 'witness point', 'normal, A towards B'])
     """
-    import matplotlib.pyplot as plt
+    if ax is None:
+        ax = new_axes((8, 6))
     from matplotlib.lines import Line2D
 
-    if ax is None:
-        _, ax = plt.subplots(figsize=(8, 6), layout="constrained")
     a, b = relation.shapes
     draw_shape(ax, a, "tab:red", 0.45, "A")
     draw_shape(ax, b, "tab:blue", 0.45, "B")

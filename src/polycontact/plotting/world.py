@@ -1,26 +1,18 @@
-"""Figure of a World's contacts: the bodies, the container, contacts and penetrations."""
+"""Figures of a World: its bodies and container (:func:`plot_world`), and its contacts
+and penetrations (:func:`plot_contacts`)."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from ._style import label_axes, legend_outside, plural
+from ._style import label_axes, legend_outside, new_axes, plural, shape_patch
 
-__all__ = ["plot_contacts"]
+__all__ = ["plot_contacts", "plot_world"]
+
+#: A World drawn with more bodies than this shows no ids unless asked.
+LABELLED_BODIES = 100
 
 _COLOURS = {"penetrating": "#d62728", "outside the container": "#ff7f0e", "body": "#9ecae1"}
-
-
-def _patch(shape: Any, **style: Any) -> Any:
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path
-
-    verts: list[Any] = []
-    codes: list[Any] = []
-    for loop in shape.loops:
-        verts += [*loop.tolist(), loop[0].tolist()]
-        codes += [Path.MOVETO] + [Path.LINETO] * (len(loop) - 1) + [Path.CLOSEPOLY]
-    return PathPatch(Path(verts, codes), **style)
 
 
 def plot_contacts(contacts: Any, ax: Any = None) -> Any:
@@ -48,20 +40,18 @@ def plot_contacts(contacts: Any, ax: Any = None) -> Any:
     >>> ax.get_title()
     '2 bodies: 1 contact, 0 penetrating pairs, 0 outside the container'
     """
-    import matplotlib.pyplot as plt
-
     if ax is None:
-        _, ax = plt.subplots(figsize=(11, 7), layout="constrained")
+        ax = new_axes((11, 7))
     pen = set(contacts.penetrating.ravel().tolist())
     out = set(contacts.container_ids[contacts.container_states == 2].tolist())
     if contacts.container is not None:
-        ax.add_patch(_patch(contacts.container, facecolor="none", edgecolor="0.2", lw=1.5,
+        ax.add_patch(shape_patch(contacts.container, facecolor="none", edgecolor="0.2", lw=1.5,
                             label="container"))
     labelled = set()
     for i in contacts.ids.tolist():
         kind = ("penetrating" if i in pen else
                 "outside the container" if i in out else "body")
-        ax.add_patch(_patch(contacts.shape(i), facecolor=_COLOURS[kind], edgecolor="0.3",
+        ax.add_patch(shape_patch(contacts.shape(i), facecolor=_COLOURS[kind], edgecolor="0.3",
                             lw=0.5, alpha=0.6, label=None if kind in labelled else kind))
         labelled.add(kind)
     touch: list[Any] = []
@@ -80,10 +70,62 @@ def plot_contacts(contacts: Any, ax: Any = None) -> Any:
                 label=plural(len(deep), "penetration"))
     ax.autoscale_view()
     label_axes(ax)
-    n = len(contacts.ids)
-    bodies = "1 body" if n == 1 else f"{n} bodies"
-    ax.set_title(f"{bodies}: {plural(len(touch), 'contact')}, "
+    ax.set_title(f"{_bodies(len(contacts.ids))}: {plural(len(touch), 'contact')}, "
                  f"{plural(len(deep), 'penetrating pair')}, "
                  f"{len(out)} outside the container")
     legend_outside(ax)
+    return ax
+
+
+def _bodies(n: int) -> str:
+    return "1 body" if n == 1 else f"{n} bodies"
+
+
+def plot_world(world: Any, ax: Any = None, *, labels: bool | None = None) -> Any:
+    """Draw the bodies of a World where they stand and its container (no contacts are
+    computed: :meth:`World.contacts` and its ``plot`` draw those).
+
+    Parameters
+    ----------
+    world : World
+    ax : matplotlib Axes, optional
+        Drawn into a new figure when omitted.
+    labels : bool, optional
+        Write each body's id (and name) at its centroid; by default when the world has
+        at most :data:`LABELLED_BODIES` bodies.
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> w = pc.World(container=[(0, 0), (4, 0), (4, 2), (0, 2)])
+    >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (1, 1), name="a"),
+    ...        w.add([(0, 0), (1, 0), (0, 1)], (3, 1))]
+    >>> ax = plot_world(w)
+    >>> ax.get_title(), [t.get_text() for t in ax.texts]
+    ('2 bodies, in a container', ['0 (a)', '1'])
+    """
+    if ax is None:
+        ax = new_axes((11, 7))
+    bodies = world.bodies()
+    if world.container is not None:
+        ax.add_patch(shape_patch(world.container, facecolor="none", edgecolor="0.2", lw=1.5,
+                                 label="container"))
+    for k, body in enumerate(bodies):
+        ax.add_patch(shape_patch(body.shape, facecolor=_COLOURS["body"], edgecolor="0.3",
+                                 lw=0.5, alpha=0.6, label="bodies" if k == 0 else None))
+    if labels or (labels is None and len(bodies) <= LABELLED_BODIES):
+        for body in bodies:
+            text = str(body.id) if body.name is None else f"{body.id} ({body.name})"
+            ax.annotate(text, body.shape.centroid, ha="center", va="center",
+                        fontsize="small")
+    ax.autoscale_view()
+    label_axes(ax)
+    inside = ", in a container" if world.container is not None else ""
+    ax.set_title(f"{_bodies(len(bodies))}{inside}")
+    if bodies or world.container is not None:
+        legend_outside(ax)
     return ax
