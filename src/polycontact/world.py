@@ -43,11 +43,10 @@ from .motion import Motion
 from .relation import Relation, classify, raw_ring_inputs
 from .bodies import BodyLike, as_shape
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, default_tolerance
+from .tolerances import RELATIVE_TOLERANCE, ROUNDING_FACTOR, check_range, default_tolerance
 
 __all__ = ["World", "WorldBody", "Contacts", "Query"]
 
-_ULP_FACTOR = ROUNDING_ULPS * 2.0**-52
 #: query_many tests every body's box, not the grid's cells, up to this many bodies.
 _SCAN_BODIES = 64
 
@@ -290,7 +289,7 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     of its two bodies' (a maximum of per-body terms), which the kernels take."""
     extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
-    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude))
+    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, ROUNDING_FACTOR * magnitude))
 
 
 def _stored_shape(xy: np.ndarray, ls: np.ndarray, lo: int, nl: int,
@@ -490,10 +489,10 @@ class World:
         >>> w.contacts().pairs.tolist()
         [[0, 1]]
         """
-        from .relation import _pack
+        from .relation import pack_bodies
 
         made: list[Any] = []
-        xy, ls, bs, sign = _pack(shapes, "shapes", made)
+        xy, ls, bs, sign = pack_bodies(shapes, "shapes", made)
         count = len(sign)
         if names is not None:
             if isinstance(names, (str, bytes)) or not isinstance(names, (Sequence, np.ndarray)):
@@ -681,8 +680,13 @@ class World:
         return tol
 
     def _grid(self) -> tuple[Any, ...]:
+        """The broad phase's record of the kernels (``polycontact._kernels.world``)."""
         return (self._keys, self._heads, self._nxt, self._level, self._lvl_count,
                 self._levels(), self._origin if self._origin is not None else np.zeros(2))
+
+    def _bodies(self) -> tuple[Any, ...]:
+        """The stored bodies' record of the kernels (``polycontact._kernels.world``)."""
+        return (self._xy, self._ls, self._lo, self._nl, self._box, self._eps)
 
     def _hazards(self) -> tuple[Any, ...]:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
@@ -705,11 +709,8 @@ class World:
         k = _k()
         tol = self._tol(tolerance)
         alive = np.sort(self._alive())
-        keys, heads, nxt, level, cnt, levels, origin = self._grid()
-        pi, pj = k.candidate_pairs(keys, heads, nxt, level, cnt, levels, origin, self._box,
-                                   self._eps, tol, alive, self._next)
-        states, used = k.classify_pairs(self._xy, self._ls, self._lo, self._nl, self._eps,
-                                        tol, pi, pj, self._vmax, self._lmax,
+        pi, pj = k.candidate_pairs(self._grid(), self._box, self._eps, tol, alive, self._next)
+        states, used = k.classify_pairs(self._bodies(), tol, pi, pj, self._vmax, self._lmax,
                                         _chunks(len(pi)))
         hit = np.flatnonzero(states)
         if self._next < 2**31:  # one key per pair, no overflow: one sort, not a lexsort
@@ -719,10 +720,8 @@ class World:
         pairs = np.stack([pi[hit], pj[hit]], axis=1)
         states, used = states[hit], used[hit]
         if self._container is not None and len(alive):
-            cst = k.container_states(self._xy, self._ls, self._lo, self._nl, self._box,
-                                     self._eps, tol, alive, *self._hazards()[:4],
-                                     self._cbox, self._ceps, self._vmax, self._lmax,
-                                     self._hmax, _chunks(len(alive)))
+            cst = k.container_states(self._bodies(), tol, alive, self._hazards(), self._vmax,
+                                     self._lmax, self._hmax, _chunks(len(alive)))
             c_ids, c_states = alive[cst > 0], cst[cst > 0]
         else:
             c_ids, c_states = np.empty(0, np.int64), np.empty(0, np.int8)
@@ -750,15 +749,13 @@ class World:
         qeps = default_tolerance(qxy)
         k = _k()
         if self._records:
-            ids, states = k.query_states(qxy, qs, qeps, *self._grid(), self._xy, self._ls,
-                                         self._lo, self._nl, self._box, self._eps, tol,
-                                         self._emax,
-                                         self._next, self._vmax, self._lmax)
+            ids, states = k.query_states((qxy, qs, qeps), self._grid(), self._bodies(), tol,
+                                         self._emax, self._next, self._vmax, self._lmax)
         else:
             ids, states = np.empty(0, np.int64), np.empty(0, np.int8)
         cstate = 0
         if self._container is not None:
-            cstate = int(k.query_container(qxy, qs, qeps, tol, *self._hazards()))
+            cstate = int(k.query_container((qxy, qs, qeps), tol, self._hazards()))
         return Query(ids, states, cstate, placed)
 
     def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
@@ -801,12 +798,11 @@ class World:
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
                                             np.zeros(4), 0.0)
+        settings = (RELATIVE_TOLERANCE, ROUNDING_FACTOR, tol, self._emax, self._next,
+                    self._vmax, self._lmax, has_c, self._hmax if has_c else 0)
         states: np.ndarray = _k().query_many(
-            sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
-            RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
-            self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
-            *hz, self._hmax if has_c else 0, scan, _chunks(len(pos)),
-        )
+            (sxy, ss, float(c[0]), float(c[1])), (pos[:, 0].copy(), pos[:, 1].copy(), ang),
+            self._grid(), self._bodies(), hz, settings, scan, _chunks(len(pos)))
         return states
 
     # -- moving bodies ---------------------------------------------------------------

@@ -39,7 +39,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import PENETRATING, _bbox, _norm, _scratch_views, _state_in, scratch_floats
+from .packs import scratch_floats, state_scratch_views
+from .primitives import bbox, grow_rows, norm, origin_distance_sq, origin_foot
+from .relation import PENETRATING, state_in
+
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
 #: segments, O(K) tests to split each of the K near the origin); above it the caller's
@@ -97,7 +100,7 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
     """
     b2 = bound * bound
     # (the segments of vertex i lie in the box of v_i - (the other body's box))
-    ex0, ex1, ey0, ey1 = _bbox(xe, xe.shape[0])
+    ex0, ex1, ey0, ey1 = bbox(xe, xe.shape[0])
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
             gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])
@@ -119,7 +122,7 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
                 y0 = sign * (xv[i, 1] - xe[j, 1])
                 x1 = sign * (xv[i, 0] - xe[jj, 0])
                 y1 = sign * (xv[i, 1] - xe[jj, 1])
-                d = _foot_sq(x0, y0, x1, y1)
+                d = origin_distance_sq(x0, y0, x1, y1)
                 if d < b2:
                     seg[n, 0] = x0
                     seg[n, 1] = y0
@@ -128,35 +131,6 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
                     seg[n, 4] = d
                     n += 1
     return n
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot_sq(ax, ay, bx, by):
-    """Squared distance from the origin to segment ab."""
-    dx = bx - ax
-    dy = by - ay
-    s = -(ax * dx + ay * dy)
-    if s <= 0.0:
-        return ax * ax + ay * ay
-    den = dx * dx + dy * dy
-    if s >= den:
-        return bx * bx + by * by
-    c = (ax * dy - ay * dx) / np.sqrt(den)  # (squared after the division: no overflow)
-    return c * c
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot(ax, ay, bx, by):
-    """Point of segment ab nearest the origin, and its distance."""
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    t = 0.0
-    if den > 0.0:
-        t = min(1.0, max(0.0, -(ax * dx + ay * dy) / den))
-    px = ax + t * dx
-    py = ay + t * dy
-    return px, py, _norm(px, py)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -192,7 +166,7 @@ def _splits(seg, n, s, tol, ts):
             continue
         fx = ex - cx
         fy = ey - cy
-        lf = _norm(fx, fy)
+        lf = norm(fx, fy)
         if not lf > 0.0:
             return -1
         den = dx * fy - dy * fx
@@ -229,16 +203,15 @@ def _splits(seg, n, s, tol, ts):
 
 
 @njit(cache=True, nogil=True)
-def _penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
+def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
     """Whether A moved by (dx, dy) penetrates B (the state kernel's verdict); ``moved``
     (shaped like ``xa``) and ``scratch`` (``scratch_floats`` of both bodies' vertices)
     are written, so that the checks of one pair allocate nothing."""
     for i in range(xa.shape[0]):
         moved[i, 0] = xa[i, 0] + dx
         moved[i, 1] = xa[i, 1] + dy
-    box, ids, touch, rays, rord = _scratch_views(scratch, xa.shape[0] + xb.shape[0])
-    return _state_in(moved, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays,
-                     rord) == PENETRATING
+    views = state_scratch_views(scratch, xa.shape[0] + xb.shape[0])
+    return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, views) == PENETRATING
 
 
 @njit(cache=True, nogil=True)
@@ -308,7 +281,7 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
                 return np.nan, np.nan, np.nan, False
             c = _pieces(seg, s, ts, k, bound, pts, c)
             if c < 0:  # (more rows needed)
-                pts = _grown(pts)
+                pts = grow_rows(pts)
                 c = _pieces(seg, s, ts, k, bound, pts, -c - 1)
             continue
         if r < 0 or not pts[r, 0] < bound:
@@ -317,9 +290,9 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
         pts[r, 3] = 1.0
         if _tried(pts, c, r):
             continue  # (an end shared by several pieces is tried once)
-        if not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
+        if not penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
             return d, px, py, True
-    if _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    if penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return np.nan, np.nan, np.nan, False
     return bound, bdx, bdy, True
 
@@ -357,7 +330,8 @@ def _pieces(seg, s, ts, k, bound, pts, c):
     for q in range(k - 1):
         if ts[q + 1] <= ts[q]:
             continue
-        got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx, ay + ts[q + 1] * dy)
+        got = origin_foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx,
+                          ay + ts[q + 1] * dy)
         if got[2] < bound:
             pts[c, 0] = got[2]
             pts[c, 1] = got[0]
@@ -367,8 +341,3 @@ def _pieces(seg, s, ts, k, bound, pts, c):
     return c
 
 
-@njit(cache=True, nogil=True)
-def _grown(pts):
-    out = np.empty((2 * pts.shape[0], pts.shape[1]))
-    out[: pts.shape[0]] = pts
-    return out
