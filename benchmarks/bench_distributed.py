@@ -44,9 +44,9 @@ DATA = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "esicup"
 
 
 def _clear() -> None:
-    from polycontact import nfp
+    from polycontact import _pieces
 
-    nfp._PIECES_CACHE.clear()
+    _pieces.clear_cache()
 
 
 def timed(fn, repeat: int, client=None) -> float:

@@ -33,10 +33,10 @@ import shapely
 import polycontact as pc
 from polycontact import Motion, Shape
 from polycontact._kernels import impact as ki
-from polycontact.broad_phase import BROAD_PHASE_INFLATION
-from polycontact.impact import _ULPS, CONTACT_RESOLUTION, _extent, body_frame
 from polycontact._dispatch import entry_point
-from polycontact.tolerances import RELATIVE_TOLERANCE
+from polycontact.impact import body_frame
+from polycontact.limits import BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, RELATIVE_TOLERANCE
+from polycontact.tolerances import ROUNDING_FACTOR
 
 ROOT = Path(__file__).resolve().parent.parent
 TOL = 1e-4
@@ -107,18 +107,19 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False
     rb, _, _, pb = body_frame(b)
     va, vb = ma.array, mb.array
     lam = CONTACT_RESOLUTION * (a.bounding_radius + b.bounding_radius)
-    eps_rel = RELATIVE_TOLERANCE * max(_extent(a), _extent(b))
+    eps_rel = RELATIVE_TOLERANCE * max(a._extent, b._extent)
     la, lb = a.bounding_radius, b.bounding_radius
     work = np.empty(ki.work_floats(len(ra) + len(rb)))  # (the API's is kept per thread)
 
     if method == "exact":
         kernel = ki.exact_call
-        args = (*pa, va, *pb, vb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, lam,
-                1_000_000, work)
+        args = (*pa, va, *pb, vb, t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR,
+                lam, 1_000_000, work)
     else:
         kernel = ki.sampled_query
-        args = (ra, a.packed[1], a.centroid, va, la, rb, b.packed[1], b.centroid, vb, lb,
-                t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, _ULPS, samples, work)
+        args = ((ra, a.packed[1], a.centroid, la), va, (rb, b.packed[1], b.centroid, lb), vb,
+                (t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR, 0.0, 0, samples),
+                work)
     if compiled:
         kernel = entry_point(kernel, args)
     return lambda: kernel(*args)

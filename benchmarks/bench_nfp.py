@@ -44,7 +44,7 @@ import numpy as np
 import shapely
 
 import polycontact as pc
-from polycontact import nfp as nfp_module
+from polycontact._pieces import clear_cache as clear_pieces_cache
 
 ROOT = Path(__file__).resolve().parents[1]
 # the data sit in <checkout>/../shared (main checkout) or ../../shared (a worktree)
@@ -102,18 +102,18 @@ def run(path: Path, repeat: int, check: bool) -> dict:
     pairs = [(i, j) for i in range(len(rings)) for j in range(len(rings))]
 
     def t_pc_warm():
-        nfp_module._PIECES_CACHE.clear()
+        clear_pieces_cache()
         return [pc.no_fit_polygon(shapes[i], shapes[j], "origin") for i, j in pairs]
 
     def t_pc_cold():
         out = []
         for i, j in pairs:
-            nfp_module._PIECES_CACHE.clear()
+            clear_pieces_cache()
             out.append(pc.no_fit_polygon(shapes[i], shapes[j], "origin"))
         return out
 
     def t_pc_region():
-        nfp_module._PIECES_CACHE.clear()
+        clear_pieces_cache()
         return [pc.no_fit_polygon(shapes[i], shapes[j], "origin").region for i, j in pairs]
 
     def t_clipper():

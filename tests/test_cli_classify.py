@@ -113,12 +113,12 @@ def test_command_line_no_traceback(tmp_path):
 def test_separate_bodies_skip_the_feature_search(tmp_path, capsys, monkeypatch):
     # Before: the features (empty for separate bodies) were always searched: 55 s on two
     # 200 000-vertex bodies. The CLI now computes only what it prints.
-    from polycontact._kernels import relation as kr
+    from polycontact._kernels import features as kfeat
 
     def no_features(*args):
         raise AssertionError("features searched for separate bodies")
 
-    monkeypatch.setattr(kr, "features", no_features)
+    monkeypatch.setattr(kfeat, "features", no_features)
     a = _write(tmp_path, "a.json", '{"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]}')
     b = _write(tmp_path, "b.json", '{"vertices": [[3, 0], [4, 0], [4, 1], [3, 1]]}')
     assert main(["classify", a, b, "--json"]) == 0

@@ -24,14 +24,15 @@ def _write(tmp_path: Path, name: str, doc) -> str:
 
 
 def _no_lazy_parts(monkeypatch) -> None:
-    """Make the distance, features and depth kernels fail if they are called."""
-    from polycontact._kernels import depth as kd
-    from polycontact._kernels import relation as kr
+    """Make the distance, features and depth fail if they are called."""
+    from polycontact import _depth
+    from polycontact._kernels import distance, features
 
     def refuse(*args, **kwargs):
         raise AssertionError("computed although --state-only")
 
-    for module, name in ((kr, "closest_pair"), (kr, "features"), (kd, "penetration")):
+    for module, name in ((distance, "closest_pair"), (features, "features"),
+                         (_depth, "penetration")):
         monkeypatch.setattr(module, name, refuse)
 
 

@@ -200,13 +200,13 @@ def test_depth_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
     # Two 50 000-vertex stars overlapping at the rim needed more memory than the machine
     # had (the process was killed). Past its budget the depth now raises a clear error;
     # the budget is lowered here to reach it with small stars.
-    from polycontact._kernels import depth as kd
+    from polycontact import _depth
 
     rng = np.random.default_rng(3)
     a, b = _star(rng, 300), _star(rng, 300, (0.3, 0.1))
-    monkeypatch.setattr(kd, "MAX_SUM_VERTICES", 1000)
+    monkeypatch.setattr(_depth, "MAX_SUM_VERTICES", 1000)
     rel = pc.classify(a, b)
     assert rel.state is pc.State.PENETRATING
-    with pytest.raises(kd.DepthTooLargeError, match="too large and interlocked"):
+    with pytest.raises(pc.DepthTooLargeError, match="too large and interlocked"):
         rel.distance
-    assert isinstance(kd.DepthTooLargeError("x"), (pc.PolycontactError, MemoryError))
+    assert isinstance(pc.DepthTooLargeError("x"), (pc.PolycontactError, MemoryError))

@@ -21,7 +21,8 @@ from test_depth import _clipper_depth, _convex_sum_depth
 
 import polycontact as pc
 from polycontact._kernels import depth as kd
-from polycontact.nfp import _pieces_packed
+from polycontact._pieces import pieces_packed
+from polycontact.limits import MAX_SUM_VERTICES
 
 
 def _star(rng: np.random.Generator, n: int, centre=(0.0, 0.0)) -> np.ndarray:
@@ -51,10 +52,10 @@ def _from_box(a: pc.Shape, b: pc.Shape, eps: float,
     """The depth searched over the convex sums from the ``escape`` (by default the box's
     escape only: the path before the shortcuts)."""
     (xa, sa), (xb, sb) = a.packed, b.packed
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    return kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *escape(xa, xb),
-                                eps, kd.MAX_SUM_VERTICES)
+    bxy, bst = pieces_packed(xb, sb)
+    axy, ast = pieces_packed(xa, sa)
+    return kd.depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), escape(xa, xb),
+                                eps, MAX_SUM_VERTICES)
 
 
 def _pairs(seed: int, count: int, holes: int):
@@ -148,10 +149,10 @@ def test_depth_from_a_first_escape_that_does_not_escape_falls_back_to_the_box():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     a, b = pc.Shape(sq), pc.Shape(sq + [0.5, 0.25])
     (xa, sa), (xb, sb) = a.packed, b.packed
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    got = kd.depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, 0.1, 0.1, 0.0, 1e-12,
-                               kd.MAX_SUM_VERTICES)
+    bxy, bst = pieces_packed(xb, sb)
+    axy, ast = pieces_packed(xa, sa)
+    got = kd.depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), (0.1, 0.1, 0.0),
+                               1e-12, MAX_SUM_VERTICES)
     assert got == pytest.approx((0.5, 0.0, -0.5) if got[2] else (0.5, -0.5, 0.0))
     assert pc.classify(sq + np.array(got[1:]), sq + [0.5, 0.25]).state is not \
         pc.State.PENETRATING

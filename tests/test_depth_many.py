@@ -17,7 +17,10 @@ from profiles import examples
 from test_depth import _clipper_depth
 
 import polycontact as pc
+from polycontact import _depth
 from polycontact._kernels import depth as kd
+from polycontact._pieces import pieces_packed
+from polycontact.limits import MAX_SUM_VERTICES
 
 
 def _ring(seed: int, n: int, centre, lo=0.5, hi=1.0, clockwise=False) -> np.ndarray:
@@ -101,12 +104,10 @@ def test_depth_without_the_grid_equals_the_depth_with_it(seed, na, nb, cx, cy):
     if rel.state is not pc.State.PENETRATING:
         return
     (xa, sa), (xb, sb) = a.packed, b.packed
-    from polycontact.nfp import _pieces_packed
-
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    args = (xa, sa, xb, sb, bxy, bst, -axy, ast, *kd.box_escape(xa, xb), rel.tolerance,
-            kd.MAX_SUM_VERTICES)
+    bxy, bst = pieces_packed(xb, sb)
+    axy, ast = pieces_packed(xa, sa)
+    args = ((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), kd.box_escape(xa, xb), rel.tolerance,
+            MAX_SUM_VERTICES)
     scan = kd.depth_from_pieces(*args, 10**9)
     grid = kd.depth_from_pieces(*args, 0)
     assert scan[0] == pytest.approx(grid[0], rel=1e-12, abs=rel.tolerance)
@@ -130,10 +131,10 @@ def test_distinct_bodies_tells_apart_bodies_of_equal_key():
 
 
 def test_batch_depth_beyond_its_memory_budget_is_refused(monkeypatch):
-    monkeypatch.setattr(kd, "MAX_SUM_VERTICES", 3)
+    monkeypatch.setattr(_depth, "MAX_SUM_VERTICES", 3)
     # (40-gons: two small bodies take the contact segments, which build no sums)
     t = 2.0 * np.pi * np.arange(40) / 40
     disk = np.column_stack((np.cos(t), np.sin(t)))
     batch = pc.classify_many(np.stack([disk, disk]), np.stack([disk + 0.5, disk + 3.0]))
-    with pytest.raises(kd.DepthTooLargeError, match="too large and interlocked"):
+    with pytest.raises(pc.DepthTooLargeError, match="too large and interlocked"):
         batch.distances  # noqa: B018

@@ -514,8 +514,8 @@ def test_a_query_kernel_refuses_a_scratch_buffer_too_short_for_its_bodies():
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     (r, tab, *_) = body_frame(sq)
     m = np.zeros(6)
-    args = (r, sq.packed[1], sq.centroid, m, 1.0, tab, r, sq.packed[1], sq.centroid, m, 1.0,
-            tab, 1.0, 1e-6, 1e-4, 1e-12, 1e-14, 0.01, 100)
+    body = (r, sq.packed[1], sq.centroid, 1.0)
+    args = (body, tab, m, body, tab, m, (1.0, 1e-6, 1e-4, 1e-12, 1e-14, 0.01, 100, 10))
     need = ki.work_floats(8)
     assert ki.exact_query(*args, np.empty(need))[1] == ki.INITIALLY_PENETRATING
     with pytest.raises(ValueError, match="scratch buffer is too short"):

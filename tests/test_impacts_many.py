@@ -23,9 +23,10 @@ from profiles import examples
 import polycontact as pc
 from polycontact import ImpactStatus, InvalidShapeError, Motion, Shape
 from polycontact._kernels.swept import swept_boxes
-from polycontact.broad_phase import BROAD_PHASE_INFLATION, intervals_array
-from polycontact.impacts import (MAX_SLICES, SWEPT_ROUNDING_ULPS, candidate_pairs, event_time,
-                                 first_impact, first_impacts, time_of_impact_many)
+from polycontact.broad_phase import intervals_array
+from polycontact.impacts import (candidate_pairs, event_time, first_impact, first_impacts,
+                                 time_of_impact_many)
+from polycontact.limits import BROAD_PHASE_INFLATION, MAX_SLICES, SWEPT_ROUNDING_ULPS
 
 SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 STATUS_CODES = {ImpactStatus.NO_HIT: 0, ImpactStatus.HIT: 1,

@@ -109,12 +109,14 @@ def _placed(c0, m, r, t):
 
 def _kin(mv, me, t0, t1):
     """The window tuple of ``_vertex_edge_time`` / ``_node_time``, as ``pair_step`` builds
-    it: (|Δa|, |α_v| + ω_v,max², |α_e| + ω_e,max², max |Δv|, ω_v,max, ω_e,max)."""
+    it: (|Δa|, |α_v| + ω_v,max², |α_e| + ω_e,max², max |Δv|, ω_v,max, ω_e,max, Δax,
+    Δay)."""
     wv = max(abs(mv[4] + mv[5] * t0), abs(mv[4] + mv[5] * t1))
     we = max(abs(me[4] + me[5] * t0), abs(me[4] + me[5] * t1))
     dv = [np.hypot(*(mv[:2] - me[:2] + (mv[2:4] - me[2:4]) * t)) for t in (t0, t1)]
-    return (float(np.hypot(*(mv[2:4] - me[2:4]))), abs(mv[5]) + wv * wv, abs(me[5]) + we * we,
-            max(dv), wv, we)
+    dax, day = mv[2:4] - me[2:4]
+    return (float(np.hypot(dax, day)), abs(mv[5]) + wv * wv, abs(me[5]) + we * we, max(dv), wv,
+            we, float(dax), float(day))
 
 
 def _segment_distance(p, a, b):
@@ -142,10 +144,10 @@ def test_vertex_edge_time_keeps_the_pair_apart(mv, me, rp, ra, rb, t0, cap):
     a, b = _placed(ce0, me, np.array([ra, rb]), t0)
     assume(_segment_distance(p, a, b) > lam)
     vel = vv + wv * np.array([-(p[1] - cv[1]), p[0] - cv[0]])
-    d2, tau = ka._vertex_edge_time(p[0], p[1], vel[0], vel[1], np.hypot(*rp), a[0], a[1], b[0],
-                                   b[1], np.hypot(*ra), np.hypot(*rb), ce[0], ce[1], ve[0], ve[1],
-                                   we, _kin(mv, me, t0, t0 + cap), lam, cap, 0.0,
-                                   *(mv[2:4] - me[2:4]))
+    d2, tau = ka._vertex_edge_time((p[0], p[1], vel[0], vel[1], np.hypot(*rp)), a[0], a[1],
+                                   b[0], b[1], np.hypot(*ra), np.hypot(*rb),
+                                   (ce[0], ce[1], ve[0], ve[1], we),
+                                   _kin(mv, me, t0, t0 + cap), lam, cap, 0.0)
     assert math.isclose(math.sqrt(d2), _segment_distance(p, a, b), rel_tol=1e-9)
     assert 0.0 <= tau <= cap
     for t in np.linspace(t0, t0 + tau, 200):
@@ -170,8 +172,8 @@ def test_node_time_keeps_the_circles_apart(ma, mb, ra, rb, rho_a, rho_b, t0, cap
     gap = lambda t: (np.hypot(*(_placed(ca0, ma, ra[None], t)[0] - _placed(cb0, mb, rb[None], t)[0]))
                      - rho_a - rho_b)
     assume(gap(t0) > lam)
-    tau = ka._node_time(qa, 0, ca, math.cos(tha), math.sin(tha), va[0], va[1], wa, qb, 0, cb,
-                        math.cos(thb), math.sin(thb), vb[0], vb[1], wb,
+    tau = ka._node_time(qa, 0, (ca, math.cos(tha), math.sin(tha), va[0], va[1], wa), qb, 0,
+                        (cb, math.cos(thb), math.sin(thb), vb[0], vb[1], wb),
                         _kin(ma, mb, t0, t0 + cap), lam, cap)
     assert 0.0 <= tau <= cap
     for t in np.linspace(t0, t0 + tau, 200):
@@ -197,10 +199,10 @@ def test_vertex_edge_time_along_a_turning_line(half, y0, s0, x, slide, we, ae, w
     mv = np.array([slide, 0.0, push, 0.0, wv, 0.0])
     me = np.array([0.0, 0.0, 0.0, 0.0, we, ae])
     vel = mv[:2] + wv * np.array([-rp[1], rp[0]])
-    d2, tau = ka._vertex_edge_time(p0[0], p0[1], vel[0], vel[1], np.hypot(*rp), ra[0], ra[1],
-                                   rb[0], rb[1], np.hypot(*ra), np.hypot(*rb), 0.0, 0.0, 0.0, 0.0,
-                                   we, _kin(mv, me, 0.0, cap), lam, cap, 0.0,
-                                   *(mv[2:4] - me[2:4]))
+    d2, tau = ka._vertex_edge_time((p0[0], p0[1], vel[0], vel[1], np.hypot(*rp)), ra[0], ra[1],
+                                   rb[0], rb[1], np.hypot(*ra), np.hypot(*rb),
+                                   (0.0, 0.0, 0.0, 0.0, we), _kin(mv, me, 0.0, cap), lam, cap,
+                                   0.0)
     assert 0.0 <= tau <= cap
     for t in np.linspace(0.0, tau, 400):
         q = _placed(cv0, mv, rp[None], t)[0]
@@ -230,10 +232,10 @@ def test_touching_step_allows_no_penetration_deeper_than_touch(vx, vy, wa, ax, w
     mb = Motion((0.0, 0.0), (0.0, 0.0), wb, 0.0)
     ra, rb = block.packed[0] - block.centroid, floor.packed[0] - floor.centroid
     lam, touch = 1e-3, 1e-4
-    _, step = ka.pair_step(ra, np.array(block.centroid), ka.edge_table(ra, block.packed[1]), rb,
-                           np.array(floor.centroid), ka.edge_table(rb, floor.packed[1]),
-                           ma.array, mb.array, 0.0, window, lam, lam / 64, np.full(3, -1),
-                           *ka.traversal_stack(), touch)
+    _, step = ka.pair_step((ra, ka.edge_table(ra, block.packed[1])), np.array(block.centroid),
+                           ma.array, (rb, ka.edge_table(rb, floor.packed[1])),
+                           np.array(floor.centroid), mb.array, (0.0, window),
+                           (lam, lam / 64, touch), np.full(3, -1), ka.traversal_stack())
     assert 0.0 <= step <= window
     for t in np.linspace(0.0, step, 40):
         pa, pb = _placed_polygon(block, ma, t), _placed_polygon(floor, mb, t)

@@ -16,7 +16,7 @@ import polycontact as pc
 from polycontact._kernels import contact_geometry as kg
 from polycontact._kernels.convolution import contact_depth_into, depth_buffers
 from polycontact._kernels.depth import box_escape
-from polycontact._kernels.overlap import overlap_moments, where
+from polycontact._kernels.overlap import overlap_moments, overlap_scratch, where
 from polycontact._kernels.poses import centroids, pairwise_sum
 
 SHAPES = [
@@ -27,6 +27,7 @@ SHAPES = [
     pc.Shape([(math.cos(t) * r, math.sin(t) * r) for t, r in
               zip(np.linspace(0, 2 * math.pi, 12, endpoint=False), [1.6, 0.6] * 6)]),
 ]
+
 
 def offset(lo: float, hi: float) -> st.SearchStrategy[float]:
     """Floats in [lo, hi], those nearer 0 than 1e-9 made 0: no offset tiny against the
@@ -50,16 +51,14 @@ def make(spec, frame):
     return s.moved((x * scale + offset * scale, y * scale + offset * scale), a)
 
 
-def moments(a: pc.Shape, b: pc.Shape, eps: float, places=None):
+def moments(a: pc.Shape, b: pc.Shape, eps: float):
+    """The overlap kernel's answer, the point of the boundary it leaves (``acc``) and
+    where it found each vertex of A and of B."""
     (xa, sa), (xb, sb) = a.packed, b.packed
     n = len(xa) + len(xb)
-    acc = np.empty(6)
-    places = places or (np.empty(len(xa), np.int8), np.empty(len(xb), np.int8))
-    got = overlap_moments(xa, sa, xb, sb, eps, np.empty(len(xa), np.bool_),
-                          np.empty(len(xb), np.bool_), np.empty((n * n, 6)),
-                          np.empty(n * n + n + 2), acc, np.empty((len(xb), 4)),
-                          np.empty(2 * len(xb), np.int64), *places)
-    return got, acc
+    scratch = overlap_scratch(len(xa), len(xb), n * n)
+    got = overlap_moments(xa, sa, xb, sb, eps, scratch)
+    return got, scratch[4], (scratch[7], scratch[8])
 
 
 @examples(150)
@@ -85,7 +84,7 @@ def test_centroids_are_the_shape_centroid_to_the_bit(spec, frame):
 def test_overlap_area_and_centroid_equal_shapely_intersection(sa, sb, frame):
     a, b = make(sa, frame), make(sb, frame)
     eps = pc.default_tolerance(a.packed[0], b.packed[0])
-    (area, cx, cy, nc), acc = moments(a, b, eps)
+    (area, cx, cy, nc), acc, _ = moments(a, b, eps)
     inter = a.to_shapely().intersection(b.to_shapely())
     size = max(np.ptp(a.packed[0], axis=0).max(), np.ptp(b.packed[0], axis=0).max())
     perimeter = a.to_shapely().length + b.to_shapely().length
@@ -105,8 +104,7 @@ def test_overlap_area_and_centroid_equal_shapely_intersection(sa, sb, frame):
 def test_the_overlap_walk_knows_where_every_vertex_lies(sa, sb, frame):
     a, b = make(sa, frame), make(sb, frame)
     eps = pc.default_tolerance(a.packed[0], b.packed[0])
-    places = (np.empty(a.n_vertices, np.int8), np.empty(b.n_vertices, np.int8))
-    moments(a, b, eps, places)
+    places = moments(a, b, eps)[2]
     for own, other, got in ((a, b, places[0]), (b, a, places[1])):
         xo, so = other.packed
         want = [where(x, y, xo, so, eps) for x, y in own.packed[0]]
@@ -123,7 +121,7 @@ def test_overlap_of_shared_and_collinear_boundaries():
     for a, b in cases:
         want = a.to_shapely().intersection(b.to_shapely()).area
         for first, second in ((a, b), (b, a)):
-            (area, *_), _ = moments(first, second, 1e-12)
+            (area, *_), _, _ = moments(first, second, 1e-12)
             assert math.isclose(area, want, abs_tol=1e-9), (want, area)
 
 

@@ -171,18 +171,20 @@ def test_speed_bound_bounds_every_vertex_speed(va, aa, wa, ala, vb, ab, wb, alb,
 
 
 def _kernel_args(a, ma, b, mb):
-    return (a.packed[0] - a.centroid, a.packed[1], np.array(a.centroid), ma.array,
-            b.packed[0] - b.centroid, b.packed[1], np.array(b.centroid), mb.array)
+    """``(body_a, motion_a, body_b, motion_b)`` as the search kernels take them."""
+    return ((a.packed[0] - a.centroid, a.packed[1], np.array(a.centroid), a.bounding_radius),
+            ma.array,
+            (b.packed[0] - b.centroid, b.packed[1], np.array(b.centroid), b.bounding_radius),
+            mb.array)
 
 
 def test_exact_search_on_flush_squares():
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     b = sq.moved((3, 0))
-    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
     iv = np.array([[0.0, 5.0]])
     code, hi, lo, contact, its, reached = ki.exact_search(
-        ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb, b.bounding_radius, iv,
-        1e-4, 1e-12, ULPS, 1e-6, 10000)
+        *_kernel_args(sq, Motion(velocity=(1, 0)), b, Motion()), iv,
+        (1e-4, 1e-12, ULPS, 1e-6, 10000))
     assert code == ki.HIT and lo < hi and hi - lo <= 1e-4 and abs(hi - 2.0) <= 1e-4
     assert lo <= 2.0 <= hi and contact <= hi
 
@@ -194,9 +196,8 @@ def test_exact_search_reports_the_budget():
     sq = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
     b = Shape([(-3, -3), (3, -3), (3, 3), (-3, 3)], [[(-1, -1), (-1, 1), (1, 1), (1, -1)]])
     spin = Motion(angular_velocity=1.0)
-    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, spin, b, spin)
-    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
+    out = ki.exact_search(*_kernel_args(sq, spin, b, spin), np.array([[0.0, 1.0]]),
+                          (1e-4, 1e-12, ULPS, 1e-3, 50))
     assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0 and out[5] < 1.0
 
 
@@ -206,9 +207,8 @@ def test_exact_search_follows_a_slide_under_an_overhang():
     # slide is stepped over, and the hit on the leg at t = 0.8 is found in a few steps
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     b = Shape([(0.5, 1), (1.8, 1), (1.8, 0), (2.1, 0), (2.1, 2), (0.5, 2)])
-    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
-    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 1.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
+    out = ki.exact_search(*_kernel_args(sq, Motion(velocity=(1, 0)), b, Motion()),
+                          np.array([[0.0, 1.0]]), (1e-4, 1e-12, ULPS, 1e-3, 50))
     # (an overlap up to the tolerance eps = 1e-12 is contact, so the first penetration
     # beyond it is at 0.8 + eps / v)
     assert out[0] == ki.HIT and out[2] <= 0.8 + 1e-12 <= out[1] and out[1] - out[2] <= 1e-4
@@ -218,9 +218,8 @@ def test_exact_search_follows_a_slide_under_an_overhang():
 def test_exact_search_follows_a_slide_in_few_steps():
     sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     b = Shape([(0.5, 1), (9, 1), (9, 2), (0.5, 2)])   # sliding contact from t = 0
-    ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, Motion(velocity=(1, 0)), b, Motion())
-    out = ki.exact_search(ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb,
-                          b.bounding_radius, np.array([[0.0, 12.0]]), 1e-4, 1e-12, ULPS, 1e-3, 50)
+    out = ki.exact_search(*_kernel_args(sq, Motion(velocity=(1, 0)), b, Motion()),
+                          np.array([[0.0, 12.0]]), (1e-4, 1e-12, ULPS, 1e-3, 50))
     assert out[0] == ki.NO_HIT and out[3] == 0.0 and out[4] < 50
 
 
@@ -237,9 +236,9 @@ def test_slide_time_keeps_the_interiors_apart(va, wa, vb, wb, dx, frac):
     na, nb = edge_table(ra, a.packed[1])[0], edge_table(rb, bar.packed[1])[0]
     mva, mvb, kin, _ = window_kinematics(ma.array, mb.array, 0.0, 1.0)
     # A's vertices against the line of the bar's top edge (edge 2: (3, 0) -> (-1, 0))
-    h = ki.slide_time(a.packed[0], np.array(a.centroid), mva, la, na, bar.packed[0],
-                      np.array(bar.centroid), mvb, nb, bar.bounding_radius, 2, kin, 0.0, 0.0,
-                      1e-12, 1.0, 0.0, 0)
+    h = ki.slide_time((a.packed[0], np.array(a.centroid), mva, la, na, a.bounding_radius),
+                      (bar.packed[0], np.array(bar.centroid), mvb, lb, nb, bar.bounding_radius),
+                      2, kin, 1e-12, 1.0, 0.0, 0)
     assert 0.0 <= h <= 1.0
     if va == vb == (0.0, 0.0) and wa == wb == 0.0:
         assert h == 1.0                 # nothing moves: the whole window
@@ -270,10 +269,8 @@ def test_sampled_search_follows_the_paper_steps():
     b = Shape([(3, 0.5), (4, 0), (4, 1)])
     for n in (2, 3, 10):
         m_a = Motion(velocity=(1, 0.1), angular_velocity=0.3)
-        ra, sa, ca, ma, rb, sb, cb, mb = _kernel_args(sq, m_a, b, Motion())
         code, hi, lo, contact, evals = ki.sampled_search(
-            ra, sa, ca, ma, sq.bounding_radius, rb, sb, cb, mb, b.bounding_radius,
-            np.array([[0.5, 4.0]]), 1e-3, n, 1e-12, ULPS)
+            *_kernel_args(sq, m_a, b, Motion()), np.array([[0.5, 4.0]]), 1e-3, n, 1e-12, ULPS)
         expected = _paper_sampled(sq, m_a, b, Motion(), 0.5, 4.0, n, 1e-3)
         assert code == ki.HIT and math.isclose(hi, expected, abs_tol=1e-12)
 
@@ -281,21 +278,22 @@ def test_sampled_search_follows_the_paper_steps():
 @given(vec, st.floats(-4, 4), vec, st.floats(-4, 4), st.floats(-1, 1), st.floats(0, 1))
 @example((0.0, 0.0), 0.0, (-1.0, 0.0), 0.0, 0.0, 0.9999999999999999)
 def test_pair_step_distance_and_soundness(va, wa, vb, wb, dy, frac):
-    from polycontact._kernels.relation import boundary_distance
+    from polycontact._kernels.distance import boundary_distance
 
     a = Shape([(0, 0), (2, 0.5), (1, 0.7), (0.5, 1.5)])
     b = Shape([(0, 0), (1, 0), (1, 3), (0.5, 1), (0, 3)]).moved((3.0, dy))
     ma, mb = Motion(va, angular_velocity=wa), Motion(vb, angular_velocity=wb)
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     ea, eb = edge_table(ra, a.packed[1]), edge_table(rb, b.packed[1])
-    d, step = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
-                        mb.array, 0.0, 1.0, 0.0, 0.0, np.full(3, -1), *traversal_stack(), 0.0)
+    d, step = pair_step((ra, ea), np.array(a.centroid), ma.array, (rb, eb), np.array(b.centroid),
+                        mb.array, (0.0, 1.0), (0.0, 0.0, 0.0), np.full(3, -1), traversal_stack())
     # the distance is exact up to lam (pairs that cannot matter are skipped): with lam = 0
     # it is never below the gap, and with lam just above the gap it is the gap
     gap = boundary_distance(*a.packed, *b.packed)
     assert d >= gap * (1 - 1e-12)
-    d_lam, _ = pair_step(ra, np.array(a.centroid), ea, rb, np.array(b.centroid), eb, ma.array,
-                         mb.array, 0.0, 1.0, 1.01 * gap, 0.0, np.full(3, -1), *traversal_stack(), 0.0)
+    d_lam, _ = pair_step((ra, ea), np.array(a.centroid), ma.array, (rb, eb),
+                         np.array(b.centroid), mb.array, (0.0, 1.0), (1.01 * gap, 0.0, 0.0),
+                         np.full(3, -1), traversal_stack())
     assert math.isclose(d_lam, gap, rel_tol=1e-12)
     speed = ki.speed_bound(ma.array, a.bounding_radius, mb.array, b.bounding_radius,
                            0.0, 1.0)
@@ -321,7 +319,7 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     """The directional step (both the all-pairs scan and, with 12-point stars, the
     sorted sweep) never lets the boundaries come within lam, with turning, spinning
     and accelerating bodies."""
-    from polycontact._kernels.relation import boundary_distance
+    from polycontact._kernels.distance import boundary_distance
 
     a = _star(n, 1.0, 0.6, 0.1)
     b = _star(n, 0.8, 0.5, 0.3).moved((2.4, dy))
@@ -331,10 +329,10 @@ def test_pair_step_keeps_every_pair_apart(va, aa, wa, ala, vb, wb, alb, dy, wind
     ra, rb = a.packed[0] - a.centroid, b.packed[0] - b.centroid
     lam = 1e-3
     lam_pair = ki.PAIR_GAP * lam
-    d, step = pair_step(ra, np.array(pa.centroid), edge_table(ra, a.packed[1]),
-                        rb, np.array(pb.centroid), edge_table(rb, b.packed[1]),
-                        ma.array, mb.array, t0, t0 + window, lam, lam_pair, np.full(3, -1),
-                        *traversal_stack(), 0.0)
+    d, step = pair_step((ra, edge_table(ra, a.packed[1])), np.array(pa.centroid), ma.array,
+                        (rb, edge_table(rb, b.packed[1])), np.array(pb.centroid), mb.array,
+                        (t0, t0 + window), (lam, lam_pair, 0.0), np.full(3, -1),
+                        traversal_stack())
     gap = boundary_distance(*pa.packed, *pb.packed)
     assume(gap > lam)                  # apart at t0 (the step starts from no contact)
     assert 0.0 <= step <= (t0 + window) - t0 and d >= gap * (1 - 1e-12)
@@ -354,7 +352,7 @@ def test_a_packed_body_unpacks_to_its_arrays(n, holes, offset, radius):
     table = edge_table(r, starts)
     centroid = np.array([offset, -offset])
     f, i = ki.pack_body(r, starts, centroid, radius, table)
-    r2, s2, c2, rad2, table2 = ki._unpack_body(f, i)
+    (r2, s2, c2, rad2), table2 = ki.unpack_body(f, i)
     assert np.array_equal(r2, r) and np.array_equal(s2, starts)
     assert np.array_equal(c2, centroid) and rad2 == radius
     for got, want in zip(table2, table):

@@ -14,7 +14,9 @@ from hypothesis import strategies as st
 from profiles import examples
 
 from polycontact._kernels import decompose
-from polycontact._kernels import nfp as kn
+from polycontact._kernels import fits as kfit
+from polycontact._kernels import minkowski as kmink
+from polycontact._kernels import outline as kout
 
 
 def _packed(polys):
@@ -42,24 +44,24 @@ def convex_polys(draw, grid=4):
 @examples(100)
 @given(convex_polys(), convex_polys())
 def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
-    xy, starts = kn.convex_sums(*_packed([p]), *_packed([q]))
+    xy, starts = kmink.convex_sums(*_packed([p]), *_packed([q]))
     got = shapely.Polygon(xy)
     want = shapely.convex_hull(shapely.MultiPoint((p[:, None, :] + q[None, :, :]).reshape(-1, 2)))
     assert got.is_valid
     assert shapely.symmetric_difference(got, want).area < 1e-12
-    assert kn._ring_stats(xy, starts)[0][0] > 0  # counter-clockwise
+    assert kout.ring_stats(xy, starts)[0][0] > 0  # counter-clockwise
 
 
 @examples(60)
 @given(st.lists(convex_polys(), min_size=2, max_size=4))
 def test_outline_rings_are_the_union(polys):
     xy, starts = _packed(polys)
-    bb = kn._bboxes(xy, starts)
-    fr = kn._frames(xy, starts)
-    outline, loose = kn.edge_cover(xy, starts, bb, fr, 1e-12)
-    ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
+    bb = kmink.boxes(xy, starts)
+    fr = kmink.frames(xy, starts)
+    outline, loose = kout.edge_cover(xy, starts, bb, fr, 1e-12)
+    ok, rxy, rst = kout.assemble_rings(outline, 4e-12)
     assert ok
-    area, _ = kn._ring_stats(rxy, rst)
+    area, _ = kout.ring_stats(rxy, rst)
     want = shapely.union_all([shapely.Polygon(p) for p in polys])
     assert abs(area.sum() - want.area) < 1e-9
     shells = [shapely.Polygon(r) for r, a in zip(_split(rxy, rst), area) if a > 0]
@@ -72,14 +74,14 @@ def test_outline_rings_are_the_union(polys):
 def test_two_squares_sharing_an_edge_have_one_outline_and_a_seam():
     left = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([left, left + [1, 0]])
-    bb = kn._bboxes(xy, starts)
-    fr = kn._frames(xy, starts)
-    outline, loose = kn.edge_cover(xy, starts, bb, fr, 1e-12)
-    ok, rxy, rst = kn.assemble_rings(outline, 4e-12)
+    bb = kmink.boxes(xy, starts)
+    fr = kmink.frames(xy, starts)
+    outline, loose = kout.edge_cover(xy, starts, bb, fr, 1e-12)
+    ok, rxy, rst = kout.assemble_rings(outline, 4e-12)
     assert ok and len(rst) == 2
-    assert kn._ring_stats(rxy, rst)[0][0] == 2.0
+    assert kout.ring_stats(rxy, rst)[0][0] == 2.0
     # the shared edge x = 1 is loose (no open square covers it) and surrounded
-    pts, segs = kn.degenerate_contacts(xy, starts, bb, fr, loose, 1e-12, 1e-9)
+    pts, segs = kfit.degenerate_contacts(xy, starts, bb, fr, loose, 1e-12, 1e-9)
     assert len(pts) == 0
     assert {tuple(sorted([tuple(s[:2]), tuple(s[2:])])) for s in segs} == {((1, 0), (1, 1))}
 
@@ -87,21 +89,21 @@ def test_two_squares_sharing_an_edge_have_one_outline_and_a_seam():
 def test_surrounded_on_an_l_of_three_squares():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1]])
-    bb = kn._bboxes(xy, starts)
-    fr = kn._frames(xy, starts)
-    assert not kn.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)  # reflex corner
-    assert kn.surrounded(0.5, 1.0, starts, bb, fr, 1e-12, 1e-9)  # shared edge
-    assert kn.surrounded(1.0, 0.5, starts, bb, fr, 1e-12, 1e-9)
-    assert not kn.surrounded(0.0, 0.5, starts, bb, fr, 1e-12, 1e-9)  # outline
+    bb = kmink.boxes(xy, starts)
+    fr = kmink.frames(xy, starts)
+    assert not kfit.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)  # reflex corner
+    assert kfit.surrounded(0.5, 1.0, starts, bb, fr, 1e-12, 1e-9)  # shared edge
+    assert kfit.surrounded(1.0, 0.5, starts, bb, fr, 1e-12, 1e-9)
+    assert not kfit.surrounded(0.0, 0.5, starts, bb, fr, 1e-12, 1e-9)  # outline
 
 
 def test_surrounded_at_a_shared_corner_of_four_squares():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy, starts = _packed([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
-    bb = kn._bboxes(xy, starts)
-    fr = kn._frames(xy, starts)
-    assert kn.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
-    assert not kn.surrounded(2.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
+    bb = kmink.boxes(xy, starts)
+    fr = kmink.frames(xy, starts)
+    assert kfit.surrounded(1.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
+    assert not kfit.surrounded(2.0, 1.0, starts, bb, fr, 1e-12, 1e-9)
 
 
 @st.composite
@@ -163,13 +165,13 @@ def test_snap_to_vertices_and_crossings():
                     [1 + e, 0.25],       # on x = 1, sliding along y: no crossing near
                     [5.0, 5.0]])         # far from everything: unchanged
     along = np.array([[0, 0], [0, 0], [1, 0], [0, 1], [0, 0]], float)
-    out = kn.snap(pts, along, xy, starts, 1e-10)
+    out = kfit.snap(pts, along, xy, starts, 1e-10)
     assert out[0].tolist() == [1.0, 1.0]
     assert out[1].tolist() == [1.0, 0.5]
     assert out[2].tolist() == pts[2].tolist() and out[3].tolist() == pts[3].tolist()
     assert out[4].tolist() == [5.0, 5.0]
     # a slide's end near the crossing of x = 0.5 + t with the square's top edge y = 1
-    cross = kn.snap(np.array([[0.7, 1 + e]]), np.array([[1.0, 2.0]]), xy, starts, 1e-10)
+    cross = kfit.snap(np.array([[0.7, 1 + e]]), np.array([[1.0, 2.0]]), xy, starts, 1e-10)
     assert cross[0, 1] == 1.0 and abs(cross[0, 0] - 0.7) < 1e-12
 
 
@@ -181,7 +183,7 @@ def test_merge_collinear():
         [5, 5, 5, 5 + 1e-13],             # shorter than tol: dropped
         [0, 0, 1, 1],                     # meets the first at an angle: stays
     ], float)
-    out = kn.merge_collinear(segs, 1e-10)
+    out = kfit.merge_collinear(segs, 1e-10)
     out = out[np.lexsort(out.T[::-1])]
     assert out.tolist() == [[0, 0, 1, 1], [0, 0, 3, 0], [0, 1, 0, 2], [0, 3, 0, 4]]
 
@@ -200,6 +202,6 @@ def test_ring_pieces_convex_small_and_too_big():
 
 def test_ring_stats_small_ring_far_from_the_origin():
     xy = np.ascontiguousarray(SMALL_FAR_RING)
-    area, length = kn._ring_stats(xy, np.array([0, len(xy)]))
+    area, length = kout.ring_stats(xy, np.array([0, len(xy)]))
     assert area[0] == pytest.approx(shapely.Polygon(xy).area, rel=1e-12)
     assert length[0] == pytest.approx(shapely.LinearRing(xy).length, rel=1e-12)

@@ -13,9 +13,13 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from polycontact import Shape
-from polycontact._kernels import depth as kd
+from polycontact._depth import penetration
+from polycontact._kernels import distance as kdist
+from polycontact._kernels import features as kfeat
 from polycontact._kernels import relation as kr
 from polycontact._kernels import relation_many as km
+from polycontact._kernels import rings as kring
+from polycontact._kernels import sweep as ksweep
 from polycontact.errors import InvalidShapeError
 from polycontact.tolerances import (
     COORDINATE_LIMIT,
@@ -32,6 +36,11 @@ RING = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 def _eps(a: Shape, b: Shape) -> float:
     return default_tolerance(a.packed[0], b.packed[0])
+
+
+def _raw_states(xa: np.ndarray, xb: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`km.raw_states` of rings ``xa`` against ``xb`` with the default tolerance."""
+    return km.raw_states(xa, xb, -1.0, *RING, km.raw_states_outputs(xa.shape[0]))
 
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: c.name)
@@ -52,8 +61,9 @@ def test_relate_state_matches_shapely_on_grid(pair):
 def test_boundary_distance_and_closest_pair(pair):
     a, b, _ = pair
     want = boundary_gap(a, b)
-    assert kr.boundary_distance(*a.packed, *b.packed) == pytest.approx(want, rel=1e-9, abs=1e-12)
-    d, xa, ya, xb, yb = kr.closest_pair(*a.packed, *b.packed)
+    assert kdist.boundary_distance(*a.packed, *b.packed) == pytest.approx(want, rel=1e-9,
+                                                                          abs=1e-12)
+    d, xa, ya, xb, yb = kdist.closest_pair(*a.packed, *b.packed)
     assert np.hypot(xa - xb, ya - yb) == pytest.approx(d, rel=1e-9, abs=1e-12)
     on_a = shapely.distance(shapely.Point(xa, ya), a.to_shapely().boundary)
     on_b = shapely.distance(shapely.Point(xb, yb), b.to_shapely().boundary)
@@ -75,7 +85,7 @@ def test_penetration_of_boxes_is_the_smallest_overlap(corner, size):
         return
     # leave along x: right (bx + wb - ax) or left (ax + wa - bx); same along y
     want = min(bx + wb - ax, ax + wa - bx, by + hb - ay, ay + ha - by)
-    depth, dx, dy = kd.penetration(*a.packed, *b.packed, _eps(a, b))
+    depth, dx, dy = penetration(*a.packed, *b.packed, _eps(a, b))
     assert depth == pytest.approx(want)
     assert np.hypot(dx, dy) == pytest.approx(depth)
     moved = a.packed[0] + np.array([dx, dy])
@@ -88,7 +98,7 @@ def test_penetration_escape_ends_the_overlap(pair):
     eps = _eps(a, b)
     if kr.relate_state(*a.packed, *b.packed, eps) != kr.PENETRATING:
         return
-    depth, dx, dy = kd.penetration(*a.packed, *b.packed, eps)
+    depth, dx, dy = penetration(*a.packed, *b.packed, eps)
     moved = a.packed[0] + np.array([dx, dy])
     assert kr.relate_state(moved, a.packed[1], *b.packed, eps) != kr.PENETRATING
     # the escape is no longer than leaving B's bounding box along an axis
@@ -115,7 +125,7 @@ def _reference_touches(xv: np.ndarray, other: Shape, eps: float) -> set[tuple[in
 def test_features_kernel_against_numpy(pair):
     a, b, _ = pair
     eps = _eps(a, b)
-    a_on, b_on, a_in, b_in, cross = kr.features(*a.packed, *b.packed, eps)
+    a_on, b_on, a_in, b_in, cross = kfeat.features(*a.packed, *b.packed, eps)
     assert {(v, e) for v, e, _ in a_on} == _reference_touches(a.packed[0], b, eps)
     assert {(v, e) for v, e, _ in b_on} == _reference_touches(b.packed[0], a, eps)
     pb, pa = b.to_shapely(), a.to_shapely()
@@ -135,7 +145,7 @@ def test_sort_into_orders_rows_by_xmin(keys):
     box = np.zeros((len(keys), 4))
     box[:, 0] = keys
     order = np.empty(len(keys), np.int64)
-    kr._sort_into(box, len(keys), order, np.empty(len(keys) + 1, np.int64))
+    ksweep.sort_into(box, len(keys), order, np.empty(len(keys) + 1, np.int64))
     assert sorted(order.tolist()) == list(range(len(keys)))
     assert np.all(np.diff(box[order, 0]) >= 0)
 
@@ -158,19 +168,19 @@ def test_long_ring_sweep_agrees_with_all_pairs(radii, snap, swap):
     n = len(ring)
     eps = default_tolerance(ring)
     folds = any(
-        kr._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n)
+        kring._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n)
     )
-    expected = not folds and kr._small_ring_is_simple(ring, n, eps)
-    assert kr._ring_is_simple(ring, n, eps) == expected
-    rows = kr._sorted_edge_boxes(ring, n)
+    expected = not folds and kring._small_ring_is_simple(ring, n, eps)
+    assert kring._ring_is_simple(ring, n, eps) == expected
+    rows = ksweep.sorted_edge_boxes(ring, n)
     assert sorted(rows[:, 4].astype(int).tolist()) == list(range(n))
     assert np.all(np.diff(rows[:, 0]) >= 0)
 
 
 def _full_ring_check(ring, eps):
     n = len(ring)
-    folds = any(kr._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n))
-    return not folds and kr._small_ring_is_simple(ring, n, eps)
+    folds = any(kring._folds(*ring[i - 1], *ring[i], *ring[(i + 1) % n], eps) for i in range(n))
+    return not folds and kring._small_ring_is_simple(ring, n, eps)
 
 
 @given(
@@ -193,7 +203,7 @@ def test_star_certificate_is_never_wrong(steps, turns, shift, scale, clockwise):
     if clockwise:
         ring = ring[::-1].copy()
     eps = default_tolerance(ring)
-    if kr._star_ring_is_simple(ring, len(ring), eps):
+    if kring._star_ring_is_simple(ring, len(ring), eps):
         assert _full_ring_check(ring, eps)
         assert shapely.Polygon(ring).is_valid
 
@@ -208,14 +218,14 @@ def test_star_certificate_fires_on_convex_and_star_rings():
     for ring, certified in ((convex, True), (star, True), (convex[::-1], True),
                             (pentagram, False), (comb, False)):
         eps = default_tolerance(ring)
-        assert kr._star_ring_is_simple(ring, len(ring), eps) == certified
-        assert kr._ring_is_simple(ring, len(ring), eps) == _full_ring_check(ring, eps)
+        assert kring._star_ring_is_simple(ring, len(ring), eps) == certified
+        assert kring._ring_is_simple(ring, len(ring), eps) == _full_ring_check(ring, eps)
 
 
 @given(st.lists(st.tuples(st.integers(-4, 4), st.integers(-4, 4)), min_size=3, max_size=9))
 def test_raw_ring_agrees_with_shape(points):
     ring = np.array(points, dtype=float)
-    n, sign, eps, box = kr._raw_ring(ring, *RING)
+    n, sign, eps, box = kring.raw_ring(ring, *RING)
     try:
         shape = Shape(ring)
     except InvalidShapeError:
@@ -232,12 +242,12 @@ def test_raw_ring_agrees_with_shape(points):
 def test_classify_raw_orientation_and_codes():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
-    assert kr.classify_raw(sq, sq[::-1] + 1.0, -1.0, *RING)[0] == kr.CONTACT
-    assert kr.classify_raw(sq, sq[::-1] + 0.5, -1.0, *RING)[0] == kr.PENETRATING
-    assert kr.classify_raw(bow, sq, -1.0, *RING)[0] == -1
-    assert kr.classify_raw(sq, bow, -1.0, *RING)[0] == -2
+    assert kring.classify_raw(sq, sq[::-1] + 1.0, -1.0, *RING)[0] == kr.CONTACT
+    assert kring.classify_raw(sq, sq[::-1] + 0.5, -1.0, *RING)[0] == kr.PENETRATING
+    assert kring.classify_raw(bow, sq, -1.0, *RING)[0] == -1
+    assert kring.classify_raw(sq, bow, -1.0, *RING)[0] == -2
     closed = np.vstack([sq, sq[:1]])
-    code, eps, na, fa, nb, fb = kr.classify_raw(closed, sq[::-1] + 3.0, 0.5, *RING)
+    code, eps, na, fa, nb, fb = kring.classify_raw(closed, sq[::-1] + 3.0, 0.5, *RING)
     assert (code, eps, na, fa, nb, fb) == (kr.SEPARATE, 0.5, 4, 1.0, 4, -1.0)
 
 
@@ -261,7 +271,7 @@ def test_many_kernels_match_single(many):
     dist = km.many_distances(*pa, *pb, states, eps)
     for d, s, a, b in zip(dist, states, sa, sb):
         if s == kr.SEPARATE:
-            assert d == pytest.approx(kr.boundary_distance(*a.packed, *b.packed))
+            assert d == pytest.approx(kdist.boundary_distance(*a.packed, *b.packed))
         elif s == kr.CONTACT:
             assert d == 0.0
         else:
@@ -281,25 +291,24 @@ def test_raw_states_matches_single_pairs(many, closed):
         ra, rb = rows(a), rows(b)
         xa = np.stack([ra[0], ra[1], ra[0], ra[1]])
         xb = np.stack([rb[0], rb[0], rb[1], rb[1]])
-        got = km.raw_states(xa, xb, -1.0, *RING)
+        got = _raw_states(xa, xb)
         for p in range(4):
-            want = kr.classify_raw(xa[p], xb[p], -1.0, *RING)
+            want = kring.classify_raw(xa[p], xb[p], -1.0, *RING)
             assert tuple(g[p] for g in got) == want
 
 
 def test_raw_states_flags_invalid_rings():
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     bow = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
-    states, _, used_a, _, used_b, _ = km.raw_states(
-        np.stack([sq, bow, sq]), np.stack([sq + 0.5, sq, bow]), -1.0, *RING
-    )
+    states, _, used_a, _, used_b, _ = _raw_states(np.stack([sq, bow, sq]),
+                                                  np.stack([sq + 0.5, sq, bow]))
     assert states.tolist() == [2, -1, -1]
     assert used_a.tolist() == [4, -1, 4] and used_b.tolist() == [4, 4, -1]
     # a lopsided bow-tie (nonzero signed area, clockwise by it): invalid, with the sign
     # _raw_ring gives an invalid ring, whichever way its area turns
     lop = np.array([[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 1.0]])
-    _, _, used_a, sign_a, _, _ = km.raw_states(lop[None], sq[None], -1.0, *RING)
-    assert used_a[0] == -1 and sign_a[0] == kr._raw_ring(lop, *RING)[1] == 1.0
+    _, _, used_a, sign_a, _, _ = _raw_states(lop[None], sq[None])
+    assert used_a[0] == -1 and sign_a[0] == kring.raw_ring(lop, *RING)[1] == 1.0
 
 
 def _comb(teeth: int) -> np.ndarray:
@@ -319,19 +328,19 @@ def test_raw_states_long_rings_that_need_the_sweep():
     star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(len(t)) % 2, 3.0, 2.0)[:, None]
     xa = np.stack([comb, comb, star, crossed, star])
     xb = np.stack([comb + [0.25, 0.5], star + [12.0, 0.0], comb, star, crossed])
-    states, eps, used_a, sign_a, used_b, sign_b = km.raw_states(xa, xb, -1.0, *RING)
+    states, eps, used_a, sign_a, used_b, sign_b = _raw_states(xa, xb)
     assert states.tolist()[3:] == [-1, -1]
     assert used_a.tolist()[3] == -1 and used_b.tolist()[4] == -1
-    assert sign_a[3] == kr._raw_ring(crossed, *RING)[1] == sign_b[4]
+    assert sign_a[3] == kring.raw_ring(crossed, *RING)[1] == sign_b[4]
     for p in range(3):
-        want = kr.classify_raw(xa[p], xb[p], -1.0, *RING)
+        want = kring.classify_raw(xa[p], xb[p], -1.0, *RING)
         assert (states[p], eps[p], used_a[p], sign_a[p], used_b[p], sign_b[p]) == want
     assert states.tolist()[:3] == [2, 0, 2]
 
 
 def test_raw_ring_small_ring_far_from_the_origin():
     # area 2e-4 at (82, 70): valid, counter-clockwise, its box exact
-    n, sign, eps, box = kr._raw_ring(SMALL_FAR_RING, *RING)
+    n, sign, eps, box = kring.raw_ring(SMALL_FAR_RING, *RING)
     assert (n, sign) == (len(SMALL_FAR_RING), 1.0)
     assert box[1] == SMALL_FAR_RING[:, 0].max() and eps == default_tolerance(SMALL_FAR_RING)
 
@@ -348,12 +357,12 @@ def test_kernel_tolerance_is_the_python_formula(extent, magnitude):
 @given(pairs(holes=False))
 def test_pair_tolerance_is_default_tolerance(pair):
     a, b, _ = pair
-    na, _, _, ba = kr._raw_ring(a.exterior, *RING)
-    nb, _, _, bb = kr._raw_ring(b.exterior, *RING)
+    na, _, _, ba = kring.raw_ring(a.exterior, *RING)
+    nb, _, _, bb = kring.raw_ring(b.exterior, *RING)
     assert na > 0 and nb > 0
     want = default_tolerance(a.exterior, b.exterior)
-    assert kr.pair_tolerance(ba, bb, RELATIVE_TOLERANCE, ROUNDING_ULPS) == want
-    assert kr.classify_raw(a.exterior, b.exterior, -1.0, *RING)[1] == want
+    assert kring.pair_tolerance(ba, bb, RELATIVE_TOLERANCE, ROUNDING_ULPS) == want
+    assert kring.classify_raw(a.exterior, b.exterior, -1.0, *RING)[1] == want
 
 
 def test_raw_ring_refuses_out_of_range_without_overflow():
@@ -362,6 +371,6 @@ def test_raw_ring_refuses_out_of_range_without_overflow():
     # products of coordinates, which overflowed at 1e90 and underflowed at 1e-90)
     with np.errstate(all="raise"):
         for ring in (sq * 1e200, sq * 1e-300, sq + [np.nan, 0.0], sq + [0.0, np.inf]):
-            assert kr._raw_ring(ring, *RING)[0] == -1
-        assert kr._raw_ring(sq * 1e-90, *RING)[0] == 4
-        assert kr._raw_ring(sq * 1e90, *RING)[0] == 4
+            assert kring.raw_ring(ring, *RING)[0] == -1
+        assert kring.raw_ring(sq * 1e-90, *RING)[0] == 4
+        assert kring.raw_ring(sq * 1e90, *RING)[0] == 4

@@ -20,6 +20,8 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact import Shape
+from polycontact._kernels import packs as kpack
+from polycontact._kernels import primitives as kprim
 from polycontact._kernels import relation as kr
 from polycontact.tolerances import default_tolerance
 
@@ -29,12 +31,12 @@ FACTORS = (0.0, 0.5, 1.0 - 1e-6, 1.0, 1.0 + 1e-12, 1.0 + 1e-9, 1.0 + 1e-6, 1.0 +
 
 
 def _states(xa, sa, xb, sb, eps):
-    """(``_apart`` fired, ``_state_in``, the full test) for one pair and tolerance."""
+    """(``_apart`` fired, ``state_in``, the full test) for one pair and tolerance."""
     na, nb = sa[-1], sb[-1]
-    ba, bb = kr._bbox(xa, na), kr._bbox(xb, nb)
-    scratch = kr._scratch(na + nb)
-    fast = kr._state_in(xa, sa, 1.0, xb, sb, 1.0, eps, *scratch)
-    full = kr._overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, *scratch)
+    ba, bb = kprim.bbox(xa, na), kprim.bbox(xb, nb)
+    scratch = kpack.state_scratch(na + nb)
+    fast = kr.state_in(xa, sa, 1.0, xb, sb, 1.0, eps, scratch)
+    full = kr._overlap_state(xa, sa, 1.0, xb, sb, 1.0, eps, ba, bb, scratch)
     return bool(kr._apart(xa, na, xb, nb, ba, bb, eps)), fast, full
 
 
@@ -161,13 +163,13 @@ def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
     """A pair of more than STACK_VERTICES vertices gets -1 (classify then calls
     relate_state), never a state computed in a scratch too small; pairs whose boxes are
     apart need no scratch and are separate at once."""
-    assert kr._STACK_FLOATS == kr.scratch_floats(kr.STACK_VERTICES)  # the stack's size
-    t = np.linspace(0.0, 2.0 * np.pi, kr.STACK_VERTICES // 2 + 1, endpoint=False)
+    assert kpack.STACK_FLOATS == kpack.scratch_floats(kpack.STACK_VERTICES)  # the stack's size
+    t = np.linspace(0.0, 2.0 * np.pi, kpack.STACK_VERTICES // 2 + 1, endpoint=False)
     big = Shape(np.c_[np.cos(t), np.sin(t)])
     assert kr.relate_shapes_into(big._kernel, big._kernel, 1e-12) == -1
     assert kr.relate_shapes_into(big._kernel, big.moved((3, 0))._kernel, 1e-12) == kr.SEPARATE
     fits = Shape(np.c_[np.cos(t[:-1]), np.sin(t[:-1])])
-    assert fits.n_vertices * 2 == kr.STACK_VERTICES
+    assert fits.n_vertices * 2 == kpack.STACK_VERTICES
     assert kr.relate_shapes_into(fits._kernel, fits._kernel, 1e-12) == kr.PENETRATING
     r = pc.classify(big, big)  # the default tolerance on the allocating path
     assert r.state is pc.State.PENETRATING and r.tolerance == big._tolerance
@@ -180,9 +182,9 @@ def test_kernel_pack_is_the_shape(pair):
     tolerance term (what relate_shapes_into reads instead of computing them), cannot be
     written, and its numbers are aligned."""
     for shape in pair[:2]:
-        xy, starts, box, tol = kr._unpack(shape._kernel)
+        xy, starts, box, tol = kpack.unpack_shape(shape._kernel)
         assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
-        assert box == kr._bbox(shape.packed[0], shape.n_vertices)
+        assert box == kprim.bbox(shape.packed[0], shape.n_vertices)
         assert tol == shape._tolerance
         assert type(shape._kernel) is bytes  # immutable by its type
         # the kernel reads float64 and int64 from the bytes' own storage: 8-byte aligned
@@ -192,8 +194,8 @@ def test_kernel_pack_is_the_shape(pair):
 
 def test_scratch_views_do_not_overlap():
     size = 13
-    buf = np.zeros(kr.scratch_floats(size))
-    box, ids, touch, rays, rord = kr._scratch_views(buf, size)
+    buf = np.zeros(kpack.scratch_floats(size))
+    box, ids, touch, rays, rord = kpack.state_scratch_views(buf, size)
     assert box.shape == (size + 1, 4) and ids.shape == (size + 1, 4)
     assert rays.shape == (2 * size + 2, 6) and rord.shape == (2 * size + 2,)
     assert touch.shape[0] >= size + 1

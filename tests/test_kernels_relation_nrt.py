@@ -3,10 +3,10 @@ they share with reference-counted kernels.
 
 A helper called from an ``_nrt=False`` kernel before anything else compiled it is
 compiled (and cached) without reference counting; if it returns new views, every
-reference-counted caller that uses it afterwards (``_scratch``, hence ``relate_state``,
-the World's kernels, ...) drops the views' buffer too early and frees it while in use.
-Such helpers are inlined (``_scratch_views``). The test runs in a subprocess with an
-empty cache of its own, so the compile order is the one it sets.
+reference-counted caller that uses it afterwards (``state_scratch``, hence
+``relate_state``, the World's kernels, ...) drops the views' buffer too early and frees
+it while in use. Such helpers are inlined (``state_scratch_views``). The test runs in a
+subprocess with an empty cache of its own, so the compile order is the one it sets.
 """
 
 from __future__ import annotations
@@ -25,12 +25,13 @@ SRC = Path(polycontact.__file__).resolve().parents[1]
 CODE = """
 import numpy as np
 from polycontact import Shape
+from polycontact._kernels import packs as kpack
 from polycontact._kernels import relation as kr
 a = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 b = a.moved((1.0, 0.5))
 # the scratch-passing kernel first: its helpers are compiled from it
 print(kr.relate_shapes_into(a._kernel, b._kernel, 1e-12))
-views = kr._scratch(8)
+views = kpack.state_scratch(8)
 print([v.base.refcount for v in views])  # one reference per view
 got = [kr.relate_state(*a.packed, *a.moved(d).packed, 1e-12)
        for d in ((1.0, 0.5), (0.5, 0.5), (3.0, 0.0)) for _ in range(50)]

@@ -19,8 +19,13 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact import nfp as nfp_module
+from polycontact._kernels import fits as kfit
+from polycontact._kernels import minkowski as kmink
 from polycontact._kernels import nfp as kn
-from polycontact.tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
+from polycontact._kernels import outline as kout
+from polycontact.limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
+                               MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                               SNAP_FACTOR)
 
 @pytest.fixture(autouse=True)
 def no_geos_fallback():
@@ -31,9 +36,9 @@ def no_geos_fallback():
     assert nfp_module.fallback_count() == before, "the GEOS fallback built some region"
 
 
-ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, nfp_module.ANGLE_TOLERANCE)
+ARGS = (-1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS, ANGLE_TOLERANCE)
 # the candidates' snapping and merging factors of the packed answers
-EXACT = (nfp_module._SNAP_FACTOR, nfp_module.HOLE_WIDTH_FACTOR)
+EXACT = (SNAP_FACTOR, HOLE_WIDTH_FACTOR)
 
 
 def star(n: int, seed: int, centre=(0.0, 0.0), lo=0.6, hi=3.0) -> np.ndarray:
@@ -60,7 +65,7 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     axy, ast = nfp_module._convex_pieces(a)
     want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT)
     head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS, *EXACT,
-                                 nfp_module._EAR_CLIPPING_MAX, nfp_module.MAX_SUM_VERTICES)
+                                 EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
     assert head[0] == 1.0
     assert head == want_head
     np.testing.assert_array_equal(got, want)
@@ -104,7 +109,7 @@ def _check_packed(bxy, bst, r, ast):
     ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
     assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
     if len(cand):
-        cand = _exact_candidates(cand, int(n_pts), *kn.convex_sums(bxy, bst, r, ast), eps)
+        cand = _exact_candidates(cand, int(n_pts), *kmink.convex_sums(bxy, bst, r, ast), eps)
     assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
     for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
                     (ring_xy, ring_starts, stats, cand)):
@@ -115,11 +120,11 @@ def _check_packed(bxy, bst, r, ast):
 
 def _exact_candidates(cand, n_pts, sums, starts, eps):
     snap_tol, near = (f * eps for f in EXACT)
-    pts = kn.snap(cand[:n_pts, :2], np.zeros((n_pts, 2)), sums, starts, snap_tol)
+    pts = kfit.snap(cand[:n_pts, :2], np.zeros((n_pts, 2)), sums, starts, snap_tol)
     segs = cand[n_pts:]
     along = np.repeat(segs[:, 2:] - segs[:, :2], 2, axis=0)
-    ends = kn.snap(segs.reshape(-1, 2), along, sums, starts, snap_tol)
-    merged = kn.merge_collinear(ends.reshape(-1, 4), near)
+    ends = kfit.snap(segs.reshape(-1, 2), along, sums, starts, snap_tol)
+    merged = kfit.merge_collinear(ends.reshape(-1, 4), near)
     merged = merged[np.lexsort(merged.T[::-1])]
     return np.vstack([np.hstack([pts, pts]), merged])
 
@@ -150,7 +155,7 @@ def test_each_path_is_taken_and_right(monkeypatch, case):
         b = pc.Shape(star(9, 2, (1.0, 0.5), 2.0), [star(5, 3, (1.0, 0.5), 0.3, 0.5)[::-1]])
         want_path = {"ring": 0, "pieces": 1}
     elif case == "large ring":  # beyond ear clipping: GEOS's pieces
-        b = pc.Shape(star(nfp_module._EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
+        b = pc.Shape(star(EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
         want_path = {"ring": 1, "pieces": 1}
     elif case == "budget":  # the ring kernel declines, the pieces path refuses
         monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
@@ -175,7 +180,7 @@ def test_outline_with_and_without_the_grid(n_sums):
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
     k = (len(bst) - 1) * (len(ast) - 1)
-    assert (k >= kn._GRID_MIN_SUMS) == (n_sums >= kn._GRID_MIN_SUMS)
+    assert (k >= kmink.GRID_MIN_SUMS) == (n_sums >= kmink.GRID_MIN_SUMS)
     nfp = pc.no_fit_polygon(a, b)
     ref = reference_region(a.to_shapely(), b.to_shapely(), nfp.reference)
     assert same_region(nfp.region, ref) is None
@@ -190,13 +195,13 @@ def test_distance_to_segments_is_shapely_s(n_pts, n_segs, seed):
     segs = rng.uniform(-3, 3, (n_segs, 2, 2))
     want = [min(shapely.distance(shapely.Point(q), shapely.LineString(s)) for s in segs)
             for q in p]
-    np.testing.assert_allclose(kn.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(kfit.distance_to_segments(p, segs), want, rtol=1e-12, atol=1e-15)
 
 
 def _former_selection(pts, pts_ok, segs, segs_ok, near):
     """The Python steps select_contacts replaced (the former nfp._clean_degenerate)."""
     slides = segs[segs_ok].reshape(-1, 2, 2)
-    on_slide = (kn.distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
+    on_slide = (kfit.distance_to_segments(pts, slides) <= near if len(slides) and len(pts)
                 else np.zeros(len(pts), dtype=bool))
     fits = []
     for p, skip, ok_p in zip(pts, on_slide.tolist(), pts_ok):
@@ -223,7 +228,7 @@ def test_selected_contacts_are_the_former_python_steps_bit_for_bit(n_pts, n_segs
         pts[0] = segs[0, :2] + 0.5 * near  # a fit at a slide's end
     pts_ok = rng.random(n_pts) < 0.7
     segs_ok = rng.random(n_segs) < 0.6
-    fits, slides = kn.select_contacts(pts, pts_ok, segs, segs_ok, near)
+    fits, slides = kfit.select_contacts(pts, pts_ok, segs, segs_ok, near)
     want_fits, want_slides = _former_selection(pts, pts_ok, segs, segs_ok, near)
     assert fits.shape == want_fits.shape and slides.shape == want_slides.shape
     np.testing.assert_array_equal(fits, want_fits)
@@ -268,7 +273,7 @@ def _former_assembly(segs, tol):
     n = len(seg)
     order = np.argsort(seg[:, 0], kind="stable")
     sx = seg[order, 0]
-    nxt = [kn._first_clockwise(seg, order, sx, np.searchsorted(sx, seg[r, 2] - tol), r, tol)
+    nxt = [kout._first_clockwise(seg, order, sx, np.searchsorted(sx, seg[r, 2] - tol), r, tol)
            for r in range(n)]
     assert min(nxt, default=0) >= 0 and len(set(nxt)) == n
     xy, starts, seen = [], [0], set()
@@ -281,7 +286,7 @@ def _former_assembly(segs, tol):
         if len(xy) > starts[-1]:
             starts.append(len(xy))
     xy = np.array(xy).reshape(-1, 2)
-    return xy, kn._split_pinched(xy, np.array(starts, np.int64), tol)
+    return xy, kout._split_pinched(xy, np.array(starts, np.int64), tol)
 
 
 @examples(60)
@@ -293,9 +298,9 @@ def test_rings_are_linked_as_by_the_clockwise_rule_bit_for_bit(cells):
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy = np.concatenate([sq + c for c in cells])
     starts = np.arange(0, 4 * len(cells) + 1, 4, dtype=np.int64)
-    outline, _ = kn.edge_cover(xy, starts, kn._bboxes(xy, starts), kn._frames(xy, starts),
+    outline, _ = kout.edge_cover(xy, starts, kmink.boxes(xy, starts), kmink.frames(xy, starts),
                                1e-12)
-    ok, got_xy, got_starts = kn.assemble_rings(outline, 4e-12)
+    ok, got_xy, got_starts = kout.assemble_rings(outline, 4e-12)
     assert ok
     want_xy, want_starts = _former_assembly(outline, 4e-12)
     np.testing.assert_array_equal(got_xy, want_xy)
@@ -330,16 +335,16 @@ def test_may_be_surrounded_is_false_only_where_not_surrounded(sums, seed):
     # middles and lattice points (shared corners and edges, outline vertices), in
     # every direction (along the edges too), never False where surrounded is True
     xy, starts = sums
-    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
-    eps, ang = 1e-12, nfp_module.ANGLE_TOLERANCE
+    bb, fr = kmink.boxes(xy, starts), kmink.frames(xy, starts)
+    eps, ang = 1e-12, ANGLE_TOLERANCE
     rng = np.random.default_rng(seed)
     pts = np.vstack([xy, 0.5 * (xy + np.roll(xy, -1, axis=0)),
                      rng.integers(0, 4, (8, 2)) + rng.choice([0.0, 0.5, 3e-13], (8, 2))])
     rejected = 0
     for px, py in pts:
-        around = kn.surrounded(px, py, starts, bb, fr, eps, ang)
+        around = kfit.surrounded(px, py, starts, bb, fr, eps, ang)
         for vx, vy in DIRECTIONS:
-            may = kn._may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang)
+            may = kfit.may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang)
             assert may or not around, (px, py, vx, vy)
             rejected += not may
     assert rejected > 0  # (outline vertices at least: the pre-test does reject)
@@ -349,11 +354,11 @@ def test_may_be_surrounded_at_a_corner_of_four_squares_and_of_one():
     sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
     xy = np.concatenate([sq, sq + [1, 0], sq + [0, 1], sq + [1, 1]])
     starts = np.arange(0, 17, 4, dtype=np.int64)
-    bb, fr = kn._bboxes(xy, starts), kn._frames(xy, starts)
-    args = (starts, bb, fr, 1e-12, nfp_module.ANGLE_TOLERANCE)
+    bb, fr = kmink.boxes(xy, starts), kmink.frames(xy, starts)
+    args = (starts, bb, fr, 1e-12, ANGLE_TOLERANCE)
     for v in DIRECTIONS:  # the shared corner: every direction is entered
-        assert kn._may_be_surrounded(1.0, 1.0, *v, *args)
-    assert kn._may_be_surrounded(2.0, 1.0, -1.0, 0.0, *args)  # (surrounded says no)
-    assert not kn._may_be_surrounded(2.0, 1.0, 1.0, 0.0, *args)  # outline: out of it
-    assert not kn._may_be_surrounded(2.0, 2.0, 1.0, 1.0, *args)
-    assert not kn._may_be_surrounded(2.0, 2.0, 0.0, 0.0, *args)  # no direction: (1, 0)
+        assert kfit.may_be_surrounded(1.0, 1.0, *v, *args)
+    assert kfit.may_be_surrounded(2.0, 1.0, -1.0, 0.0, *args)  # (surrounded says no)
+    assert not kfit.may_be_surrounded(2.0, 1.0, 1.0, 0.0, *args)  # outline: out of it
+    assert not kfit.may_be_surrounded(2.0, 2.0, 1.0, 1.0, *args)
+    assert not kfit.may_be_surrounded(2.0, 2.0, 0.0, 0.0, *args)  # no direction: (1, 0)

@@ -363,12 +363,12 @@ def test_prebuilt_shapes_in_threads_and_above_the_scratch():
     # same answer
     from concurrent.futures import ThreadPoolExecutor
 
-    from polycontact._kernels import relation as kr
+    from polycontact._kernels import packs as kpack
 
     t = np.linspace(0.0, 2.0 * np.pi, 300, endpoint=False)
     ring = np.c_[np.cos(t), np.sin(t)] * (1.0 + 0.2 * np.sin(7 * t))[:, None]
     big = Shape(ring)
-    assert 2 * big.n_vertices > kr.STACK_VERTICES
+    assert 2 * big.n_vertices > kpack.STACK_VERTICES
     shapes = [Shape(ring[::20] + [0.5 * k, 0.0]) for k in range(8)] + [big, big.moved((1.9, 0))]
     jobs = [(a, b) for a in shapes for b in shapes]
     want = [classify(a.packed[0], b.packed[0]).state for a, b in jobs]

@@ -3,7 +3,8 @@
 ``json.loads`` raises ``RecursionError`` on deeply nested arrays and a plain
 ``ValueError`` on an integer longer than Python converts; the structures polycontact
 reads (bodies, scenes, layouts, instances, cache indexes) are never more than a few
-levels deep, so anything deeper than :data:`MAX_DEPTH` is refused before it is walked.
+levels deep, so anything deeper than :data:`polycontact.limits.JSON_MAX_DEPTH` is refused
+before it is walked.
 
 >>> load_json('{"t_max": 5, "bodies": []}')
 {'t_max': 5, 'bodies': []}
@@ -18,27 +19,27 @@ from __future__ import annotations
 import json
 from typing import Any
 
-__all__ = ["MAX_DEPTH", "load_json"]
+from .limits import JSON_MAX_DEPTH
 
-#: The deepest nesting of arrays and objects accepted (a GeoJSON polygon is 4 deep).
-MAX_DEPTH = 32
+__all__ = ["load_json"]
 
 
 def load_json(text: str | bytes) -> Any:
     """The value of JSON ``text``; ``ValueError`` with the reason if it is not JSON, holds
-    an integer too long to convert, or is nested deeper than :data:`MAX_DEPTH`."""
+    an integer too long to convert, or is nested deeper than
+    :data:`polycontact.limits.JSON_MAX_DEPTH`."""
     try:
         data = json.loads(text)
     except RecursionError:
-        raise ValueError(f"nested deeper than {MAX_DEPTH} levels") from None
+        raise ValueError(f"nested deeper than {JSON_MAX_DEPTH} levels") from None
     except ValueError as exc:  # a JSONDecodeError, or an integer too long to convert
         raise ValueError(str(exc)) from None
     level = [data] if isinstance(data, (list, dict)) else []
     depth = 0
     while level:
         depth += 1
-        if depth > MAX_DEPTH:
-            raise ValueError(f"nested deeper than {MAX_DEPTH} levels")
+        if depth > JSON_MAX_DEPTH:
+            raise ValueError(f"nested deeper than {JSON_MAX_DEPTH} levels")
         level = [v for item in level for v in (item.values() if isinstance(item, dict) else item)
                  if isinstance(v, (list, dict))]
     return data

@@ -23,14 +23,10 @@ from ._checks import finite_number
 from .motion import Motion
 from .bodies import BodyLike, as_shape
 from .shape import Shape
-from .tolerances import COORDINATE_LIMIT, check_range
+from .limits import BROAD_PHASE_INFLATION, COORDINATE_LIMIT
+from .tolerances import check_range
 
 __all__ = ["broad_phase_intervals", "BROAD_PHASE_INFLATION"]
-
-#: The sum of the radii is enlarged by this relative amount before solving, so that
-#: rounding in the quartic's coefficients cannot drop an instant at which the circles
-#: exactly graze (a double root): the intervals are conservative, never too short.
-BROAD_PHASE_INFLATION = 1e-12
 
 
 def check_t_max(t_max: Any) -> float:

@@ -1,22 +1,20 @@
-"""Compiling the kernels: where Numba's cache goes, whether it is warm, and warm-up.
+"""Compiling the kernels: whether the cache is warm, and warm-up.
 
 polycontact's kernels are compiled by Numba on first use and cached on disk. The first
 run on a new machine (or after an upgrade) therefore takes about a minute; every run
 after it loads the compiled code in well under a second.
 
-**Where the cache goes.** Numba's default would write it beside the installed sources
-(``site-packages/polycontact``), where ``pip uninstall`` leaves it behind. polycontact
-puts its own kernels' cache in the per-user cache directory instead
-(``platformdirs.user_cache_dir("polycontact")``, e.g. ``~/.cache/polycontact/numba`` on
-Linux). Setting ``NUMBA_CACHE_DIR`` overrides this for every Numba library, as Numba
-documents; other libraries' caches are never moved by polycontact. Either way the
-kernels go in a subdirectory named after a hash of all the kernels' sources
-(:func:`kernel_sources_fingerprint`), since Numba tracks only each function's own file.
+**Where the cache goes.** In the per-user cache directory (:func:`cache_directory`,
+e.g. ``~/.cache/polycontact/numba`` on Linux; ``NUMBA_CACHE_DIR`` overrides it for
+every Numba library), in a subdirectory named after a hash of all the kernels' sources
+(:func:`kernel_sources_fingerprint`); see :mod:`polycontact._kernels.cache`.
 
 **First run.** :func:`warmup` compiles (or loads) every kernel family and reports each
 stage to a callback; the command line says "compiling kernels, first run only, about a
 minute" on stderr before a command whose kernels are not cached yet, with one line per
 stage (``polycontact warmup`` does it on purpose), so stdout stays parseable.
+
+This module is the top of the package: :func:`warmup` calls every public function.
 
 Examples
 --------
@@ -29,112 +27,29 @@ True
 
 from __future__ import annotations
 
-import hashlib
-import os
+import importlib
 import time
 from collections.abc import Callable, Iterable
-from pathlib import Path
 from typing import Any
+
+from ._kernels.cache import cache_directory, kernel_sources_fingerprint
 
 __all__ = ["FAMILIES", "cache_directory", "is_warm", "kernel_sources_fingerprint", "warmup"]
 
 #: Kernel families, each with the kernels a warm cache must hold for it.
 FAMILIES: dict[str, tuple[str, ...]] = {
     "classification": ("relation.relate_shapes_into", "relation.relate_state",
-                       "relation.classify_raw", "depth.contact_depths"),
+                       "rings.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
-    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "nfp.touching_contacts",
-                       "nfp.select_contacts"),
+    "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
+                       "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
 }
 
-_PACKAGE = Path(__file__).resolve().parent
-
-
-def cache_directory() -> Path:
-    """The directory that holds polycontact's compiled kernels.
-
-    ``NUMBA_CACHE_DIR`` when it is set (Numba's own override), else the per-user cache
-    directory of polycontact.
-    """
-    override = os.environ.get("NUMBA_CACHE_DIR")
-    if override:
-        return Path(override)
-    import platformdirs
-
-    return Path(platformdirs.user_cache_dir("polycontact")) / "numba"
-
-
-def kernel_sources_fingerprint(directory: Path | None = None) -> str:
-    """A hash of the sources of every kernel module (``directory``: the ``_kernels``
-    package by default), part of the cache's path.
-
-    Numba's cache checks only the file of the function it compiled, but a kernel's
-    compiled code includes the kernels it calls from other modules: after one of
-    those changes (an upgrade that keeps a file's size and time, a branch switched in
-    a source checkout) Numba would load the old code. Any change to any kernel source
-    changes this hash, hence the cache directory: the kernels are compiled afresh.
-
-    >>> len(kernel_sources_fingerprint())
-    16
-    """
-    digest = hashlib.sha256()
-    for path in sorted((directory or _PACKAGE / "_kernels").glob("*.py")):
-        digest.update(path.name.encode())
-        digest.update(path.read_bytes())
-    return digest.hexdigest()[:16]
-
-
-def install_cache_locator() -> None:
-    """Make Numba cache polycontact's kernels in :func:`cache_directory`, in a
-    subdirectory named after the kernels' sources (:func:`kernel_sources_fingerprint`).
-
-    Called by ``polycontact._kernels`` before any kernel is defined. A locator class is
-    put first in Numba's list; it claims only functions whose source lies in this
-    package. If this Numba has no such list, its default applies: the cache stays
-    beside the sources and is checked file by file only (see
-    :func:`kernel_sources_fingerprint`).
-    """
-    try:
-        from numba.core import caching
-    except ImportError:  # pragma: no cover - numba is a dependency
-        return
-    classes = getattr(getattr(caching, "CacheImpl", None), "_locator_classes", None)
-    base = getattr(caching, "UserProvidedCacheLocator", None)
-    if not isinstance(classes, list) or base is None:  # pragma: no cover - other Numba
-        return
-    if any(getattr(c, "_polycontact", False) for c in classes):
-        return
-    fingerprint = kernel_sources_fingerprint()
-
-    class _Locator(base):  # type: ignore[misc, valid-type]
-        _polycontact = True
-
-        def __init__(self, py_func: Any, py_file: str) -> None:
-            self._py_file = py_file
-            self._lineno = py_func.__code__.co_firstlineno
-            sub = self.get_suitable_cache_subpath(py_file)
-            self._cache_path = str(cache_directory() / f"{sub}-{fingerprint}")
-
-        @classmethod
-        def from_function(cls, py_func: Any, py_file: str) -> Any:
-            if not Path(py_file).resolve().is_relative_to(_PACKAGE):
-                return None
-            locator = cls(py_func, py_file)
-            try:
-                locator.ensure_cache_path()
-            except OSError:
-                return None  # not writable: Numba's next locator decides
-            return locator
-
-    classes.insert(0, _Locator)
-
 
 def _dispatcher(name: str) -> Any:
     """The compiled kernel (a Numba dispatcher) ``"module.function"`` of ``_kernels``."""
-    import importlib
-
     module, func = name.split(".")
     return getattr(importlib.import_module(f"._kernels.{module}", __package__), func)
 

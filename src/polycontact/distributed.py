@@ -41,7 +41,8 @@ from typing import Any
 
 import numpy as np
 
-from .impact import MAX_ITERATIONS
+from .limits import (DEFAULT_BATCH, DEFAULT_IMPACT_BATCH, MAX_ITERATIONS, SAMPLES,
+                     TIME_TOLERANCE)
 
 __all__ = [
     "WarmupPlugin",
@@ -54,16 +55,6 @@ __all__ = [
     "DEFAULT_BATCH",
     "DEFAULT_IMPACT_BATCH",
 ]
-
-#: Default pairs per task of :func:`map_batches` (classification: about 10 ms of work
-#: per task, well above a Dask task's overhead of about 1 ms), unless that would make
-#: fewer than four tasks per worker thread.
-DEFAULT_BATCH = 20_000
-
-#: Default pairs per task of :func:`time_of_impact_many`: a pair's search costs ten to
-#: a thousand times a classification, so a task of this many pairs is still well above
-#: Dask's overhead; fewer if that would make fewer than four tasks per worker thread.
-DEFAULT_IMPACT_BATCH = 2_000
 
 #: Prefix of the names under which ``WarmupPlugin`` is registered (one per family).
 PLUGIN_NAME = "polycontact-warmup"
@@ -188,8 +179,8 @@ def map_batches(
         Aligned inputs, e.g. shapes_a, shapes_b.
     client : dask.distributed.Client, optional
     chunk_size : int, optional
-        Items per task; default :data:`DEFAULT_BATCH`, fewer if that would give less
-        than four tasks per worker thread.
+        Items per task; default :data:`~polycontact.limits.DEFAULT_BATCH`, fewer if
+        that would give less than four tasks per worker thread.
     families : iterable of str, optional
         Kernel families the workers warm up (default all).
     **kwargs
@@ -264,7 +255,7 @@ def classify_many(
     --------
     See the module's example.
     """
-    from .relation import RelationBatch, _pack
+    from .relation import RelationBatch, pack_bodies
     from .relation import classify_many as local
 
     client = current_client(client)
@@ -275,7 +266,7 @@ def classify_many(
             f"shapes_a and shapes_b differ in length ({len(shapes_a)} and {len(shapes_b)})")
     # packed now (a copy): the distances, computed locally on first access, are those of
     # the bodies as they were at the call, whatever the caller does with its arrays since
-    packed = (*_pack(shapes_a, "shapes_a"), *_pack(shapes_b, "shapes_b"))
+    packed = (*pack_bodies(shapes_a, "shapes_a"), *pack_bodies(shapes_b, "shapes_b"))
     parts = map_batches(_states, shapes_a, shapes_b, client=client, chunk_size=chunk_size,
                         families=["classification"], tolerance=tolerance)
     states = np.concatenate([p[0] for p in parts]) if parts else np.empty(0, np.int8)
@@ -298,8 +289,8 @@ def time_of_impact_many(
     t_max: float,
     *,
     method: str = "exact",
-    time_tolerance: float = 1e-4,
-    samples: int = 10,
+    time_tolerance: float = TIME_TOLERANCE,
+    samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
     client: Any = None,
@@ -330,8 +321,8 @@ def time_of_impact_many(
         tasks side by side); without a client, as for the local call.
     client : dask.distributed.Client, optional
     chunk_size : int, optional
-        Pairs per task; default :data:`DEFAULT_IMPACT_BATCH`, fewer if that would give
-        less than four tasks per worker thread.
+        Pairs per task; default :data:`~polycontact.limits.DEFAULT_IMPACT_BATCH`, fewer
+        if that would give less than four tasks per worker thread.
 
     Returns
     -------
@@ -358,15 +349,16 @@ def time_of_impact_many(
         return impacts.time_of_impact_many(shapes_a, motions_a, shapes_b, motions_b,
                                            threads=threads, **options)
     # the local call's checks, in its order, before anything is sent
-    a = impacts._shapes(shapes_a, "shapes_a")
-    b = impacts._shapes(shapes_b, "shapes_b")
+    a = impacts.check_shapes(shapes_a, "shapes_a")
+    b = impacts.check_shapes(shapes_b, "shapes_b")
     if len(a) != len(b):
         raise ValueError(f"shapes_a and shapes_b differ in length ({len(a)} and {len(b)})")
-    ma = impacts._motions(motions_a, "motions_a", len(a), "shapes_a")
-    mb = impacts._motions(motions_b, "motions_b", len(b), "shapes_b")
-    t_max, tol, samples, max_iterations, threads = impacts._options(
-        t_max, method, time_tolerance, samples, max_iterations, 1 if threads is None else threads)
-    uniq, sa, sb, rows_a, rows_b, eps_rel = impacts._prepare(a, b, ma, mb, t_max)
+    ma = impacts.check_motions(motions_a, "motions_a", len(a), "shapes_a")
+    mb = impacts.check_motions(motions_b, "motions_b", len(b), "shapes_b")
+    t_max, tol, samples, max_iterations, threads = impacts.check_many_options(
+        t_max, method, time_tolerance, samples, max_iterations,
+        1 if threads is None else threads)
+    uniq, sa, sb, rows_a, rows_b, eps_rel = impacts.prepare_pairs(a, b, ma, mb, t_max)
     count = len(a)
     if count == 0:
         return impacts.time_of_impact_many([], [], [], [], threads=threads, **options)
@@ -381,7 +373,7 @@ def time_of_impact_many(
         for k, r in results:
             parts[k] = r
     raw = tuple(np.concatenate(field) for field in zip(*parts))
-    return impacts._batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
+    return impacts.impact_batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
 
 
 def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
@@ -418,15 +410,15 @@ def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, metho
                   threads: int) -> tuple[Any, ...]:
     """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
     (only the shapes it uses are packed for the kernel); the raw result arrays."""
-    from .impacts import _search
+    from .impacts import search_pairs
 
     sa, sb, own, rows_a, rows_b, eps_rel = task
     common, mine = shared.shapes(), own.shapes()
     used, inverse = np.unique(np.concatenate([sa, sb]), return_inverse=True)
     shapes = [common[u] if u < len(common) else mine[u - len(common)] for u in used]
     n = len(sa)
-    return _search(shapes, inverse[:n], inverse[n:], rows_a, rows_b, eps_rel, t_max, method,
-                   tol, samples, max_iterations, threads)
+    return search_pairs(shapes, inverse[:n], inverse[n:], rows_a, rows_b, eps_rel, t_max,
+                        method, tol, samples, max_iterations, threads)
 
 
 class _ShapePack:

@@ -24,9 +24,9 @@ class InvalidSceneError(PolycontactError, ValueError):
 
 class NfpTooLargeError(PolycontactError, MemoryError):
     """The no-fit polygon of these shapes would need more memory than allowed
-    (``polycontact.nfp.MAX_SUM_VERTICES`` vertices of convex sums)."""
+    (``polycontact.limits.MAX_SUM_VERTICES`` vertices of convex sums)."""
 
 
 class DepthTooLargeError(PolycontactError, MemoryError):
     """The penetration depth of these bodies would need more memory than allowed
-    (``polycontact._kernels.depth.MAX_SUM_VERTICES`` vertices of convex sums)."""
+    (``polycontact.limits.MAX_SUM_VERTICES`` vertices of convex sums)."""

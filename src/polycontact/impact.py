@@ -27,28 +27,17 @@ import numpy as np
 
 from ._checks import finite_number
 from ._dispatch import entry_point
-from .broad_phase import (BROAD_PHASE_INFLATION, base_reach, check_motion, check_reach,
-                          check_t_max, intervals_array, reach_excess)
+from .broad_phase import (base_reach, check_motion, check_reach, check_t_max, intervals_array,
+                          reach_excess)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
 from .bodies import BodyLike, as_shape
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range
+from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS,
+                     RELATIVE_TOLERANCE, SAMPLES, TIME_TOLERANCE)
+from .tolerances import ROUNDING_FACTOR, check_range
 
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
-
-#: Contact resolution of the exact method, relative to L_A + L_B (the sum of the
-#: bounding radii): near contact, the search probes in steps during which no point of
-#: either body moves more than this length relative to the other. One millionth of the
-#: bodies' size is far below any gap a user draws (the paper's own resolution, 1e-4 s
-#: at 10–25 m/s on 300 m bodies, is 3e-6 of the size) and keeps a sliding contact
-#: affordable to follow.
-CONTACT_RESOLUTION = 1e-6
-
-#: Default iteration budget of the exact method (one iteration steps, or classifies the
-#: bodies at the end of a probe). Reached only by long contacts that last while the
-#: bodies turn (see ``time_of_impact``); the result then says so.
-MAX_ITERATIONS = 1_000_000
 
 _METHODS = ("exact", "sampled")
 
@@ -285,29 +274,20 @@ def _fine_bracket(a: Shape, ma: Motion, b: Shape, mb: Motion, t_lo: float, t_hi:
     if speed <= 0.0 or t_hi - t_lo <= lam / speed:
         return t_lo, t_hi
     (ra, ea, *_), (rb, eb, *_) = body_frame(a), body_frame(b)
-    code, hi, lo, *_ = ki._prepared_exact_search(
-        ra, a.packed[1], a.centroid, ma.array, la, ea, rb, b.packed[1], b.centroid, mb.array,
-        lb, eb, np.array([[t_lo, t_hi]]), 2.0 * lam / speed, eps_rel, _ULPS, lam, MAX_ITERATIONS)
+    code, hi, lo, *_ = ki.exact_search_tables(
+        (ra, a.packed[1], a.centroid, la), ea, ma.array, (rb, b.packed[1], b.centroid, lb), eb,
+        mb.array, np.array([[t_lo, t_hi]]),
+        (2.0 * lam / speed, eps_rel, ROUNDING_FACTOR, lam, MAX_ITERATIONS))
     return (lo, hi) if code == ki.HIT else (t_lo, t_hi)
-
-
-#: The float-spacing part of the distance tolerance (see ``tolerance_for``).
-_ULPS = ROUNDING_ULPS * 2.0**-52
-
-
-def _extent(shape: Shape) -> float:
-    """The larger side of the shape's bounding box (the ``extent`` of ``tolerance_for``),
-    cached on the shape."""
-    return float(shape._extent)
 
 
 def _eps_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float) -> float:
     """The distance tolerance at time t, as the kernels compute it: the size term
     ``eps_rel`` or the float spacing of the coordinates at t, whichever is larger."""
-    from ._kernels.impact import _eps_at as eps_at
+    from ._kernels.impact import tolerance_at
 
-    return float(eps_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
-                        b.bounding_radius, t, eps_rel, _ULPS))
+    return float(tolerance_at(a.centroid, ma.array, a.bounding_radius, b.centroid, mb.array,
+                              b.bounding_radius, t, eps_rel, ROUNDING_FACTOR))
 
 
 def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: float,
@@ -318,7 +298,7 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
     penetration (speed bound × bracket length): every vertex that can meet an edge by
     then counts as touching.
     """
-    from ._kernels.relation import boundary_distance
+    from ._kernels.distance import boundary_distance
 
     pa = a.at(ma, t)
     pb = b.at(mb, t)
@@ -335,8 +315,8 @@ def time_of_impact(
     *,
     t_max: float,
     method: str = "exact",
-    time_tolerance: float = 1e-4,
-    samples: int = 10,
+    time_tolerance: float = TIME_TOLERANCE,
+    samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
 ) -> Impact:
     """First time at which two moving bodies penetrate, and where they meet.
@@ -363,9 +343,10 @@ def time_of_impact(
         "exact": conservative advancement, never tunnels (see Notes). "sampled": the
         paper's §3 steps 3–6, ``samples`` points per round.
     time_tolerance : float
-        Accuracy of ``time`` (the paper's threshold, 1e-4); any value > 0. Below what
-        float64 resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there,
-        and the result's ``time_tolerance`` says so.
+        Accuracy of ``time`` (default the paper's threshold,
+        :data:`~polycontact.limits.TIME_TOLERANCE`); any value > 0. Below what float64
+        resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there, and the
+        result's ``time_tolerance`` says so.
     samples : int
         Points per round of the sampled method (>= 2); ignored by "exact".
     max_iterations : int
@@ -556,17 +537,18 @@ def time_of_impact(
     args: tuple[Any, ...]
     if exact:
         args = (pa[0], pa[1], ma._array, pb[0], pb[1], mb._array, t_max, BROAD_PHASE_INFLATION,
-                tol, eps_rel, _ULPS, CONTACT_RESOLUTION * (la + lb), int(max_iterations), work)
-    else:
-        args = (ra, a._starts, a._centroid, ma._array, la, rb, b._starts, b._centroid,
-                mb._array, lb, t_max, BROAD_PHASE_INFLATION, tol, eps_rel, _ULPS, int(samples),
+                tol, eps_rel, ROUNDING_FACTOR, CONTACT_RESOLUTION * (la + lb), int(max_iterations),
                 work)
+    else:  # (the query's record, see _kernels.impact.exact_query: the exact method's at 0)
+        args = ((ra, a._starts, a._centroid, la), ma._array, (rb, b._starts, b._centroid, lb),
+                mb._array, (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR, 0.0, 0,
+                            int(samples)), work)
     # the compiled code called directly when every argument has the type it always has
     # (Shapes and Motions), else through the dispatcher
     run = _ENTRY.get(method) if fixed else None
     out = run(*args) if run is not None else _query(method, args, fixed)
     # (the broad phase's intervals, left in the scratch, are recomputed if asked for)
-    return _result(a, ma, b, mb, method, out, t_max, eps_rel, tol, None)
+    return impact_from_kernel(a, ma, b, mb, method, out, t_max, eps_rel, tol, None)
 
 
 _LOCAL = threading.local()
@@ -667,8 +649,9 @@ def body_frame(shape: Shape, tables: bool = True, what: str = "shape") -> tuple[
     return frame
 
 
-def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, out: tuple[Any, ...],
-            t_max: float, eps_rel: float, tol: float, intervals: np.ndarray | None) -> Impact:
+def impact_from_kernel(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str,
+                       out: tuple[Any, ...], t_max: float, eps_rel: float, tol: float,
+                       intervals: np.ndarray | None) -> Impact:
     """The :class:`Impact` of a query kernel's answer ``out`` = (number of intervals,
     status code, t_hi, t_lo, first contact, iterations, t_reached): Python floats and
     ints (Numba boxes float64 and int64 so); the broad phase's ``intervals`` (None:
@@ -689,7 +672,7 @@ def _result(a: Shape, ma: Motion, b: Shape, mb: Motion, method: str, out: tuple[
 
 def _lazy_fields(bodies: tuple[Any, ...], out: tuple[Any, ...], method: str, t_max: float,
                  tol: float, intervals: np.ndarray | None) -> dict[str, Any]:
-    """The fields of an :class:`Impact` that :func:`_result` leaves to the first access:
+    """The fields of an :class:`Impact` that :func:`impact_from_kernel` leaves to the first access:
     ``first_contact``, ``state``, ``method``, ``time_bracket``, ``iterations``,
     ``searched_to``, ``broad_phase`` (``intervals``, or the kernel's recomputed: the same
     operations) and ``time_tolerance``."""

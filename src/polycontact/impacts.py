@@ -25,37 +25,19 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .broad_phase import (BROAD_PHASE_INFLATION, check_motion, check_reach, check_t_max,
-                          reach_excess)
+from .broad_phase import check_motion, check_reach, check_t_max, reach_excess
 from .errors import InvalidShapeError
-from .impact import (_ULPS, CONTACT_RESOLUTION, MAX_ITERATIONS, Impact,
-                     ImpactStatus, _extent, _result, body_frame, check_options)
+from .impact import Impact, ImpactStatus, body_frame, check_options, impact_from_kernel
+from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS, MAX_SLICES,
+                     RELATIVE_TOLERANCE, SAMPLES, SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
 from .bodies import as_shape
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE
+from .tolerances import ROUNDING_FACTOR
 
 __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
 
-#: At most this many time slices (space–time boxes) per body in the swept bounds. A
-#: body gets one slice per bounding radius its centroid travels; past this many the
-#: boxes of a long, fast path grow longer instead of more numerous.
-MAX_SLICES = 16
-
-#: The swept boxes are grown beyond each body's bounding radius as the circle-overlap
-#: broad phase of ``time_of_impact`` grows the sum of the radii: by
-#: ``BROAD_PHASE_INFLATION`` of the radius, and by this many units of 2**-52 of the
-#: body's reach (its radius plus the |terms| of its centroid's path over [0, t_max]:
-#: position, travel at the initial speed, travel by the acceleration, summed over x
-#: and y). 16 of them are the pairwise call's own widening
-#: (``_kernels.broad_phase.rounding_allowance``, which sums the same terms of both
-#: bodies), the rest cover the rounding of |c_A(t) − c_B(t)| there and of the boxes
-#: here (a few units each), so the boxes never leave out a pair the pairwise call
-#: would search. Far from the origin this is the float spacing of the positions, not a
-#: fraction of them: a unit body at 1e9 is grown by ~3e-5 (1e-6 of the reach, the
-#: margin before, was 1e3: every body within a thousand units was a candidate).
-SWEPT_ROUNDING_ULPS = 64.0
 
 @dataclass(frozen=True)
 class ImpactBatch:
@@ -119,7 +101,8 @@ def _sequence(items: Any, what: str) -> list[Any]:
     return list(items)
 
 
-def _shapes(items: Any, what: str) -> list[Shape]:
+def check_shapes(items: Any, what: str) -> list[Shape]:
+    """The bodies of the sequence ``items`` as Shapes (an error naming ``what[k]``)."""
     out = []
     for k, obj in enumerate(_sequence(items, what)):
         if type(obj) is Shape:
@@ -136,7 +119,9 @@ def _shapes(items: Any, what: str) -> list[Shape]:
     return out
 
 
-def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion]:
+def check_motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion]:
+    """The ``count`` Motions of the sequence ``items``, one per shape of ``shapes_what``
+    (an error naming ``what``)."""
     motions = _sequence(items, what)
     if len(motions) != count:
         raise ValueError(f"{what}: expected {count} motions (one per shape of {shapes_what}), "
@@ -145,8 +130,11 @@ def _motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion
             for k, m in enumerate(motions)]
 
 
-def _options(t_max: float, method: str, time_tolerance: float, samples: int,
-             max_iterations: int, threads: int | None) -> tuple[float, float, int, int, int]:
+def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
+                       max_iterations: int,
+                       threads: int | None) -> tuple[float, float, int, int, int]:
+    """:func:`polycontact.impact.check_options` and ``threads``:
+    ``(t_max, time_tolerance, samples, max_iterations, threads)``."""
     t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
     if threads is None:
         threads = os.cpu_count() or 1
@@ -171,9 +159,9 @@ def _pack(shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
             np.concatenate([i for _, i in packs]), i_off)
 
 
-def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
-            mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
-            samples: int, max_iterations: int, threads: int) -> tuple[Any, ...]:
+def search_pairs(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
+                 mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
+                 samples: int, max_iterations: int, threads: int) -> tuple[Any, ...]:
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
     search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
     of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
@@ -193,9 +181,12 @@ def _search(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
     iv = np.empty((p_count, MAX_INTERVALS, 2))
     out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
 
+    pairs = (sa, sb, ma, mb, eps_rel)
+    settings = (t_max, BROAD_PHASE_INFLATION, tol, ROUNDING_FACTOR, CONTACT_RESOLUTION,
+                max_iterations, exact, samples)
+
     def run(todo: np.ndarray) -> None:
-        impacts_chunk(todo, sa, sb, ma, mb, eps_rel, *tables, t_max, BROAD_PHASE_INFLATION,
-                      tol, _ULPS, CONTACT_RESOLUTION, max_iterations, exact, samples, *out)
+        impacts_chunk(todo, pairs, tables, settings, out)
 
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
@@ -218,10 +209,11 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
         a, ma = shape_of(p, 0), motion_of(p, 0)
         b, mb = shape_of(p, 1), motion_of(p, 1)
         # (the intervals copied: the result keeps them, not the whole batch's array)
-        return _result(a, ma, b, mb, method,
-                       (int(n_iv[p]), int(code[p]), float(t_hi[p]), float(t_lo[p]),
-                        float(contact[p]), int(iters[p]), float(reached[p])),
-                       t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
+        return impact_from_kernel(a, ma, b, mb, method,
+                                  (int(n_iv[p]), int(code[p]), float(t_hi[p]),
+                                   float(t_lo[p]), float(contact[p]), int(iters[p]),
+                                   float(reached[p])),
+                                  t_max, float(eps_rel[p]), tol, iv[p, :n_iv[p]].copy())
 
     return make
 
@@ -253,7 +245,7 @@ def _names(k: int) -> tuple[str, str]:
 
 def _extents(shapes: list[Shape], motions: list[Motion],
              name_of: Callable[[int], tuple[str, str]], t_max: float) -> np.ndarray:
-    """Each body's extent (:func:`polycontact.impact._extent`: its pairs' distance
+    """Each body's extent (the larger side of its bounding box: its pairs' distance
     tolerance has the size term ``RELATIVE_TOLERANCE * max(extent_a, extent_b)``, as in
     ``time_of_impact``), after the checks ``time_of_impact`` makes: the coordinates
     (once per shape, with its body frame), then motions that would carry coordinates,
@@ -264,7 +256,7 @@ def _extents(shapes: list[Shape], motions: list[Motion],
     for k, (s, m, base) in enumerate(zip(shapes, motions, bases)):
         if reach_excess(base, s.bounding_radius, m._norms, t_max) is not None:
             check_reach(s, m, t_max, name_of(k)[1])  # raises, naming the motion
-    return np.array([_extent(s) for s in shapes], dtype=np.float64)
+    return np.array([float(s._extent) for s in shapes], dtype=np.float64)
 
 
 def time_of_impact_many(
@@ -275,8 +267,8 @@ def time_of_impact_many(
     *,
     t_max: float,
     method: str = "exact",
-    time_tolerance: float = 1e-4,
-    samples: int = 10,
+    time_tolerance: float = TIME_TOLERANCE,
+    samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
 ) -> ImpactBatch:
@@ -332,27 +324,27 @@ def time_of_impact_many(
     >>> batch.impact(0).status.value
     'hit'
     """
-    a = _shapes(shapes_a, "shapes_a")
-    b = _shapes(shapes_b, "shapes_b")
+    a = check_shapes(shapes_a, "shapes_a")
+    b = check_shapes(shapes_b, "shapes_b")
     if len(a) != len(b):
         raise ValueError(f"shapes_a and shapes_b differ in length ({len(a)} and {len(b)})")
-    ma = _motions(motions_a, "motions_a", len(a), "shapes_a")
-    mb = _motions(motions_b, "motions_b", len(b), "shapes_b")
-    t_max, tol, samples, max_iterations, threads = _options(
+    ma = check_motions(motions_a, "motions_a", len(a), "shapes_a")
+    mb = check_motions(motions_b, "motions_b", len(b), "shapes_b")
+    t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
-    uniq, sa, sb, rows_a, rows_b, eps_rel = _prepare(a, b, ma, mb, t_max)
-    raw = _search(uniq, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol, samples,
-                  max_iterations, threads)
-    return _batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
+    uniq, sa, sb, rows_a, rows_b, eps_rel = prepare_pairs(a, b, ma, mb, t_max)
+    raw = search_pairs(uniq, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol, samples,
+                       max_iterations, threads)
+    return impact_batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
 
 
-def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
-             t_max: float) -> tuple[Any, ...]:
+def prepare_pairs(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+                  t_max: float) -> tuple[Any, ...]:
     """Check every body of the pairs as ``time_of_impact`` does (errors naming where it
     first appears: ``shapes_a[k]``, ``motions_b[k]``, ...), then the inputs of
-    :func:`_search`: the distinct shapes, each pair's two indices among them, its two
+    :func:`search_pairs`: the distinct shapes, each pair's two indices among them, its two
     motion rows and its ``eps_rel``. (:func:`polycontact.distributed.time_of_impact_many`
-    runs this in the caller's process and :func:`_search` on slices.)"""
+    runs this in the caller's process and :func:`search_pairs` on slices.)"""
     # a body (the same shape and motion objects) in many pairs is prepared once
     p_count = len(a)
     seen: dict[tuple[int, int], int] = {}
@@ -381,11 +373,11 @@ def _prepare(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
     return uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel
 
 
-def _batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
-           raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
-           tol: float) -> ImpactBatch:
+def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+                 raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
+                 tol: float) -> ImpactBatch:
     """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
-    the raw result arrays of :func:`_search`."""
+    the raw result arrays of :func:`search_pairs`."""
     code, t_hi, _, contact, *_ = raw
     collides = code == 1
     pairs = (a, b)
@@ -421,8 +413,8 @@ def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
     >>> candidate_pairs(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5).tolist()
     [[0, 1]]
     """
-    shapes = _shapes(shapes, "shapes")
-    motions = _motions(motions, "motions", len(shapes), "shapes")
+    shapes = check_shapes(shapes, "shapes")
+    motions = check_motions(motions, "motions", len(shapes), "shapes")
     t_max = check_t_max(t_max)
     _extents(shapes, motions, _names, t_max)
     return _candidates(shapes, motions, t_max)
@@ -468,8 +460,8 @@ def first_impacts(
     t_max: float,
     *,
     method: str = "exact",
-    time_tolerance: float = 1e-4,
-    samples: int = 10,
+    time_tolerance: float = TIME_TOLERANCE,
+    samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
 ) -> list[PairImpact]:
@@ -525,9 +517,9 @@ def first_impacts(
     0 2 no-hit contact 0.5
     0 1 hit penetrating 2.0
     """
-    shapes = _shapes(shapes, "shapes")
-    motions = _motions(motions, "motions", len(shapes), "shapes")
-    t_max, tol, samples, max_iterations, threads = _options(
+    shapes = check_shapes(shapes, "shapes")
+    motions = check_motions(motions, "motions", len(shapes), "shapes")
+    t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
     extent = _extents(shapes, motions, _names, t_max)
@@ -544,8 +536,8 @@ def first_impacts(
     m = _motion_array(sub_motions)
     eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[pairs[:, 0]], extent[pairs[:, 1]])
     i, j = local[pairs[:, 0]], local[pairs[:, 1]]
-    raw = _search(uniq, index[i], index[j], m[i], m[j], eps_rel, t_max, method, tol, samples,
-                  max_iterations, threads)
+    raw = search_pairs(uniq, index[i], index[j], m[i], m[j], eps_rel, t_max, method, tol,
+                       samples, max_iterations, threads)
     i, j = pairs[:, 0], pairs[:, 1]
     code, _, _, contact, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,

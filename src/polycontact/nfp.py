@@ -20,7 +20,7 @@ calling this for many pairs of the same pieces decomposes each piece once.
 An area union loses the positions where A fits exactly: a jigsaw piece in its socket
 (an isolated point) or a square sliding in a slot of its own width (a segment). They are
 the positions inside ``E`` where the interiors do not overlap; polycontact finds them
-separately (see :mod:`polycontact._kernels.nfp`) and reports them as
+separately (see :mod:`polycontact._kernels.fits`) and reports them as
 :attr:`NoFitPolygon.exact_fits` and :attr:`NoFitPolygon.slides`.
 
 Examples
@@ -50,34 +50,15 @@ import shapely.affinity
 
 from ._checks import finite_number
 from ._checks import point as point_arg
+from ._pieces import pieces_of_geometry, pieces_packed
 from .bodies import BodyLike, as_shape
 from .errors import InvalidShapeError, NfpTooLargeError
+from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR, MAX_SUM_VERTICES,
+                     RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
 from .shape import Shape
-from .tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range, snap_grid, tolerance_for
+from .tolerances import check_range, snap_grid, tolerance_for
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
-
-#: Holes of the union narrower than ``HOLE_WIDTH_FACTOR * tolerance`` (twice the area
-#: over the perimeter) are rounding artefacts where closed sums meet exactly (an exact
-#: fit shows up as a pinhole of about 1e-15 of the coordinates), not positions where A
-#: fits: they are filled.
-HOLE_WIDTH_FACTOR = 16.0
-
-#: Candidate exact fits and slide ends are snapped to the sums' vertices and edge
-#: crossings within ``_SNAP_FACTOR * tolerance`` (they are found within a few).
-_SNAP_FACTOR = 64.0
-
-#: Angular gap (radians) below which the sums around a point are taken to close up:
-#: edge directions of sums computed in float64 carry errors near 1e-15 rad.
-ANGLE_TOLERANCE = 1e-9
-
-
-#: Most vertices of convex sums a no-fit polygon builds (about 350 bytes each with the
-#: outline's work arrays: 3.5 GB). Beyond, it is refused with an error, not killed by
-#: the system for want of memory (two large concave bodies make a sum per pair of
-#: their convex pieces).
-MAX_SUM_VERTICES = 10_000_000
-
 
 #: The empty exact fits and slides of most results, shared: read-only (and empty).
 _NO_FITS = np.empty((0, 2))
@@ -118,22 +99,15 @@ def fallback_count() -> int:
 @functools.cache
 def _kernels() -> SimpleNamespace:
     """The compiled kernels, imported on first use (Numba loads only when needed)."""
-    from ._kernels import decompose, nfp
-    return SimpleNamespace(nfp=nfp, decompose=decompose)
+    from ._kernels import fits, minkowski, nfp
+
+    return SimpleNamespace(nfp=nfp, minkowski=minkowski, fits=fits)
 
 
 #: WKB header of a one-ring polygon in the machine's byte order (that of the kernels'
 #: float64 coordinates): byte order, type 3, rings, points.
 _WKB_POLYGON = struct.Struct("=BIII")
 _WKB_BYTE_ORDER = 1 if sys.byteorder == "little" else 0
-
-#: Rings up to this many vertices are triangulated by ear clipping (quadratic, but
-#: without the cost of a GEOS call); larger ones and shapes with holes by GEOS.
-_EAR_CLIPPING_MAX = 64
-
-_PIECES_CACHE: dict[tuple[bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
-_PIECES_CACHE_SIZE = 4096
-
 
 @dataclass(frozen=True, eq=False)
 class NoFitPolygon:
@@ -345,7 +319,8 @@ def no_fit_polygon(
     convex or small (k_A = O(1)) and each sum meets few others, that is near
     O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
     follows that product (figures: ``benchmarks/bench_scaling.py``). Past
-    :data:`MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError` is raised.
+    :data:`~polycontact.limits.MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError`
+    is raised.
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
@@ -360,11 +335,11 @@ def no_fit_polygon(
     xb, sb = b.packed
     out = None
     if len(sa) == 2 and len(sb) == 2:
-        # two rings: decomposed and summed in one kernel call (see _pieces_packed)
+        # two rings: decomposed and summed in one kernel call (see polycontact._pieces)
         ax, ay = a0.tolist()
         out = _kernels().nfp.ring_entrance(
             xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
-            ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR, _EAR_CLIPPING_MAX,
+            ANGLE_TOLERANCE, SNAP_FACTOR, HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX,
             MAX_SUM_VERTICES)
     if out is None or not out[0][0]:
         out = _entrance_kernel(*pieces(), tolerance)
@@ -429,7 +404,7 @@ def inner_fit_polygon(
     x0, y0 = c.exterior.min(axis=0) - 2.0 * span - 1.0
     x1, y1 = c.exterior.max(axis=0) + 2.0 * span + 1.0
     outside = shapely.box(x0, y0, x1, y1).difference(c.to_shapely())
-    fxy, fst = _pieces_of_geometry(outside)
+    fxy, fst = pieces_of_geometry(outside)
     blocked, pts, segs, eps = _entrance_result(
         _entrance_kernel(fxy, fst, r, ast, tolerance), lambda: (fxy, fst, r, ast))
     if type(blocked) is tuple:
@@ -504,42 +479,7 @@ def _tolerance(tolerance: float | None) -> float:
 
 def _convex_pieces(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
     """Convex CCW pieces of a shape, packed; cached by coordinates."""
-    return _pieces_packed(*shape.packed)
-
-
-def _pieces_packed(xy: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Convex CCW pieces of packed loops (the first the outer one, CCW; then the holes,
-    CW), packed; cached by coordinates."""
-    key = (xy.tobytes(), starts.tobytes())
-    hit = _PIECES_CACHE.get(key)
-    if hit is not None:
-        return hit
-    ok = False
-    if len(starts) == 2:
-        ok, pxy, pst = _kernels().decompose.ring_pieces(
-            xy, RELATIVE_TOLERANCE, ROUNDING_ULPS, _EAR_CLIPPING_MAX)
-        pieces = (pxy, pst)
-    if not ok:
-        # (shapely.Polygon is slow with an empty hole list)
-        loops = [xy[starts[k] : starts[k + 1]] for k in range(len(starts) - 1)]
-        geom = (shapely.Polygon(loops[0], loops[1:]) if len(loops) > 1
-                else shapely.polygons(shapely.linearrings(loops[0])))
-        pieces = _pieces_of_geometry(geom)
-    if len(_PIECES_CACHE) >= _PIECES_CACHE_SIZE:
-        _PIECES_CACHE.pop(next(iter(_PIECES_CACHE)))
-    _PIECES_CACHE[key] = pieces
-    return pieces
-
-
-def _pieces_of_geometry(geom: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Convex pieces of a shapely (Multi)Polygon: GEOS triangulation, then merging."""
-    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(geom))
-    coords = shapely.get_coordinates(tris).reshape(-1, 4, 2)[:, :3, :]
-    # GEOS adds no vertex: triangles share exact coordinates, hence vertex indices
-    vxy, idx = np.unique(coords.reshape(-1, 2), axis=0, return_inverse=True)
-    pieces: tuple[np.ndarray, np.ndarray] = _kernels().decompose.convex_pieces(
-        vxy, idx.reshape(-1, 3), RELATIVE_TOLERANCE, ROUNDING_ULPS)
-    return pieces
+    return pieces_packed(*shape.packed)
 
 
 def _entrance_kernel(
@@ -556,7 +496,7 @@ def _entrance_kernel(
         )
     out: tuple[Any, ...] = _kernels().nfp.entrance_packed(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        ANGLE_TOLERANCE, _SNAP_FACTOR, HOLE_WIDTH_FACTOR
+        ANGLE_TOLERANCE, SNAP_FACTOR, HOLE_WIDTH_FACTOR
     )
     return out
 
@@ -587,7 +527,7 @@ def _entrance_result(
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = _kernels().nfp.convex_sums(*pieces())
+        sums, starts = _kernels().minkowski.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     if not n_cand:
@@ -696,7 +636,7 @@ def _touching(
     """The selection of :func:`_clean_degenerate` for the no-fit polygon: the candidates
     where A with its reference there (at a slide's middle and both ends) touches B
     without overlapping, verified by the classifier and selected in one kernel call."""
-    touching_contacts = _kernels().nfp.touching_contacts
+    touching_contacts = _kernels().fits.touching_contacts
     xa, sa = a.packed
     xb, sb = b.packed
     tol = HOLE_WIDTH_FACTOR * eps
@@ -718,7 +658,7 @@ def _checked(
 
     def select(pts: np.ndarray, segs: np.ndarray, near: float) -> Any:
         pts_ok, segs_ok = check(pts, segs)
-        return _kernels().nfp.select_contacts(
+        return _kernels().fits.select_contacts(
             np.ascontiguousarray(pts), np.asarray(pts_ok, dtype=np.bool_), segs,
             np.asarray(segs_ok, dtype=np.bool_), near)
 
@@ -733,9 +673,9 @@ def _clean_degenerate(
     The candidates found on the edges with the margin ``eps`` are within a few eps of
     the true positions; exact fits and slide ends are vertices of some sum or crossings
     of sum edges, and the kernel has snapped them to those (within
-    ``_SNAP_FACTOR * eps``) and merged collinear slides. ``make_select()`` gives
+    ``SNAP_FACTOR * eps``) and merged collinear slides. ``make_select()`` gives
     ``select(pts, segs, near)``: the verified candidates with fits on a kept slide or
-    near a kept fit dropped (:func:`polycontact._kernels.nfp.select_contacts`, after
+    near a kept fit dropped (:func:`polycontact._kernels.fits.select_contacts`, after
     the no-fit polygon's check :func:`_touching` or any other, :func:`_checked`).
     """
     if len(pts) == 0 and len(segs) == 0:

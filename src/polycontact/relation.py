@@ -302,15 +302,15 @@ class Relation:
 
     @_cached
     def _closest(self) -> tuple[float, float, float, float, float]:
-        from ._kernels import relation as kr
+        from ._kernels.distance import closest_pair
 
-        return cast("tuple[float, float, float, float, float]", kr.closest_pair(*self._packed))
+        return cast("tuple[float, float, float, float, float]", closest_pair(*self._packed))
 
     @_cached
     def _penetration(self) -> tuple[float, float, float]:
-        from ._kernels import depth as kd
+        from ._depth import penetration
 
-        return cast("tuple[float, float, float]", kd.penetration(*self._packed, self.tolerance))
+        return penetration(*self._packed, self.tolerance)
 
     @_cached
     def distance(self) -> float:
@@ -330,9 +330,9 @@ class Relation:
 
     @_cached
     def _raw_features(self) -> tuple[Any, ...]:
-        from ._kernels import relation as kr
+        from ._kernels.features import features
 
-        return cast("tuple[Any, ...]", kr.features(*self._packed, self.tolerance))
+        return cast("tuple[Any, ...]", features(*self._packed, self.tolerance))
 
     @_cached
     def features(self) -> tuple[Feature, ...]:
@@ -582,7 +582,9 @@ def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relati
         and b.flags.c_contiguous
     ):
         if not _RAW:
-            _RAW.append(_kr().classify_raw)
+            from ._kernels.rings import classify_raw
+
+            _RAW.append(classify_raw)
         code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, *_RING_ARGS)
         if code >= 0:
             # The lean path: the bytes are the copy the lazy parts are computed from.
@@ -628,15 +630,14 @@ class RelationBatch:
     @cached_property
     def distances(self) -> np.ndarray:
         """Signed distance of every pair (gap, 0 at contact, minus the depth), read-only."""
-        from ._kernels import depth as kd
-        from ._kernels import relation as kr
+        from ._depth import penetrations
         from ._kernels import relation_many as km
 
         pack = self._pack()
         out = km.many_distances(*pack, self.states, self.tolerances)
-        pen = np.flatnonzero(self.states == kr.PENETRATING)
+        pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
         if pen.size:
-            out[pen] = -kd.penetrations(*pack, pen, self.tolerances[pen])[:, 0]
+            out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
         return _read_only(out)
 
 
@@ -690,7 +691,7 @@ def _classify_arrays(
         copy_a[p0:p1] = arr_a[p0:p1]
         copy_b[p0:p1] = arr_b[p0:p1]
         km.raw_states(copy_a[p0:p1], copy_b[p0:p1], tol, *_RING_ARGS,
-                      [o[p0:p1] for o in out])
+                      tuple(o[p0:p1] for o in out))
 
     try:
         _split(arr_a.shape[0], chunk)
@@ -804,7 +805,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
-def _pack(items: Any, what: str, made: list[Any] | None = None) -> tuple[Any, ...]:
+def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
     if isinstance(items, (str, bytes)) or not isinstance(items, Sequence | np.ndarray):
@@ -856,8 +857,8 @@ def classify_many(
         batch = _classify_arrays(arr_a, arr_b, tol)
         if batch is not None:
             return batch
-    pa = _pack(shapes_a, "shapes_a")
-    pb = _pack(shapes_b, "shapes_b")
+    pa = pack_bodies(shapes_a, "shapes_a")
+    pb = pack_bodies(shapes_b, "shapes_b")
     if len(pa[3]) != len(pb[3]):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"

@@ -29,6 +29,7 @@ from .bodies import as_shape
 from .broad_phase import check_reach
 from .errors import InvalidSceneError, InvalidShapeError
 from .impact import Impact, ImpactStatus, time_of_impact
+from .limits import SAMPLES, TIME_TOLERANCE
 from .motion import Motion
 from .shape import Shape
 
@@ -105,7 +106,7 @@ class Scene:
         *,
         method: str = "exact",
         time_tolerance: float | None = None,
-        samples: int = 10,
+        samples: int = SAMPLES,
     ) -> tuple[Body, Body, Impact]:
         """The earliest event among all pairs: ``(body_a, body_b, impact)``.
 
@@ -115,7 +116,7 @@ class Scene:
         else the first pair.
         """
         tol = time_tolerance if time_tolerance is not None else self.time_tolerance
-        tol_ = 1e-4 if tol is None else tol
+        tol_ = TIME_TOLERANCE if tol is None else tol
         if len(self.bodies) >= 3:
             # only the pairs whose swept bounds meet are searched (same answer as the
             # loop over all pairs below: tests/test_impacts_many.py)
@@ -133,7 +134,7 @@ class Scene:
             for b in self.bodies[i + 1:]:
                 imp = time_of_impact(
                     a.shape, a.motion, b.shape, b.motion, t_max=self.t_max, method=method,
-                    time_tolerance=1e-4 if tol is None else tol, samples=samples,
+                    time_tolerance=tol_, samples=samples,
                 )
                 results.append((a, b, imp))
         return min(results, key=lambda r: _event_order(r[2]))
@@ -144,7 +145,7 @@ class Scene:
         *,
         method: str = "exact",
         time_tolerance: float | None = None,
-        samples: int = 10,
+        samples: int = SAMPLES,
     ) -> list[tuple[Body, Body, Impact]]:
         """Every pair that meets within ``[0, t_max]`` (touches, penetrates, or has no
         verdict), sorted by time: ``(body_a, body_b, impact)`` in file order
@@ -165,7 +166,8 @@ class Scene:
         tol = time_tolerance if time_tolerance is not None else self.time_tolerance
         events = first_impacts([b.shape for b in self.bodies], [b.motion for b in self.bodies],
                                self.t_max, method=method,
-                               time_tolerance=1e-4 if tol is None else tol, samples=samples)
+                               time_tolerance=TIME_TOLERANCE if tol is None else tol,
+                               samples=samples)
         return [(self.bodies[e.i], self.bodies[e.j], e.impact) for e in events]
 
 

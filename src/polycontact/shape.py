@@ -15,6 +15,7 @@ and with repeated or closing points counted; :meth:`Shape.input_vertex`,
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -94,15 +95,119 @@ def _whole_body(obj: Any) -> bool:
 
 def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
     """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
-    through :mod:`polycontact.bodies`; such a body carries its own holes."""
+    through :func:`as_shape`; such a body carries its own holes."""
     if len(list(holes)):
         raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
                         "holes only with an array of vertices")
+    return as_shape(obj, "vertices", repair=repair)
+
+
+#: The forms a body may take, as error messages list them.
+BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+
+_BODY_KEYS = {"vertices", "holes", "name"}
+_HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
+
+
+def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever accepted form it takes (the forms
+    :mod:`polycontact.bodies` lists; offered to the package from there).
+
+    Parameters
+    ----------
+    obj : body
+        One of the forms listed in :mod:`polycontact.bodies`.
+    what : str
+        The argument's name, put at the start of every error message.
+    repair : bool, default False
+        Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
+
+    Returns
+    -------
+    Shape
+        ``obj`` itself when it is already a Shape.
+
+    Raises
+    ------
+    TypeError
+        ``obj`` is of no accepted type.
+    InvalidShapeError
+        ``obj`` is of an accepted type but not a valid polygon.
+    """
     if isinstance(obj, Shape):
         return obj
-    from .bodies import as_shape
+    try:
+        return _coerce(obj, repair)
+    except InvalidShapeError as exc:
+        raise InvalidShapeError(f"{what}: {exc}") from None
+    except TypeError as exc:
+        raise TypeError(f"{what}: {exc}") from None
 
-    return as_shape(obj, "vertices", repair=repair)
+
+def _coerce(obj: Any, repair: bool) -> Shape:
+    if isinstance(obj, (bytes, bytearray, memoryview)):
+        return Shape.from_shapely(_from_wkb(bytes(obj)), repair=repair)
+    if isinstance(obj, str):
+        return _from_text(obj, repair)
+    if hasattr(obj, "geom_type") and hasattr(obj, "wkb"):  # a shapely geometry
+        return Shape.from_shapely(obj, repair=repair)
+    if isinstance(obj, Mapping):
+        return _from_mapping(obj, repair)
+    geo = getattr(obj, "__geo_interface__", None)
+    if isinstance(geo, Mapping):
+        return _from_mapping(geo, repair)
+    if isinstance(obj, (np.ndarray, list, tuple)):
+        return Shape(obj, repair=repair)
+    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+
+
+def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
+    if "vertices" in data:
+        unknown = sorted(set(data) - _BODY_KEYS)
+        if unknown:
+            raise InvalidShapeError(
+                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
+            )
+        holes = data.get("holes", ())
+        if holes is None or isinstance(holes, (str, bytes, Mapping)):
+            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+        return Shape(data["vertices"], holes, repair=repair)
+    if "type" in data:
+        return Shape.from_geojson(dict(data), repair=repair)
+    raise InvalidShapeError(
+        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        f"got keys {sorted(map(str, data))}"
+    )
+
+
+def _from_text(text: str, repair: bool) -> Shape:
+    stripped = text.strip()
+    if not stripped:
+        raise InvalidShapeError("empty text: no body in it")
+    if stripped.startswith(("{", "[")):
+        try:
+            data = load_json(text)
+        except ValueError as exc:
+            raise InvalidShapeError(f"not valid JSON ({exc})") from None
+        if isinstance(data, list):  # the vertices alone: [[x, y], ...]
+            return Shape(data, repair=repair)
+        if not isinstance(data, Mapping):
+            raise InvalidShapeError("JSON text: expected an object or a list of vertices")
+        return _from_mapping(data, repair)
+    if _HEX.fullmatch(stripped):  # hex WKB, as shapely's ``wkb_hex``
+        return Shape.from_shapely(_from_wkb(bytes.fromhex(stripped)), repair=repair)
+    return Shape.from_wkt(text, repair=repair)
+
+
+def _from_wkb(data: bytes) -> Any:
+    import shapely
+
+    if not data:
+        raise InvalidShapeError("empty WKB: no body in it")
+    try:
+        return shapely.from_wkb(data)
+    except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
+        raise InvalidShapeError(f"not valid WKB ({exc})") from None
 
 
 def _first_unreal(ring: ArrayLike) -> tuple[int, Any] | None:
@@ -619,10 +724,13 @@ class Shape:
 def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The map of loops already in the caller's numbering (see :func:`_input_maps`)."""
     local = np.arange(int(starts[-1]), dtype=np.int64) - np.repeat(starts[:-1], np.diff(starts))
-    return (_frozen(np.arange(len(starts) - 1)), _frozen(np.stack([local, local], axis=1)))
+    return (frozen_ints(np.arange(len(starts) - 1)),
+            frozen_ints(np.stack([local, local], axis=1)))
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
+def frozen_ints(a: np.ndarray) -> np.ndarray:
+    """``a`` as a C-contiguous int64 array (copied only when it is not one), made
+    read-only."""
     a = np.ascontiguousarray(a, dtype=np.int64)
     a.flags.writeable = False
     return a
@@ -666,7 +774,7 @@ def _input_maps(
             raise RuntimeError("internal error: the map to the caller's numbering does not "
                                "follow _clean_ring")
         maps.append(m)
-    return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
+    return frozen_ints(np.arange(len(maps))), frozen_ints(np.concatenate(maps))
 
 
 def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
@@ -706,7 +814,7 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
                                            _to_segment(ring[(i + 1) % len(ring)], s, e)) <= eps:
                     rows[-1][i, 1] = c
                     break
-    return _frozen(np.array(loop_map)), _frozen(np.concatenate(rows))
+    return frozen_ints(np.array(loop_map)), frozen_ints(np.concatenate(rows))
 
 
 def _to_segment(p: np.ndarray, s: np.ndarray, e: np.ndarray) -> float:
@@ -723,7 +831,7 @@ def _fmt(v: float) -> str:
 def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                  tolerance: float) -> bytes:
     """The shape as the bytes of one float64 array, the layout of
-    :data:`polycontact._kernels.relation.PACK_HEAD`: loop count, bounding box ``(xmin,
+    :data:`polycontact._kernels.packs.PACK_HEAD`: loop count, bounding box ``(xmin,
     ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the shape's
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
     patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the

@@ -25,8 +25,10 @@ differences (areas, centroids, Minkowski sums), which would overflow or underflo
 float64 beyond these bounds. Inputs outside them are refused with an error that says
 so; they are never answered wrongly.
 
-Tolerances are always passed to kernels as arguments (Numba freezes module globals at
-compile time), so these constants are only defaults read by the public functions.
+The constants (:mod:`polycontact.limits`, where each is defined with its reason) are
+re-exported here. Tolerances are always passed to kernels as arguments (Numba freezes
+module globals at compile time), so these constants are only defaults read by the
+public functions.
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import InvalidShapeError
+from .limits import (COORDINATE_LIMIT, EXTENT_FLOOR, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                     VALIDATION_ULPS)
 
 __all__ = [
     "RELATIVE_TOLERANCE",
@@ -48,33 +52,11 @@ __all__ = [
     "snap_grid",
 ]
 
-#: Relative to the size of the bodies: 1e-12 of a body's extent counts as zero. Far
-#: below any gap a user means (a shift of 1e-9 of a body's size is seen, 1000 times
-#: the tolerance), far above the rounding of arithmetic on coordinates of that size.
-RELATIVE_TOLERANCE = 1e-12
-
-#: Relative to the float spacing of the coordinates: 64 units in the last place of the
-#: largest absolute coordinate (64 * 2**-52 ~ 1.4e-14 of it). A translation or rotation of a
-#: small body far from the origin moves its vertices by rounding errors of a few ulps
-#: of its coordinates; 64 ulps is well above that and still resolves 1e-4 at 1e9.
-ROUNDING_ULPS = 64.0
-
-#: Largest absolute coordinate accepted. Products of three coordinate differences (up to
-#: (2e100)**3 = 8e300) stay finite in float64 (max ~1.8e308).
-COORDINATE_LIMIT = 1e100
-
-#: Smallest body extent accepted: products of three lengths (1e-300) stay normal floats.
-EXTENT_FLOOR = 1e-100
-
-#: A polygon is refused as invalid (two of its features meet) only when they are
-#: closer than float64 can tell apart: 4 units in the last place of its largest
-#: absolute coordinate, about the rounding of a distance computed from such coordinates. This
-#: is far below :func:`tolerance_for` on purpose: a valid polygon (GEOS's "very skinny
-#: polygon", 10 wide and 1e15 long) is accepted, and its features closer than the
-#: classification tolerance are then decided as touching.
-VALIDATION_ULPS = 4.0
-
 _ULP = 2.0**-52
+
+#: :data:`ROUNDING_ULPS` as a factor of the largest |coordinate| (``ROUNDING_ULPS ×
+#: 2**-52``): the form the time-of-impact and World kernels take it in.
+ROUNDING_FACTOR = ROUNDING_ULPS * _ULP
 
 
 def tolerance_for(extent: float, magnitude: float) -> float:

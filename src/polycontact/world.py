@@ -40,18 +40,17 @@ import numpy.typing as npt
 
 from ._checks import finite_number, points, real_array
 from ._checks import point as point_arg
-from .broad_phase import BROAD_PHASE_INFLATION
-from .impact import MAX_ITERATIONS
 from .motion import Motion
 from .relation import Relation, classify
 from .bodies import BodyLike, as_shape
-from .shape import Shape, _frozen
-from .tolerances import (COORDINATE_LIMIT, RELATIVE_TOLERANCE, ROUNDING_ULPS, check_range,
-                         default_tolerance)
+from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
+                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SWEPT_ROUNDING_ULPS,
+                     TIME_TOLERANCE)
+from .shape import Shape, frozen_ints
+from .tolerances import ROUNDING_FACTOR, check_range, default_tolerance
 
 __all__ = ["World", "WorldBody", "Contacts", "Query", "Sweep"]
 
-_ULP_FACTOR = ROUNDING_ULPS * 2.0**-52
 #: query_many tests every body's box, not the grid's cells, up to this many bodies.
 _SCAN_BODIES = 64
 
@@ -411,10 +410,9 @@ class Sweep:
     def _geometry(self) -> tuple[np.ndarray, np.ndarray]:
         from ._kernels.world_sweep import event_geometry
 
-        ev = self._events
-        point, normal = event_geometry(*ev, _chunks(len(self.times), _GEOMETRY_WORK))
+        point, normal = event_geometry(*self._events, _chunks(len(self.times), _GEOMETRY_WORK))
         for k in np.flatnonzero(np.isnan(normal[:, 0])).tolist():
-            point[k], normal[k] = _event_by_shapes(ev, k)
+            point[k], normal[k] = _event_by_shapes(self._events, k)
         point.flags.writeable = False
         normal.flags.writeable = False
         return point, normal
@@ -433,8 +431,7 @@ class Sweep:
 def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarray]:
     """Point and normal of pair k of a Sweep's events by :func:`polycontact.classify`
     (for bodies too large for the compiled depth)."""
-    pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb = ev[:12]
-    ma, mb = ev[15], ev[16]
+    (pa, pb, times, ca, cb, ta, tb, _, _, _, ma, mb), (bxy, ls, lo, nl, cen) = ev[:2]
     shapes = []
     for b, c, turn, m in ((pa[k], ca[k], ta[k], ma[k]), (pb[k], cb[k], tb[k], mb[k])):
         st = ls[lo[b] : lo[b] + nl[b] + 1]
@@ -498,7 +495,7 @@ def _body_tolerances(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     of its two bodies' (a maximum of per-body terms), which the kernels take."""
     extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     magnitude = np.maximum(-lo.min(axis=1), hi.max(axis=1))
-    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, _ULP_FACTOR * magnitude))
+    return cast("np.ndarray", np.maximum(RELATIVE_TOLERANCE * extent, ROUNDING_FACTOR * magnitude))
 
 
 def _stored_rows(xy: np.ndarray, ls: np.ndarray, bs: np.ndarray, sign: np.ndarray,
@@ -552,7 +549,7 @@ def _body_shape(xy: np.ndarray, ls: np.ndarray, lmap: np.ndarray, vmap: np.ndarr
     st = ls[lo : lo + nl + 1]
     loops = [xy[st[k] : st[k + 1]].copy() for k in range(nl)]
     return Shape._trusted(loops, repairs,
-                          (_frozen(lmap[lo : lo + nl]), _frozen(vmap[st[0] : st[-1]])))
+                          (frozen_ints(lmap[lo : lo + nl]), frozen_ints(vmap[st[0] : st[-1]])))
 
 
 def _contact_geometry(store: tuple[Any, ...], pairs: np.ndarray, states: np.ndarray,
@@ -564,11 +561,11 @@ def _contact_geometry(store: tuple[Any, ...], pairs: np.ndarray, states: np.ndar
     pi = np.ascontiguousarray(pairs[:, 0])
     pj = np.ascontiguousarray(pairs[:, 1])
     dist, normal, point, area, cen, side, vert, edge = kg.pair_geometry(
-        xy, ls, lo, nl, pi, pj, states, tolerances, vmax, lmax,
+        (xy, ls, lo, nl), (pi, pj, states, tolerances), vmax, lmax,
         _chunks(len(pi), _GEOMETRY_WORK))
     for k in np.flatnonzero(np.isnan(dist)).tolist():
         # a depth the contact segments leave undecided: the search over convex sums
-        from ._kernels.depth import penetration
+        from ._depth import penetration
 
         a = _snapshot_shape(store, int(pi[k]))
         b = _snapshot_shape(store, int(pj[k]))
@@ -817,10 +814,10 @@ class World:
         [[10.0, 0.0], [11.0, 0.0]]
         """
         from ._kernels.poses import centroids, pose_rows
-        from .relation import _pack
+        from .relation import pack_bodies
 
         objects: list[Shape | None] = []
-        xy, ls, bs, sign = _pack(shapes, "shapes", objects)
+        xy, ls, bs, sign = pack_bodies(shapes, "shapes", objects)
         count = len(sign)
         if names is not None:
             if isinstance(names, (str, bytes)) or not isinstance(names, (Sequence, np.ndarray)):
@@ -850,9 +847,8 @@ class World:
         self._rad[ids] = rad
         self._store(ids, rows, rows, vmap, ls, lmap, bs)
         if placed and count:
-            _, emax = pose_rows(ids, self._bxy, self._xy, self._ls, self._lo, self._nl,
-                                self._cen, p[:, 0].copy(), p[:, 1].copy(), a, self._box,
-                                self._eps, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+            _, emax = pose_rows(ids, (p[:, 0].copy(), p[:, 1].copy(), a), self._bodies(),
+                                (self._bxy, self._cen), (RELATIVE_TOLERANCE, ROUNDING_ULPS),
                                 _chunks(count, _POSE_WORK))
             self._emax = max(self._emax, float(emax))
         self._pos[ids] = p
@@ -996,7 +992,7 @@ class World:
 
     def _write_poses(self, idx: np.ndarray, pos: np.ndarray, ang: np.ndarray) -> None:
         """Set the checked poses: rows, boxes, tolerances, then the grid."""
-        from ._kernels.poses import pose_rows, regrid
+        from ._kernels.poses import pose_rows
 
         if not len(idx):
             return
@@ -1004,16 +1000,17 @@ class World:
             every = len(idx) == len(self._records)
             self._xy = np.empty_like(self._xy) if every else self._xy.copy()
             self._shared = False
-        _, emax = pose_rows(idx, self._bxy, self._xy, self._ls, self._lo, self._nl, self._cen,
-                            np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
-                            np.ascontiguousarray(ang), self._box, self._eps,
-                            RELATIVE_TOLERANCE, ROUNDING_ULPS, _chunks(len(idx), _POSE_WORK))
+        poses = (np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
+                 np.ascontiguousarray(ang))
+        _, emax = pose_rows(idx, poses, self._bodies(), (self._bxy, self._cen),
+                            (RELATIVE_TOLERANCE, ROUNDING_ULPS), _chunks(len(idx), _POSE_WORK))
         self._emax = max(self._emax, float(emax))
         self._pos[idx] = pos
         self._ang[idx] = ang
         self._ver[idx] += 1
-        made, done = regrid(idx, self._keys, self._heads, self._nxt, self._prv, self._slot,
-                            self._level, self._lvl_count, self._box, self._origin, self._filled)
+        made, done = _k().regrid(idx, self._keys, self._heads, self._nxt, self._prv,
+                                 self._slot, self._level, self._lvl_count, self._box,
+                                 self._origin, self._filled)
         self._filled += made
         if done < len(idx):  # the table would be more than half full: a new one, with
             self._rebuild(extra=int(idx[0]))  # every body in the cell of its new box
@@ -1161,8 +1158,13 @@ class World:
         return tol
 
     def _grid(self) -> tuple[Any, ...]:
+        """The broad phase's record of the kernels (``polycontact._kernels.world``)."""
         return (self._keys, self._heads, self._nxt, self._level, self._lvl_count,
                 self._levels(), self._origin if self._origin is not None else np.zeros(2))
+
+    def _bodies(self) -> tuple[Any, ...]:
+        """The stored bodies' record of the kernels (``polycontact._kernels.world``)."""
+        return (self._xy, self._ls, self._lo, self._nl, self._box, self._eps)
 
     def _hazards(self) -> tuple[Any, ...]:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
@@ -1203,20 +1205,18 @@ class World:
         k = _k()
         tol = self._tol(tolerance)
         gap = finite_number(margin, "margin", minimum=0.0)
-        alive = np.flatnonzero(self._live[: self._next]).astype(np.int64)
-        keys, heads, nxt, level, cnt, levels, origin = self._grid()
-        pi, pj = k.candidate_pairs(keys, heads, nxt, level, cnt, levels, origin, self._box,
-                                   self._eps, tol, alive, self._next, gap)
-        states, used = k.classify_pairs(self._xy, self._ls, self._lo, self._nl, self._eps,
-                                        tol, pi, pj, self._vmax, self._lmax,
+        alive = self._alive()
+        pi, pj = k.candidate_pairs(self._grid(), self._box, self._eps, tol, alive, self._next,
+                                   gap)
+        states, used = k.classify_pairs(self._bodies(), tol, pi, pj, self._vmax, self._lmax,
                                         _chunks(len(pi)))
         keep = states > 0
         if gap > 0.0:
             from ._kernels.contact_geometry import boundary_gaps
 
             near = np.flatnonzero(~keep)
-            gaps = boundary_gaps(self._xy, self._ls, self._lo, self._nl, pi[near], pj[near],
-                                 self._lmax, _chunks(len(near)))
+            gaps = boundary_gaps(self._bodies()[:4], pi[near], pj[near], self._lmax,
+                                 _chunks(len(near)))
             keep[near[gaps <= gap]] = True
         hit = np.flatnonzero(keep)
         if self._next < 2**31:  # one key per pair, no overflow: one sort, not a lexsort
@@ -1226,10 +1226,8 @@ class World:
         pairs = np.stack([pi[hit], pj[hit]], axis=1)
         states, used = states[hit], used[hit]
         if self._container is not None and len(alive):
-            cst = k.container_states(self._xy, self._ls, self._lo, self._nl, self._box,
-                                     self._eps, tol, alive, *self._hazards()[:4],
-                                     self._cbox, self._ceps, self._vmax, self._lmax,
-                                     self._hmax, _chunks(len(alive)))
+            cst = k.container_states(self._bodies(), tol, alive, self._hazards(), self._vmax,
+                                     self._lmax, self._hmax, _chunks(len(alive)))
             c_ids, c_states = alive[cst > 0], cst[cst > 0]
         else:
             c_ids, c_states = np.empty(0, np.int64), np.empty(0, np.int8)
@@ -1257,15 +1255,13 @@ class World:
         qeps = default_tolerance(qxy)
         k = _k()
         if self._records:
-            ids, states = k.query_states(qxy, qs, qeps, *self._grid(), self._xy, self._ls,
-                                         self._lo, self._nl, self._box, self._eps, tol,
-                                         self._emax,
-                                         self._next, self._vmax, self._lmax)
+            ids, states = k.query_states((qxy, qs, qeps), self._grid(), self._bodies(), tol,
+                                         self._emax, self._next, self._vmax, self._lmax)
         else:
             ids, states = np.empty(0, np.int64), np.empty(0, np.int8)
         cstate = 0
         if self._container is not None:
-            cstate = int(k.query_container(qxy, qs, qeps, tol, *self._hazards()))
+            cstate = int(k.query_container((qxy, qs, qeps), tol, self._hazards()))
         return Query(ids, states, cstate, placed)
 
     def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
@@ -1308,12 +1304,11 @@ class World:
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
                                             np.zeros(4), 0.0)
+        settings = (RELATIVE_TOLERANCE, ROUNDING_FACTOR, tol, self._emax, self._next,
+                    self._vmax, self._lmax, has_c, self._hmax if has_c else 0)
         states: np.ndarray = _k().query_many(
-            sxy, ss, float(c[0]), float(c[1]), pos[:, 0].copy(), pos[:, 1].copy(), ang,
-            RELATIVE_TOLERANCE, _ULP_FACTOR, tol, *self._grid(), self._xy, self._ls, self._lo,
-            self._nl, self._box, self._eps, self._emax, self._next, self._vmax, self._lmax, has_c,
-            *hz, self._hmax if has_c else 0, scan, _chunks(len(pos)),
-        )
+            (sxy, ss, float(c[0]), float(c[1])), (pos[:, 0].copy(), pos[:, 1].copy(), ang),
+            self._grid(), self._bodies(), hz, settings, scan, _chunks(len(pos)))
         return states
 
     # -- moving bodies ---------------------------------------------------------------
@@ -1347,7 +1342,8 @@ class World:
             Of shapes (N,), (N, 2), (N,); zero when omitted.
         time_tolerance : float, optional
             How precisely the first penetration time of a pair that collides is
-            located (as for ``time_of_impact``); default ``1e-4 * dt``.
+            located (as for ``time_of_impact``); default
+            :data:`~polycontact.limits.TIME_TOLERANCE` times ``dt``.
         max_iterations : int
             The exact search's budget per pair (see ``time_of_impact``).
 
@@ -1371,8 +1367,6 @@ class World:
         """
         from ._kernels.world_sweep import sweep_search
         from ._kernels.swept import box_pairs, swept_boxes
-        from .impact import _ULPS, CONTACT_RESOLUTION
-        from .impacts import MAX_SLICES, SWEPT_ROUNDING_ULPS
 
         step = finite_number(dt, "dt", minimum=0.0)
         ids = self.ids
@@ -1385,9 +1379,9 @@ class World:
                 motion[:, col] = _values(arr, name, n)
         if accelerations is not None:
             motion[:, 2:4] = points(accelerations, "accelerations", (n, 2))
-        tol = 1e-4 * step if time_tolerance is None else finite_number(
+        tol = TIME_TOLERANCE * step if time_tolerance is None else finite_number(
             time_tolerance, "time_tolerance", positive=True)
-        tol = tol if tol > 0.0 else 1e-4
+        tol = tol if tol > 0.0 else TIME_TOLERANCE
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
                 or max_iterations < 1:
             raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
@@ -1405,22 +1399,23 @@ class World:
         extent = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2])
         pi = np.ascontiguousarray(cand[:, 0])
         pj = np.ascontiguousarray(cand[:, 1])
+        base = (self._bxy, self._ls, self._lo, self._nl, self._cen)
         code, t_hit, t_contact, state = sweep_search(
-            pi, pj, ids, self._bxy, self._ls, self._lo, self._nl, self._cen, self._pos,
-            self._ang, self._rad, extent, motion, tint, tflt, tio, tfo, self._vmax,
-            self._lmax, step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, _ULPS,
-            CONTACT_RESOLUTION, int(max_iterations), _chunks(len(pi), _GEOMETRY_WORK))
+            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base,
+            (tint, tflt, tio, tfo),
+            (step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, ROUNDING_FACTOR,
+             CONTACT_RESOLUTION, int(max_iterations)),
+            self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
         met = np.flatnonzero(state > 0)
         order = met[np.lexsort((pj[met], pi[met], t_contact[met]))]
         i, j = pi[order], pj[order]
         a, b = ids[i], ids[j]
         times = t_contact[order]
-        events = (a, b, times, self._bxy, self._ls, self._lo.copy(), self._nl.copy(),
-                  self._cen, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
-                  self._rad[a], self._rad[b],
-                  RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i],
-                  motion[j], tint, tflt, tio.copy(), tfo.copy(), self._vmax, self._lmax,
-                  _ULPS)
+        events = ((a, b, times, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
+                   self._rad[a], self._rad[b],
+                   RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j]),
+                  (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
+                  (tint, tflt, tio.copy(), tfo.copy()), self._vmax, self._lmax, ROUNDING_FACTOR)
         hit = np.where(code[order] == 2, 0.0, np.where(code[order] == 1, t_hit[order], np.nan))
         return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
                      events)
@@ -1477,8 +1472,8 @@ class World:
                 tint = np.concatenate([tint, np.empty(max(itop - len(tint), len(tint)), np.int64)])
             if ftop > len(tflt):
                 tflt = np.concatenate([tflt, np.empty(max(ftop - len(tflt), len(tflt)))])
-            frame_tables(self._bxy, self._ls, self._lo, self._nl, self._cen, todo, tint, tflt,
-                         tio, tfo)
+            frame_tables((self._bxy, self._ls, self._lo, self._nl, self._cen), todo,
+                         (tint, tflt, tio, tfo))
         self._frames = (tint, tflt, tio, tfo, itop, ftop)
 
     def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:

@@ -7,10 +7,15 @@ Conventions shared by every kernel:
   and ``starts`` (int64, shape (L + 1,)) with loop ``k`` occupying rows
   ``starts[k]:starts[k + 1]``. Edge ``e`` of loop ``k`` joins its vertex ``e`` and vertex
   ``(e + 1) % n_k``.
-- Tolerances arrive as arguments, never from module globals.
-- Kernels are compiled on first use (``cache=True``), never at import.
+- Tolerances and limits arrive as arguments, never from module globals.
+- Kernels are compiled on first use (``cache=True``), never at import; the cache
+  locator (:mod:`.cache`) is installed here, before any kernel module is loaded.
+- This package imports NumPy, Numba and itself only (and ``platformdirs`` for the
+  cache's directory). A kernel reports what it finds (a status code, NaNs); the public
+  function that called it raises the error. (A kernel raises only when its caller gave
+  it a scratch buffer too short.)
 """
 
-from ..compiling import install_cache_locator
+from .cache import install_cache_locator
 
 install_cache_locator()

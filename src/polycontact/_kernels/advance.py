@@ -28,7 +28,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .validate import closest_on_segment
+from .primitives import closest_on_segment, outward_normal
+
 
 #: Entries of the traversal stack (see :func:`traversal_stack`).
 STACK_SIZE = 160
@@ -199,20 +200,7 @@ def _root_or_linear(g, r, k, speed, cap):
 
 
 @njit(cache=True, nogil=True)
-def outward_normal(ax, ay, bx, by):
-    """``(length, nx, ny)`` of edge ab and its unit outward normal (the interior is on
-    the edge's left, so the normal points right); the normal is (0, 0) for a point."""
-    ex = bx - ax
-    ey = by - ay
-    ln = np.sqrt(ex * ex + ey * ey)
-    if ln == 0.0:
-        return 0.0, 0.0, 0.0
-    return ln, ey / ln, -ex / ln
-
-
-@njit(cache=True, nogil=True)
-def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, level, cap, dax,
-               day):
+def line_time(p, ax, ay, bx, by, e, kin, level, cap):
     """A time in [0, cap] during which vertex p stays more than ``level`` in front of the
     line of edge ab as the line turns with its body E (0 if it is not now; arguments as
     in :func:`_vertex_edge_time`).
@@ -221,10 +209,12 @@ def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, 
     s = n_E·(P − X); with w = p − c_E, P̈ = Rᵀ(ẅ − 2 ω_E J ẇ − ω_E² w − α_E J w), so
     |s''| <= |n·Δa| + K_v |r_p| + 2 W_e |ẇ| + K_e |w|, with |ẇ| <= V + W_v |r_p| and
     |w| growing by at most that speed times the step; s' now is (ṗ − u(p))·n_E. The
-    relative acceleration ``(dax, day)`` counts only across the line (n turns by at
-    most W_e·cap, which adds |Δa| W_e cap), so a body sliding along a still edge while
-    it speeds up or slows down keeps long steps.
+    relative acceleration Δa counts only across the line (n turns by at most W_e·cap,
+    which adds |Δa| W_e cap), so a body sliding along a still edge while it speeds up or
+    slows down keeps long steps.
     """
+    px, py, vx, vy, rp = p
+    cex, cey, uex, uey, we = e
     ln, lx, ly = outward_normal(ax, ay, bx, by)
     if ln == 0.0:
         return 0.0
@@ -233,27 +223,27 @@ def _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin, 
     sp = kin[3] + kin[4] * rp
     far = np.sqrt(wx * wx + wy * wy) + cap * sp
     # the relative acceleration (dax, day) across the line, which turns by <= W_e·cap
-    k = (abs(dax * lx + day * ly) + kin[0] * kin[5] * cap + kin[1] * rp + 2.0 * kin[5] * sp
-         + kin[2] * far)
+    k = (abs(kin[6] * lx + kin[7] * ly) + kin[0] * kin[5] * cap + kin[1] * rp
+         + 2.0 * kin[5] * sp + kin[2] * far)
     slope = (vx - uex + we * wy) * lx + (vy - uey - we * wx) * ly
     return _root((px - ax) * lx + (py - ay) * ly - level, slope, k, cap)
 
 
 @njit(cache=True, nogil=True)
-def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex, uey, we, kin,
-                      lam, cap, touch, dax, day):
+def _vertex_edge_time(p, ax, ay, bx, by, ra, rb, e, kin, lam, cap, touch):
     """``(d², τ)``: the squared distance from vertex p to edge ab of the other body E, and
     a time in [0, cap] during which p stays more than ``lam`` from the edge. A pair within
     ``lam`` now gets 0, or, when ``touch`` > 0, the time during which p stays no more
-    than ``touch`` behind the edge's turning line (:func:`_line_time`; see
+    than ``touch`` behind the edge's turning line (:func:`line_time`; see
     :func:`pair_step` for what that proves).
 
-    ``(vx, vy)`` is p's velocity, ``rp`` its distance from its body's centroid; ``ra``,
-    ``rb`` those of the edge's ends from E's centroid ``(cex, cey)``; E moves with
-    velocity ``(uex, uey)`` and angular velocity ``we``, so its point x moves at
-    u(x) = u_E + ω_E J (x − c_E). ``kin`` is ``(|Δa|, K_v, K_e, V, W_v, W_e)``: the
+    ``p`` is ``(px, py, vx, vy, rp)``: the vertex, its velocity, and its distance from
+    its body's centroid; ``ra``, ``rb`` those of the edge's ends from E's centroid;
+    ``e`` is ``(cex, cey, uex, uey, we)``: E's centroid, velocity and angular velocity,
+    so that its point x moves at u(x) = u_E + ω_E J (x − c_E). ``kin`` is
+    ``(|Δa|, K_v, K_e, V, W_v, W_e, Δax, Δay)`` (:func:`window_kinematics`): the
     relative acceleration, |α| + ω_max² of p's body and of E, the largest |Δv| and |ω|
-    of p's body and of E over the window; ``(dax, day)`` is Δa itself.
+    of p's body and of E over the window, and Δa itself.
 
     The longest of three lower bounds of the same time:
 
@@ -264,16 +254,17 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
     - the same with the plain speed bound |f'| <= V + W_v |r_p| + W_e |r_x|
       (:func:`_root_or_linear`);
     - when p is more than ``lam`` outside the edge's line, its signed distance to the
-      line turning with E (:func:`_line_time`), a lower bound of the distance to the
+      line turning with E (:func:`line_time`), a lower bound of the distance to the
       edge. Its slope now is the velocity of p relative to E's point under it, so a
       vertex sliding along the line (or closing slowly towards it while the edge
       turns) keeps long steps.
     """
+    px, py, vx, vy, rp = p
+    cex, cey, uex, uey, we = e
     qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
     if d2 <= lam * lam:
         if touch > 0.0:
-            return d2, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
-                                  -touch, cap, dax, day)
+            return d2, line_time(p, ax, ay, bx, by, e, kin, -touch, cap)
         return d2, 0.0
     sp = kin[3] + kin[4] * rp
     if d2 > (lam + cap * (sp + kin[5] * max(ra, rb))) ** 2:
@@ -293,23 +284,24 @@ def _vertex_edge_time(px, py, vx, vy, rp, ax, ay, bx, by, ra, rb, cex, cey, uex,
                               (vx - ubx) * nx + (vy - uby) * ny, kp + kin[2] * rb,
                               sp + kin[5] * rb, cap))
     if tau < cap:
-        tau = max(tau, _line_time(px, py, vx, vy, rp, ax, ay, bx, by, cex, cey, uex, uey, we, kin,
-                                  lam, cap, dax, day))
+        tau = max(tau, line_time(p, ax, ay, bx, by, e, kin, lam, cap))
     return d2, tau
 
 
 @njit(cache=True, nogil=True)
-def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vby, wb, kin,
-               lam, cap):
+def _node_time(qa, ka, fa, qb, kb, fb, kin, lam, cap):
     """A time in [0, cap] during which node ``ka`` of A's tree and node ``kb`` of B's
     (``qa``, ``qb``: the ``circles`` of :func:`edge_table`) stay more than ``lam`` apart
-    (0 if their circles are that close now).
+    (0 if their circles are that close now). ``fa``, ``fb``: each body's frame at t0,
+    ``(c, cos, sin, vx, vy, ω)`` (its centroid, turn, velocity and angular velocity).
 
     The centres are material points at body-frame ``(cx, cy)``; with u = C_A − C_B and
     n = u/|u| now, |u(t)| >= n·u(t), whose slope now is n·(Ċ_A − Ċ_B) and whose second
     derivative is at most Δa + K_A |r_cA| + K_B |r_cB|; the circles are apart while
     |u| > rho_A + rho_B.
     """
+    ca, csa, sna, vax, vay, wa = fa
+    cb, csb, snb, vbx, vby, wb = fb
     rx = qa[ka, 0]
     ry = qa[ka, 1]
     xa = csa * rx - sna * ry
@@ -329,12 +321,15 @@ def _node_time(qa, ka, ca, csa, sna, vax, vay, wa, qb, kb, cb, csb, snb, vbx, vb
 
 
 @njit(cache=True, nogil=True)
-def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, sne, uex, uey, we,
-               re_len, nxt_e, kin, lam, step, dmin2, crit, touch, dax, day):
-    """Vertex i of one body against edge j of the other: ``(dmin2, step)`` updated, and
-    ``crit`` set to ``(way, i, j)`` when the pair shortens the step. The three points
-    are placed from the body frame (``rv``, ``re``), each body turned by its
-    ``(cos, sin)`` about its centroid ``cv``, ``ce``."""
+def _leaf_pair(way, i, j, v, e, kin, lam, step, dmin2, crit, touch):
+    """Vertex i of one body (``v``) against edge j of the other (``e``): ``(dmin2,
+    step)`` updated, and ``crit`` set to ``(way, i, j)`` when the pair shortens the
+    step. Each body is ``(r, nxt, r_len, frame)``: its vertices in the body frame, the
+    next vertex and the distance from the centroid of each (:func:`edge_table`), and its
+    frame at t0 (see :func:`_node_time`); the three points are placed from the body
+    frame, each body turned about its centroid."""
+    rv, _, rv_len, (cv, csv, snv, vvx, vvy, wv) = v
+    re, nxt_e, re_len, (ce, cse, sne, uex, uey, we) = e
     j1 = nxt_e[j]
     px = cv[0] + csv * rv[i, 0] - snv * rv[i, 1]
     py = cv[1] + snv * rv[i, 0] + csv * rv[i, 1]
@@ -342,9 +337,9 @@ def _leaf_pair(way, i, j, rv, cv, csv, snv, vvx, vvy, wv, rv_len, re, ce, cse, s
     ay = ce[1] + sne * re[j, 0] + cse * re[j, 1]
     bx = ce[0] + cse * re[j1, 0] - sne * re[j1, 1]
     by = ce[1] + sne * re[j1, 0] + cse * re[j1, 1]
-    d2, tau = _vertex_edge_time(px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]),
-                                rv_len[i], ax, ay, bx, by, re_len[j], re_len[j1], ce[0], ce[1],
-                                uex, uey, we, kin, lam, step, touch, dax, day)
+    d2, tau = _vertex_edge_time(
+        (px, py, vvx - wv * (py - cv[1]), vvy + wv * (px - cv[0]), rv_len[i]), ax, ay, bx, by,
+        re_len[j], re_len[j1], (ce[0], ce[1], uex, uey, we), kin, lam, step, touch)
     if tau < step:
         step = tau
         crit[0], crit[1], crit[2] = way, i, j
@@ -356,9 +351,9 @@ def window_kinematics(ma, mb, t0, t1):
     """``((vax, vay, ωa), (vbx, vby, ωb), kin_ab, kin_ba)``: each body's velocity and
     angular velocity at t0, and the window tuples of the bounds over [t0, t1] for
     vertices of A against edges of B and the other way round:
-    ``(|Δa|, K_v, K_e, V, W_v, W_e)`` with K = |α| + ω_max², V the largest |Δv| and W
-    the largest |ω| over the window (ω and Δv are affine in t: their largest norms are
-    at the window's ends)."""
+    ``(|Δa|, K_v, K_e, V, W_v, W_e, Δax, Δay)`` with K = |α| + ω_max², V the largest |Δv|
+    and W the largest |ω| over the window (ω and Δv are affine in t: their largest norms
+    are at the window's ends), Δa = a_A − a_B."""
     h = t1 - t0
     vax = ma[0] + ma[2] * t0
     vay = ma[1] + ma[3] * t0
@@ -376,24 +371,22 @@ def window_kinematics(ma, mb, t0, t1):
     dvx = vax - vbx
     dvy = vay - vby
     lin = np.sqrt(max(dvx * dvx + dvy * dvy, (dvx + dax * h) ** 2 + (dvy + day * h) ** 2))
-    return ((vax, vay, wa), (vbx, vby, wb), (da, ka, kb, lin, wa_max, wb_max),
-            (da, kb, ka, lin, wb_max, wa_max))
+    return ((vax, vay, wa), (vbx, vby, wb), (da, ka, kb, lin, wa_max, wb_max, dax, day),
+            (da, kb, ka, lin, wb_max, wa_max, dax, day))
 
 
 @njit(cache=True, nogil=True)
-def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack, stau,
-              touch):
+def pair_step(a, ca, ma, b, cb, mb, window, gaps, crit, traversal):
     """``(distance, step)``: the gap, and a time step in [0, t1 − t0] during which no
     vertex comes within ``lam_pair`` (<= ``lam``) of an edge of the other body.
 
-    ``ra`` are A's vertices in its body frame (relative to its centroid at t = 0, as
-    given to :func:`edge_table`), ``ca`` its centroid at t0, ``ea`` its
-    :func:`edge_table` (likewise B); ``ma``,
-    ``mb`` the motion vectors ``[vx, vy, ax, ay, ω, α]``; [t0, t1] the window over which
-    the bounds hold. ``crit`` (int64, 3) names the pair that set the last step,
-    ``(way, vertex, edge)`` (way 0: vertex of A; −1: none); it is charged first, so that
-    the step is near its final value early and most node pairs are pruned, and it is
-    updated. ``stack``, ``stau``: :func:`traversal_stack`.
+    ``a`` is ``(r, table)``: A's vertices in its body frame (relative to its centroid at
+    t = 0) and their :func:`edge_table`; ``ca`` its centroid at t0 (likewise B); ``ma``,
+    ``mb`` the motion vectors ``[vx, vy, ax, ay, ω, α]``; ``window`` ``(t0, t1)``, over
+    which the bounds hold; ``gaps`` ``(lam, lam_pair, touch)``. ``crit`` (int64, 3) names
+    the pair that set the last step, ``(way, vertex, edge)`` (way 0: vertex of A; −1:
+    none); it is charged first, so that the step is near its final value early and most
+    node pairs are pruned, and it is updated. ``traversal``: :func:`traversal_stack`.
 
     Each vertex–edge pair is charged :func:`_vertex_edge_time`; pairs of tree nodes
     whose circles stay more than ``lam`` apart for the current step
@@ -416,28 +409,29 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
     straight edge, under an overhang or not — is followed by steps as long as the
     nearest other pair allows.
     """
+    t0, t1 = window
+    lam, lam_pair, touch = gaps
+    stack, stau = traversal
+    ra, ea = a
+    rb, eb = b
     h = t1 - t0
     tha = ma[4] * t0 + 0.5 * ma[5] * t0 * t0
     thb = mb[4] * t0 + 0.5 * mb[5] * t0 * t0
-    csa = np.cos(tha)
-    sna = np.sin(tha)
-    csb = np.cos(thb)
-    snb = np.sin(thb)
     (vax, vay, wa), (vbx, vby, wb), kin_ab, kin_ba = window_kinematics(ma, mb, t0, t1)
-    dax = ma[2] - mb[2]
-    day = ma[3] - mb[3]
-    nxa, la, qa, ra_len = ea
-    nxb, lb, qb, rb_len = eb
+    fa = (ca, np.cos(tha), np.sin(tha), vax, vay, wa)
+    fb = (cb, np.cos(thb), np.sin(thb), vbx, vby, wb)
+    va = (ra, ea[0], ea[3], fa)
+    vb = (rb, eb[0], eb[3], fb)
+    la, qa = ea[1], ea[2]
+    lb, qb = eb[1], eb[2]
     step = h
     dmin2 = np.inf
     if crit[0] == 0:
-        dmin2, step = _leaf_pair(0, crit[1], crit[2], ra, ca, csa, sna, vax, vay, wa, ra_len, rb,
-                                 cb, csb, snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step,
-                                 dmin2, crit, touch, dax, day)
+        dmin2, step = _leaf_pair(0, crit[1], crit[2], va, vb, kin_ab, lam_pair, step, dmin2,
+                                 crit, touch)
     elif crit[0] == 1:
-        dmin2, step = _leaf_pair(1, crit[1], crit[2], rb, cb, csb, snb, vbx, vby, wb, rb_len, ra,
-                                 ca, csa, sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step,
-                                 dmin2, crit, touch, dax, day)
+        dmin2, step = _leaf_pair(1, crit[1], crit[2], vb, va, kin_ba, lam_pair, step, dmin2,
+                                 crit, touch)
     stack[0, 0] = 0
     stack[0, 1] = 0
     stau[0] = 0.0
@@ -451,22 +445,18 @@ def pair_step(ra, ca, ea, rb, cb, eb, ma, mb, t0, t1, lam, lam_pair, crit, stack
         i = la[na, 2]
         j = lb[nb, 2]
         if i >= 0 and j >= 0:
-            dmin2, step = _leaf_pair(0, i, j, ra, ca, csa, sna, vax, vay, wa, ra_len, rb, cb, csb,
-                                     snb, vbx, vby, wb, rb_len, nxb, kin_ab, lam_pair, step, dmin2,
-                                     crit, touch, dax, day)
-            dmin2, step = _leaf_pair(1, j, i, rb, cb, csb, snb, vbx, vby, wb, rb_len, ra, ca, csa,
-                                     sna, vax, vay, wa, ra_len, nxa, kin_ba, lam_pair, step, dmin2,
-                                     crit, touch, dax, day)
+            dmin2, step = _leaf_pair(0, i, j, va, vb, kin_ab, lam_pair, step, dmin2, crit,
+                                     touch)
+            dmin2, step = _leaf_pair(1, j, i, vb, va, kin_ba, lam_pair, step, dmin2, crit,
+                                     touch)
             continue
         # open the wider node (a leaf is never opened)
         if j >= 0 or (i < 0 and qa[na, 2] >= qb[nb, 2]):
             a1, b1, a2, b2 = la[na, 0], nb, la[na, 1], nb
         else:
             a1, b1, a2, b2 = na, lb[nb, 0], na, lb[nb, 1]
-        t_1 = _node_time(qa, a1, ca, csa, sna, vax, vay, wa, qb, b1, cb, csb, snb, vbx, vby, wb,
-                         kin_ab, lam, step)
-        t_2 = _node_time(qa, a2, ca, csa, sna, vax, vay, wa, qb, b2, cb, csb, snb, vbx, vby, wb,
-                         kin_ab, lam, step)
+        t_1 = _node_time(qa, a1, fa, qb, b1, fb, kin_ab, lam, step)
+        t_2 = _node_time(qa, a2, fa, qb, b2, fb, kin_ab, lam, step)
         if t_1 < t_2:                   # the nearer pair is opened first
             a1, b1, t_1, a2, b2, t_2 = a2, b2, t_2, a1, b1, t_1
         if t_1 < step:

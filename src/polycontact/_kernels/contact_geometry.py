@@ -19,8 +19,10 @@ For each pair of bodies (packed as in :mod:`polycontact._kernels.world`), by its
   run together) is left with a NaN distance, for the caller's search over convex sums.
 
 Vertices and edges come out as packed rows of each body; the caller maps them to its
-numbering. The pairs run in parallel chunks (one chunk: serial, no thread start); each
-chunk allocates its scratch once.
+numbering. The bodies come as ``rows`` = ``(xy, ls, lo, nl)``, the packed rows of a
+World's bodies (the first four fields of its ``bodies`` record). The pairs run in
+parallel chunks (one chunk: serial, no thread start); each chunk allocates its scratch
+once.
 """
 
 from __future__ import annotations
@@ -28,12 +30,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .convolution import FEW_VERTICES, _next, contact_depth_into, depth_buffers
+from .convolution import FEW_VERTICES, contact_depth_into, depth_buffers
 from .depth import box_escape
-from .overlap import overlap_moments, where
-from .relation import _bbox
-from .validate import closest_on_segment
-from .world import _view
+from .overlap import overlap_moments, overlap_scratch, where
+from .primitives import bbox, closest_on_segment, loop_next, loop_prev
+from .world import body_view
 
 SEPARATE = 0
 CONTACT = 1
@@ -61,7 +62,7 @@ def closest_features(xa, sa, xb, sb):
         xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
         nv = sv[sv.shape[0] - 1]
         no = so[so.shape[0] - 1]
-        ox0, ox1, oy0, oy1 = _bbox(xo, no)
+        ox0, ox1, oy0, oy1 = bbox(xo, no)
         for i in range(nv):
             px = xv[i, 0]
             py = xv[i, 1]
@@ -71,7 +72,7 @@ def closest_features(xa, sa, xb, sb):
                 continue
             for ko in range(so.shape[0] - 1):
                 for f in range(so[ko], so[ko + 1]):
-                    f1 = _next(f, so, ko)
+                    f1 = loop_next(f, so, ko)
                     ax, bx = xo[f, 0], xo[f1, 0]
                     ay, by = xo[f, 1], xo[f1, 1]
                     ex = max(0.0, px - max(ax, bx), min(ax, bx) - px)
@@ -108,18 +109,18 @@ def touch(xa, sa, xb, sb, eps):
         xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
         sign = 1.0 if side == 0 else -1.0
         no = so[so.shape[0] - 1]
-        ox0, ox1, oy0, oy1 = _bbox(xo, no)
+        ox0, ox1, oy0, oy1 = bbox(xo, no)
         for kv in range(sv.shape[0] - 1):
             for i in range(sv[kv], sv[kv + 1]):
                 px = xv[i, 0]
                 py = xv[i, 1]
                 if px < ox0 - eps or px > ox1 + eps or py < oy0 - eps or py > oy1 + eps:
                     continue
-                ip = i - 1 if i > sv[kv] else sv[kv + 1] - 1
-                inx = _next(i, sv, kv)
+                ip = loop_prev(i, sv, kv)
+                inx = loop_next(i, sv, kv)
                 for ko in range(so.shape[0] - 1):
                     for f in range(so[ko], so[ko + 1]):
-                        f1 = _next(f, so, ko)
+                        f1 = loop_next(f, so, ko)
                         ax, ay, bx, by = xo[f, 0], xo[f, 1], xo[f1, 0], xo[f1, 1]
                         if closest_on_segment(px, py, ax, ay, bx, by)[2] > eps * eps:
                             continue
@@ -160,7 +161,7 @@ def carrier(xa, sa, xb, sb, dx, dy):
             py = xv[i, 1] + sy
             for ko in range(so.shape[0] - 1):
                 for f in range(so[ko], so[ko + 1]):
-                    f1 = _next(f, so, ko)
+                    f1 = loop_next(f, so, ko)
                     d2 = closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[f1, 0],
                                             xo[f1, 1])[2]
                     if d2 < best:
@@ -170,22 +171,24 @@ def carrier(xa, sa, xb, sb, dx, dy):
 
 
 @njit(cache=True, nogil=True)
-def _penetrating(ya, sa, yb, sb, e, depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids,
-                 where_a, where_b):
+def _penetrating(ya, sa, yb, sb, e, buffers):
     """Geometry of a penetrating pair: ``(depth, nx, ny, px, py, area, cx, cy, side,
-    vertex, edge)``, NaN depth when undecided here (see the module docstring)."""
+    vertex, edge)``, NaN depth when undecided here (see the module docstring);
+    ``buffers`` = ``(depth, overlap)``: the scratch of
+    :func:`polycontact._kernels.convolution.contact_depth_into` and of
+    :func:`polycontact._kernels.overlap.overlap_moments`."""
     na = ya.shape[0]
     nb = yb.shape[0]
-    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, cross, ts, acc,
-                                       boxes, ids, where_a, where_b)
+    depth_buf, scratch = buffers
+    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
     if nc < 0:  # more crossings than the scratch holds: a buffer of the bodies' size
-        big = np.empty((na * nb + 1, 6))
-        area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, deg_a, deg_b, big,
-                                           np.empty(na * nb + na + nb + 3), acc, boxes, ids,
-                                           where_a, where_b)
-        cross = big
+        big = na * nb + 1
+        scratch = (scratch[0], scratch[1], np.empty((big, 6)), np.empty(big + na + nb + 2),
+                   scratch[4], scratch[5], scratch[6], scratch[7], scratch[8])
+        area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
     if na + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
+    cross, acc, where_a, where_b = scratch[2], scratch[4], scratch[7], scratch[8]
     bound, bdx, bdy = box_escape(ya, yb)
     # A vertex inside the other body by more than a length keeps the bodies penetrating
     # through any translation shorter than it (less the tolerance): no test there.
@@ -214,7 +217,7 @@ def _deepest(xv, where_v, xo, so):
         near = np.inf
         for k in range(so.shape[0] - 1):
             for f in range(so[k], so[k + 1]):
-                g = _next(f, so, k)
+                g = loop_next(f, so, k)
                 near = min(near, closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0],
                                                     xo[g, 1])[2])
         best = max(best, near)
@@ -232,7 +235,7 @@ def normal_of(ya, sa, yb, sb, d, dx, dy, side, f):
     ko = 0
     while so[ko + 1] <= f:
         ko += 1
-    f1 = _next(f, so, ko)
+    f1 = loop_next(f, so, ko)
     ux = xo[f1, 0] - xo[f, 0]
     uy = xo[f1, 1] - xo[f, 1]
     ln = np.sqrt(ux * ux + uy * uy)
@@ -272,11 +275,8 @@ def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
     vertex, edge) for one pair in ``state`` (see the module docstring); ``buffers`` as
     :func:`geometry_buffers` makes them."""
     dist, normal, point, area, centroid, side, vert, edge = out
-    depth_buf, deg_a, deg_b, cross, ts, acc, boxes, ids, where_a, where_b = buffers
     if state == PENETRATING:
-        d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, depth_buf,
-                                                           deg_a, deg_b, cross, ts, acc,
-                                                           boxes, ids, where_a, where_b)
+        d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, buffers)
         dist[k] = -d
     elif state == CONTACT:
         nx, ny, s, v, f = touch(ya, sa, yb, sb, e)
@@ -323,63 +323,65 @@ def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
 def geometry_buffers(vmax):
     """Scratch of :func:`pair_geometry_into` for bodies of up to ``vmax`` vertices."""
     m = min(vmax, FEW_VERTICES)
-    cap = 8 * vmax + 64
-    return (depth_buffers(m, m), np.empty(vmax, np.bool_), np.empty(vmax, np.bool_),
-            np.empty((cap, 6)), np.empty(cap + 2 * vmax + 2), np.empty(6),
-            np.empty((vmax, 4)), np.empty(2 * vmax, np.int64), np.empty(vmax, np.int8),
-            np.empty(vmax, np.int8))
+    return depth_buffers(m, m), overlap_scratch(vmax, vmax, 8 * vmax + 64)
 
 
 @njit(cache=True, nogil=True)
-def _geometry_range(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, k0, k1, out):
+def _geometry_range(rows, pairs, vmax, lmax, k0, k1, out):
+    """:func:`pair_geometry` for the pairs ``k0:k1``, into ``out``."""
+    xy, ls, lo, nl = rows
+    pi, pj, states, tols = pairs
     buffers = geometry_buffers(vmax)
     ba = np.empty(lmax + 1, np.int64)
     bb = np.empty(lmax + 1, np.int64)
     for k in range(k0, k1):
-        ya, sa = _view(xy, ls, lo, nl, pi[k], ba)
-        yb, sb = _view(xy, ls, lo, nl, pj[k], bb)
+        ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
+        yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
         pair_geometry_into(ya, sa, yb, sb, states[k], tols[k], buffers, out, k)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def pair_geometry(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, chunks):
-    """Geometry of the pairs (pi[k], pj[k]) of a World's bodies in ``states[k]`` with
-    tolerances ``tols[k]``: ``(distance, normal, point, area, centroid, side, vertex,
-    edge)`` (see the module docstring; vertices and edges as packed rows of each body),
-    in parallel chunks (``chunks`` = 1: serial, no thread start)."""
-    n = pi.shape[0]
+def pair_geometry(rows, pairs, vmax, lmax, chunks):
+    """Geometry of the pairs ``pairs`` = ``(pi, pj, states, tols)`` of a World's bodies
+    (``rows``, see the module docstring): bodies pi[k] and pj[k] in ``states[k]`` with
+    tolerance ``tols[k]``. Returns ``(distance, normal, point, area, centroid, side,
+    vertex, edge)`` (vertices and edges as packed rows of each body), in parallel chunks
+    (``chunks`` = 1: serial, no thread start); ``vmax``, ``lmax``: the most vertices
+    and loops of a body."""
+    n = pairs[0].shape[0]
     out = (np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n), np.empty((n, 2)),
            np.empty(n, np.int8), np.empty(n, np.int64), np.empty(n, np.int64))
     if chunks == 1:
-        _geometry_range(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, 0, n, out)
+        _geometry_range(rows, pairs, vmax, lmax, 0, n, out)
         return out
     for c in prange(chunks):
-        _geometry_range(xy, ls, lo, nl, pi, pj, states, tols, vmax, lmax, n * c // chunks,
-                        n * (c + 1) // chunks, out)
+        _geometry_range(rows, pairs, vmax, lmax, n * c // chunks, n * (c + 1) // chunks, out)
     return out
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def boundary_gaps(xy, ls, lo, nl, pi, pj, lmax, chunks):
-    """The gap between the boundaries of each pair (pi[k], pj[k]) (see
-    :func:`closest_features`), in parallel chunks."""
+def boundary_gaps(rows, pi, pj, lmax, chunks):
+    """The gap between the boundaries of each pair (pi[k], pj[k]) of a World's bodies
+    (``rows``; see :func:`closest_features`), in parallel chunks."""
     n = pi.shape[0]
     out = np.empty(n)
     if chunks == 1:
-        _gaps_range(xy, ls, lo, nl, pi, pj, lmax, 0, n, out)
+        _gaps_range(rows, pi, pj, lmax, 0, n, out)
         return out
     for c in prange(chunks):
-        _gaps_range(xy, ls, lo, nl, pi, pj, lmax, n * c // chunks, n * (c + 1) // chunks, out)
+        _gaps_range(rows, pi, pj, lmax, n * c // chunks, n * (c + 1) // chunks, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _gaps_range(xy, ls, lo, nl, pi, pj, lmax, k0, k1, out):
+def _gaps_range(rows, pi, pj, lmax, k0, k1, out):
+    """:func:`boundary_gaps` for the pairs ``k0:k1``, into ``out``."""
+    xy, ls, lo, nl = rows
     ba = np.empty(lmax + 1, np.int64)
     bb = np.empty(lmax + 1, np.int64)
     for k in range(k0, k1):
-        ya, sa = _view(xy, ls, lo, nl, pi[k], ba)
-        yb, sb = _view(xy, ls, lo, nl, pj[k], bb)
+        ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
+        yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
         out[k] = closest_features(ya, sa, yb, sb)[0]
 
 
@@ -388,16 +390,10 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
     """Normal, point and carrying features of a penetration whose depth ``d`` and
     escape (dx, dy) were found elsewhere (the search over convex sums):
     ``(nx, ny, px, py, side, vertex, edge)``, as :func:`pair_geometry_into` gives them."""
-    na = xa.shape[0]
-    nb = xb.shape[0]
     side, v, f = carrier(xa, sa, xb, sb, dx, dy)
-    cross = np.empty((na * nb + 1, 6))
-    acc = np.empty(6)
-    nc = overlap_moments(xa, sa, xb, sb, e, np.empty(na, np.bool_), np.empty(nb, np.bool_),
-                         cross, np.empty(na * nb + na + nb + 3), acc, np.empty((nb, 4)),
-                         np.empty(2 * nb, np.int64), np.empty(na, np.int8),
-                         np.empty(nb, np.int8))[3]
-    px, py = point_of(xa, sa, xb, sb, e, side, v, cross, nc, acc)
+    scratch = overlap_scratch(xa.shape[0], xb.shape[0], xa.shape[0] * xb.shape[0] + 1)
+    nc = overlap_moments(xa, sa, xb, sb, e, scratch)[3]
+    px, py = point_of(xa, sa, xb, sb, e, side, v, scratch[2], nc, scratch[4])
     nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
     return nx, ny, px, py, side, v, f
 

@@ -39,7 +39,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import PENETRATING, _bbox, _norm, _scratch_views, _state_in, scratch_floats
+from .packs import scratch_floats, state_scratch_views
+from .primitives import (bbox, grow_rows, loop_next, loop_prev, norm, origin_distance_sq,
+                         origin_foot)
+from .relation import PENETRATING, state_in
+
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
 #: segments, O(K) tests to split each of the K near the origin); above it the caller's
@@ -56,32 +60,13 @@ _SIN_PARALLEL = 1.0 / 64.0
 _SIN_SLACK = 1e-6
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _next(i, starts, k):
-    return i + 1 if i + 1 < starts[k + 1] else starts[k]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _prev(i, starts, k):
-    return i - 1 if i > starts[k] else starts[k + 1] - 1
-
-
-@njit(cache=True, nogil=True)
-def _edges(x, st):
-    """Each edge's direction and length (rows ``(gx, gy, length)``, edge i from vertex
-    i to the next of its loop) and each vertex's successor."""
-    e = np.empty((x.shape[0], 3))
-    nxt = np.empty(x.shape[0], np.int64)
-    _edges_into(x, st, e, nxt)
-    return e, nxt
-
-
 @njit(cache=True, nogil=True)
 def _edges_into(x, st, e, nxt):
-    """:func:`_edges` written into ``e`` and ``nxt``."""
+    """Each edge's direction and length (rows ``(gx, gy, length)`` of ``e``, edge i from
+    vertex i to the next of its loop) and each vertex's successor (``nxt``)."""
     for k in range(st.shape[0] - 1):
         for i in range(st[k], st[k + 1]):
-            j = _next(i, st, k)
+            j = loop_next(i, st, k)
             nxt[i] = j
             e[i, 0] = x[j, 0] - x[i, 0]
             e[i, 1] = x[j, 1] - x[i, 1]
@@ -91,7 +76,7 @@ def _edges_into(x, st, e, nxt):
 @njit(cache=True, nogil=True)
 def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
     """Append the kept segments of the vertices of one body (``xv``, loop starts ``sv``,
-    edges ``ev`` of :func:`_edges`) against the edges of the other (``xe``, edges
+    edges ``ev`` of :func:`_edges_into`) against the edges of the other (``xe``, edges
     ``ee``, successors ``ne``) nearer than ``bound``: rows ``(x0, y0, x1, y1, squared
     distance, side, vertex, edge)`` of translations of A; ``sign`` +1 when the vertices
     are B's (``v − e``, side 1), −1 when they are A's (``e − w``, side 0).
@@ -104,10 +89,10 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
     """
     b2 = bound * bound
     # (the segments of vertex i lie in the box of v_i - (the other body's box))
-    ex0, ex1, ey0, ey1 = _bbox(xe, xe.shape[0])
+    ex0, ex1, ey0, ey1 = bbox(xe, xe.shape[0])
     # only the edges whose boxes come within bound of V's box can hold one: listed in
     # ``near`` (the rest are farther than bound from every vertex of V)
-    vx0, vx1, vy0, vy1 = _bbox(xv, xv.shape[0])
+    vx0, vx1, vy0, vy1 = bbox(xv, xv.shape[0])
     m = 0
     for j in range(xe.shape[0]):
         jj = ne[j]
@@ -122,7 +107,7 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
             gapy = max(0.0, xv[i, 1] - ey1, ey0 - xv[i, 1])
             if gapx * gapx + gapy * gapy >= b2:
                 continue
-            p = _prev(i, sv, k)
+            p = loop_prev(i, sv, k)
             ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
             vx, vy, lv = ev[i, 0], ev[i, 1], ev[i, 2]
             if (ux * vy - uy * vx) < -(_SIN_SLACK * lu * lv + slack * (lu + lv)):
@@ -138,7 +123,7 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
                 y0 = sign * (xv[i, 1] - xe[j, 1])
                 x1 = sign * (xv[i, 0] - xe[jj, 0])
                 y1 = sign * (xv[i, 1] - xe[jj, 1])
-                d = _foot_sq(x0, y0, x1, y1)
+                d = origin_distance_sq(x0, y0, x1, y1)
                 if d < b2:
                     seg[n, 0] = x0
                     seg[n, 1] = y0
@@ -150,35 +135,6 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
                     seg[n, 7] = j
                     n += 1
     return n
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot_sq(ax, ay, bx, by):
-    """Squared distance from the origin to segment ab."""
-    dx = bx - ax
-    dy = by - ay
-    s = -(ax * dx + ay * dy)
-    if s <= 0.0:
-        return ax * ax + ay * ay
-    den = dx * dx + dy * dy
-    if s >= den:
-        return bx * bx + by * by
-    c = (ax * dy - ay * dx) / np.sqrt(den)  # (squared after the division: no overflow)
-    return c * c
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot(ax, ay, bx, by):
-    """Point of segment ab nearest the origin, and its distance."""
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    t = 0.0
-    if den > 0.0:
-        t = min(1.0, max(0.0, -(ax * dx + ay * dy) / den))
-    px = ax + t * dx
-    py = ay + t * dy
-    return px, py, _norm(px, py)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -214,7 +170,7 @@ def _splits(seg, n, s, tol, ts):
             continue
         fx = ex - cx
         fy = ey - cy
-        lf = _norm(fx, fy)
+        lf = norm(fx, fy)
         if not lf > 0.0:
             return -1
         den = dx * fy - dy * fx
@@ -251,16 +207,15 @@ def _splits(seg, n, s, tol, ts):
 
 
 @njit(cache=True, nogil=True)
-def _penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
+def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
     """Whether A moved by (dx, dy) penetrates B (the state kernel's verdict); ``moved``
     (shaped like ``xa``) and ``scratch`` (``scratch_floats`` of both bodies' vertices)
     are written, so that the checks of one pair allocate nothing."""
     for i in range(xa.shape[0]):
         moved[i, 0] = xa[i, 0] + dx
         moved[i, 1] = xa[i, 1] + dy
-    box, ids, touch, rays, rord = _scratch_views(scratch, xa.shape[0] + xb.shape[0])
-    return _state_in(moved, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays,
-                     rord) == PENETRATING
+    views = state_scratch_views(scratch, xa.shape[0] + xb.shape[0])
+    return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, views) == PENETRATING
 
 
 @njit(cache=True, nogil=True)
@@ -272,9 +227,9 @@ def _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
     having been found to penetrate, either makes p the depth within 2 ``eps``."""
     if d > 0.0:
         f = 1.0 + 2.0 * eps / d
-        if not _penetrates(xa, sa, xb, sb, px * f, py * f, eps, moved, scratch):
+        if not penetrates(xa, sa, xb, sb, px * f, py * f, eps, moved, scratch):
             return True
-    return not _penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch)
+    return not penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch)
 
 
 @njit(cache=True, nogil=True)
@@ -360,7 +315,7 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
         if s < 0 or seg[q, 4] < seg[s, 4]:
             s = q
     if s >= 0 and low <= seg[s, 4] < bound:
-        px, py, d = _foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+        px, py, d = origin_foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
         if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
             return d, px, py, True, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
         pts[0, 0] = d
@@ -385,7 +340,7 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
                 return np.nan, np.nan, np.nan, False, -1, -1, -1
             c = _pieces(seg, s, ts, k, bound, pts, c)
             if c < 0:  # (more rows needed)
-                pts = _grown(pts)
+                pts = grow_rows(pts)
                 c = _pieces(seg, s, ts, k, bound, pts, -c - 1)
             continue
         if r < 0 or not pts[r, 0] < bound:
@@ -397,7 +352,7 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
         if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
             q = int(pts[r, 4])
             return d, px, py, True, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
-    if _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    if penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
         return np.nan, np.nan, np.nan, False, -1, -1, -1
     return bound, bdx, bdy, True, -1, -1, -1
 
@@ -435,7 +390,8 @@ def _pieces(seg, s, ts, k, bound, pts, c):
     for q in range(k - 1):
         if ts[q + 1] <= ts[q]:
             continue
-        got = _foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx, ay + ts[q + 1] * dy)
+        got = origin_foot(ax + ts[q] * dx, ay + ts[q] * dy, ax + ts[q + 1] * dx,
+                          ay + ts[q + 1] * dy)
         if got[2] < bound:
             pts[c, 0] = got[2]
             pts[c, 1] = got[0]
@@ -444,10 +400,3 @@ def _pieces(seg, s, ts, k, bound, pts, c):
             pts[c, 4] = s
             c += 1
     return c
-
-
-@njit(cache=True, nogil=True)
-def _grown(pts):
-    out = np.empty((2 * pts.shape[0], pts.shape[1]))
-    out[: pts.shape[0]] = pts
-    return out

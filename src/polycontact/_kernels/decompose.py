@@ -11,12 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .primitives import orient
 from .tolerance import tolerance_of
-
-
-@njit(cache=True, nogil=True)
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
 #: Up to this many half-edges (three per triangle), :func:`convex_pieces` pairs them
@@ -52,7 +48,7 @@ def convex_pieces(vxy, tri, rel_tol, ulps):
         a = tri[t, 0]
         b = tri[t, 1]
         c = tri[t, 2]
-        o = _orient(vx[a], vy[a], vx[b], vy[b], vx[c], vy[c])
+        o = orient(vx[a], vy[a], vx[b], vy[b], vx[c], vy[c])
         longest = max(np.hypot(vx[b] - vx[a], vy[b] - vy[a]),
                       np.hypot(vx[c] - vx[b], vy[c] - vy[b]),
                       np.hypot(vx[a] - vx[c], vy[a] - vy[c]))
@@ -107,11 +103,11 @@ def convex_pieces(vxy, tri, rel_tol, ulps):
         # After the merge: prv[h] -> u -> nxt[g] ... prv[g] -> v -> nxt[h]
         a = org[prv[h]]
         b = org[nxt[nxt[g]]]
-        if _orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) < 0.0:
+        if orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) < 0.0:
             continue
         a = org[prv[g]]
         b = org[nxt[nxt[h]]]
-        if _orient(vx[a], vy[a], vx[v], vy[v], vx[b], vy[b]) < 0.0:
+        if orient(vx[a], vy[a], vx[v], vy[v], vx[b], vy[b]) < 0.0:
             continue
         nxt[prv[h]] = nxt[g]
         prv[nxt[g]] = prv[h]
@@ -137,7 +133,7 @@ def convex_pieces(vxy, tri, rel_tol, ulps):
             a = org[prv[h]]
             b = org[nxt[h]]
             # drop straight-through vertices left by merges (exactly collinear)
-            if _orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) != 0.0:
+            if orient(vx[a], vy[a], vx[u], vy[u], vx[b], vy[b]) != 0.0:
                 out[n_out, 0] = vx[u]
                 out[n_out, 1] = vy[u]
                 n_out += 1
@@ -154,7 +150,7 @@ def is_convex(xy):
     for i in range(n):
         j = (i + 1) % n
         k = (i + 2) % n
-        if _orient(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], xy[k, 0], xy[k, 1]) < 0.0:
+        if orient(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], xy[k, 0], xy[k, 1]) < 0.0:
             return False
     return True
 
@@ -166,7 +162,7 @@ def _ear_quality(xy, p, i, q, nxt):
     An ear is a strictly convex vertex whose triangle (p, i, q) holds no other
     remaining vertex, boundary included (vertices equal to p, i or q excepted).
     """
-    o = _orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1])
+    o = orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1])
     if o <= 0.0:
         return -1.0
     j = nxt[q]
@@ -175,9 +171,9 @@ def _ear_quality(xy, p, i, q, nxt):
         y = xy[j, 1]
         if not ((x == xy[p, 0] and y == xy[p, 1]) or (x == xy[i, 0] and y == xy[i, 1])
                 or (x == xy[q, 0] and y == xy[q, 1])):
-            if (_orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], x, y) >= 0.0
-                    and _orient(xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1], x, y) >= 0.0
-                    and _orient(xy[q, 0], xy[q, 1], xy[p, 0], xy[p, 1], x, y) >= 0.0):
+            if (orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], x, y) >= 0.0
+                    and orient(xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1], x, y) >= 0.0
+                    and orient(xy[q, 0], xy[q, 1], xy[p, 0], xy[p, 1], x, y) >= 0.0):
                 return -1.0
         j = nxt[j]
     d2 = ((xy[i, 0] - xy[p, 0]) ** 2 + (xy[i, 1] - xy[p, 1]) ** 2
@@ -210,7 +206,7 @@ def ear_triangles(xy):
     while steps < left and left > 3:
         p = prv[i]
         q = nxt[i]
-        if _orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1]) == 0.0:
+        if orient(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], xy[q, 0], xy[q, 1]) == 0.0:
             nxt[p] = q
             prv[q] = p
             alive[i] = False

@@ -28,9 +28,9 @@ in both) first take the vertex-edge contact segments of
 fallback when that kernel cannot decide (segments that run together: slides, exact
 fits).
 
-Many pairs (:func:`penetrations`, for ``classify_many(...).distances``): each distinct
-pair computed once, in parallel; for the pairs left to this search, each distinct body
-decomposed once.
+Many pairs (for ``classify_many(...).distances``): :func:`contact_depths` and
+:func:`depths_of_pairs` compute pairs in parallel, :func:`distinct_bodies` finds the
+bodies to decompose once (see :func:`polycontact._depth.penetrations`).
 """
 
 from __future__ import annotations
@@ -38,26 +38,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..errors import DepthTooLargeError
-from .nfp import (_GRID, _GRID_MIN_SUMS, _bboxes, _frames, _lowest, clip_edge, sum_index,
-                  sum_into)
-from .convolution import FEW_VERTICES, _foot, _penetrates, contact_depth
+from .convolution import FEW_VERTICES, contact_depth, penetrates
 from .decompose import ring_pieces
-from .relation import _bbox, scratch_floats
-from .relation_many import _body, _oriented
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _foot_sq(ax, ay, bx, by, ux, uy, c):
-    """Squared distance from the origin to segment ab, of unit direction (ux, uy) and
-    line offset c (:func:`polycontact._kernels.nfp._frames`: the origin lies at -c
-    from the line): no division."""
-    s = -(ax * ux + ay * uy)  # where the foot of the line falls, from a towards b
-    if s <= 0.0:
-        return ax * ax + ay * ay
-    if s >= (bx - ax) * ux + (by - ay) * uy:
-        return bx * bx + by * by
-    return c * c
+from .minkowski import (GRID, GRID_MIN_SUMS, boxes, clip_edge, frames, in_some_sum, lowest,
+                        sum_index, sum_into)
+from .packs import scratch_floats
+from .primitives import bbox, origin_distance_sq_framed, origin_foot
+from .relation_many import body, oriented
 
 
 @njit(cache=True, nogil=True)
@@ -138,44 +125,27 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     for k in range(pairs.shape[0]):
         ps = bstarts[pairs[k, 0]]
         pe = bstarts[pairs[k, 0] + 1]
-        w = sum_into(bxy, ps, pe, _lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
+        w = sum_into(bxy, ps, pe, lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
                      rstarts[pairs[k, 1] + 1], out, w)
         starts[k + 1] = w
     return out[:w].copy(), starts
 
 
 @njit(cache=True, nogil=True)
-def _covered(px, py, starts, bb, fr, skip, eps):
-    """Whether p lies inside a convex sum other than ``skip`` by more than eps (edge
-    frames ``fr``, boxes ``bb``: :mod:`polycontact._kernels.nfp`)."""
-    for q in range(starts.shape[0] - 1):
-        if (q == skip or px <= bb[q, 0] + eps or px >= bb[q, 2] - eps or py <= bb[q, 1] + eps
-                or py >= bb[q, 3] - eps):
-            continue
-        inside = True
-        for i in range(starts[q], starts[q + 1]):
-            if fr[i, 3] != 0.0 and fr[i, 0] * py - fr[i, 1] * px - fr[i, 2] <= eps:
-                inside = False
-                break
-        if inside:
-            return True
-    return False
-
-
-@njit(cache=True, nogil=True)
-def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                      max_vertices, grid_from=_GRID_MIN_SUMS):
+def depth_from_pieces(a, b, pieces_b, pieces_r, escape, eps, max_vertices,
+                      grid_from=GRID_MIN_SUMS):
     """Penetration depth of A into B: ``(depth, dx, dy)``, the shortest escape.
 
-    ``(xa, sa)``, ``(xb, sb)``: the packed bodies (interior on the left); ``(bxy,
-    bstarts)``: convex CCW pieces of B; ``(rxy, rstarts)``: convex CCW pieces of −A;
-    ``(bdx, bdy)``: a translation of A, of length ``bound``, that ends the overlap
-    (:func:`first_escape`, or :func:`box_escape`).
+    ``a`` = ``(xa, sa)``, ``b`` = ``(xb, sb)``: the packed bodies (interior on the left);
+    ``pieces_b`` = ``(bxy, bstarts)``: convex CCW pieces of B; ``pieces_r`` = ``(rxy,
+    rstarts)``: convex CCW pieces of −A; ``escape`` = ``(bound, bdx, bdy)``: a
+    translation of A, of length ``bound``, that ends the overlap (:func:`first_escape`,
+    or :func:`box_escape`).
     Returns ``(bound, bdx, bdy)`` when nothing nearer ends it (confirmed by the state
     kernel; if rounding left it penetrating, the search is made again from the box's
     escape), NaNs when the sums would hold more than ``max_vertices`` vertices (none
     is built). The edges are clipped with the grid of
-    :func:`polycontact._kernels.nfp.sum_index` from ``grid_from`` sums on, else by the
+    :func:`polycontact._kernels.minkowski.sum_index` from ``grid_from`` sums on, else by the
     scan alone (a 12-gon pair makes about 9 sums; the grid's set-up cost 83 of its 105
     us).
 
@@ -185,33 +155,40 @@ def depth_from_pieces(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bd
     usually: the sum that covered the previous edge is tried first) and one state check,
     O((m + n) log(m + n)), per uncovered part nearer than the best escape so far.
     """
+    xa, sa = a
+    xb, sb = b
     moved = np.empty_like(xa)
     scratch = np.empty(scratch_floats(xa.shape[0] + xb.shape[0]))
-    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from, moved, scratch)
-    if got[3] or np.isnan(got[0]) or not _penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
+    got = _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_from,
+                          moved, scratch)
+    if got[3] or np.isnan(got[0]) or not penetrates(xa, sa, xb, sb, escape[1], escape[2], eps,
+                                                    moved, scratch):
         return got[0], got[1], got[2]
     # (a normal's escape left touching within rounding, yet penetrating: the box's)
-    bound, bdx, bdy = box_escape(xa, xb)
-    got = _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                          max_vertices, grid_from, moved, scratch)
+    got = _nearest_escape(a, b, pieces_b, pieces_r, box_escape(xa, xb), eps, max_vertices,
+                          grid_from, moved, scratch)
     return got[0], got[1], got[2]
 
 
 @njit(cache=True, nogil=True)
-def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy, eps,
-                    max_vertices, grid_from, moved, scratch):
+def _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_from, moved,
+                    scratch):
     """:func:`depth_from_pieces`'s search: ``(depth, dx, dy, found)``, ``found`` False
-    when nothing nearer than ``bound`` was found (then ``(bound, bdx, bdy)``, not
-    confirmed); ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution._penetrates`.
+    when nothing nearer than ``bound`` was found (then ``escape``, not confirmed);
+    ``moved``, ``scratch``: see :func:`polycontact._kernels.convolution.penetrates`.
 
     The origin's distance to the outline of a sum that holds it is a lower bound of the
     depth (the union holds that sum); when the largest is within ``eps`` of ``bound``,
     the search stops there: the depth is ``bound`` within ``eps``; when the origin's
     foot on that outline escapes, it is the depth.
     """
+    xa, sa = a
+    xb, sb = b
+    bxy, bstarts = pieces_b
+    rxy, rstarts = pieces_r
+    bound, bdx, bdy = escape
     best = bound
-    pairs = _select_pairs(_bboxes(bxy, bstarts), _bboxes(rxy, rstarts), bound,
+    pairs = _select_pairs(boxes(bxy, bstarts), boxes(rxy, rstarts), bound,
                           bstarts, rstarts, max_vertices)
     if pairs.shape[0] == 1 and pairs[0, 0] < 0:
         return np.nan, np.nan, np.nan, False
@@ -219,8 +196,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
         return best, bdx, bdy, False
     xy, starts = _pair_sums(bxy, bstarts, rxy, rstarts, pairs)
     k = starts.shape[0] - 1
-    bb = _bboxes(xy, starts)
-    fr = _frames(xy, starts)
+    bb = boxes(xy, starts)
+    fr = frames(xy, starts)
     n_edges = xy.shape[0]
     dist = np.empty(n_edges)  # squared distances of the edges from the origin
     owner = np.empty(n_edges, np.int64)
@@ -241,8 +218,8 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
                 if -fr[i, 2] < inner:  # the origin's distance inside edge i
                     inner = -fr[i, 2]
                     nearest = i
-                dist[i] = _foot_sq(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], fr[i, 0], fr[i, 1],
-                                   fr[i, 2])
+                dist[i] = origin_distance_sq_framed(xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1],
+                                                    fr[i, 0], fr[i, 1], fr[i, 2])
         if inner < np.inf and inner > low:
             low = inner
             deepest = p
@@ -254,13 +231,14 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
     if deepest >= 0:
         fx = low * fr[side, 1]
         fy = -low * fr[side, 0]
-        if (not _covered(fx, fy, starts, bb, fr, deepest, eps)
-                and not _penetrates(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
+        if (not in_some_sum(fx, fy, starts, bb, fr, eps, deepest)
+                and not penetrates(xa, sa, xb, sb, fx, fy, eps, moved, scratch)):
             return low, fx, fy, True
     near = np.flatnonzero(dist < best * best)  # (only these are visited: sorted alone)
     by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
-    index = sum_index(xy, starts, bb, fr, -bound, -bound, 2.0 * bound / _GRID, grid_from)
+    sums = (xy, starts, bb, fr)
+    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = deepest
     found = False
@@ -278,8 +256,7 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
         tlo, thi = _in_disk(ax, ay, bx, by, best)
         if tlo >= thi:
             continue
-        n1, n0, hint = clip_edge(xy, starts, bb, fr, index, p, ax, ay, bx, by, tlo, thi, eps,
-                                 hint)
+        n1, n0, hint = clip_edge(sums, index, p, ax, ay, bx, by, tlo, thi, eps, hint)
         if n1 == 0 and n0 == 0:
             continue
         dx = bx - ax
@@ -294,73 +271,19 @@ def _nearest_escape(xa, sa, xb, sb, bxy, bstarts, rxy, rstarts, bound, bdx, bdy,
             py0 = ay + lo * dy
             px1 = ax + hi * dx
             py1 = ay + hi * dy
-            fx, fy, fd = _foot(px0, py0, px1, py1)
+            fx, fy, fd = origin_foot(px0, py0, px1, py1)
             if fd >= best:
                 continue
             for cx, cy in ((fx, fy), (px0, py0), (px1, py1),
                            (0.5 * (px0 + px1), 0.5 * (py0 + py1))):
                 cd = np.hypot(cx, cy)
-                if cd < best and not _penetrates(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
+                if cd < best and not penetrates(xa, sa, xb, sb, cx, cy, eps, moved, scratch):
                     best = cd
                     bdx = cx
                     bdy = cy
                     found = True
                     break
     return best, bdx, bdy, found
-
-
-def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
-                eps: float) -> tuple[float, float, float]:
-    """Smallest translation ``(dx, dy)`` of A after which the interiors no longer overlap.
-
-    Returns ``(depth, dx, dy)``; the bodies are packed (outer loop first, interior on
-    the left of every edge). Bodies of at most
-    :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices in all take
-    :func:`polycontact._kernels.convolution.contact_depth` (no decomposition), unless
-    it cannot decide. Otherwise the first escape is :func:`first_escape`'s (out of B's
-    bounding box, or along an edge normal); then :func:`depth_from_pieces` looks for a
-    nearer one on the union of the convex sums of the pieces of B and −A (decomposed in
-    O(n log n), cached by coordinates).
-
-    Cost: the decomposition (cached), then O(P log P + K log K) for the P pairs of
-    pieces whose sums reach the disk of the first escape and their K edges, plus the
-    clipping of each edge nearer than the depth (usually by one sum; by up to P when it
-    is uncovered) and one state check, O((m + n) log(m + n)), per uncovered part nearer
-    than the best escape so far. When one body is small or convex, P = O(m + n) and the
-    whole is near O((m + n) log(m + n)). Two large concave bodies whose pieces are long
-    (stars) make P grow with the product of their piece counts even for a shallow
-    overlap, up to about m n / 4 for deeply interlocked ones: O(P + K P) at worst
-    (figures: ``benchmarks/bench_scaling.py``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> st = np.array([0, 4])
-    >>> [float(v) for v in penetration(sq, st, sq + np.array([0.75, 0.5]), st, 1e-12)]
-    [0.25, -0.25, 0.0]
-    """
-    from ..nfp import _pieces_packed
-
-    if len(xa) + len(xb) <= FEW_VERTICES:
-        fast = contact_depth(xa, sa, xb, sb, *box_escape(xa, xb), eps)
-        if fast[3]:
-            return fast[0], fast[1], fast[2]
-    bxy, bst = _pieces_packed(xb, sb)
-    axy, ast = _pieces_packed(xa, sa)
-    got = depth_from_pieces(xa, sa, xb, sb, bxy, bst, -axy, ast, *first_escape(xa, xb), eps,
-                            MAX_SUM_VERTICES)
-    if np.isnan(got[0]):
-        raise _too_large(len(xa), len(xb))
-    return got
-
-
-def _too_large(m: int, n: int) -> DepthTooLargeError:
-    return DepthTooLargeError(
-        f"penetration depth: the convex sums of the pieces near the overlap would hold "
-        f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({m} and "
-        f"{n} vertices) are too large and interlocked for this depth"
-    )
 
 
 #: Up to this many vertices in both bodies, :func:`first_escape` tries the normals of
@@ -444,8 +367,8 @@ def box_escape(xa, xb):
     """The shortest of the four axis translations of A (vertices ``xa``) that take it
     out of the bounding box of B (vertices ``xb``): ``(length, dx, dy)``; the first of
     +x, −x, +y, −y on a tie."""
-    ax0, ax1, ay0, ay1 = _bbox(xa, xa.shape[0])
-    bx0, bx1, by0, by1 = _bbox(xb, xb.shape[0])
+    ax0, ax1, ay0, ay1 = bbox(xa, xa.shape[0])
+    bx0, bx1, by0, by1 = bbox(xb, xb.shape[0])
     bound = bx1 - ax0
     bdx = bound
     bdy = 0.0
@@ -463,19 +386,11 @@ def box_escape(xa, xb):
     return bound, bdx, bdy
 
 
-#: Most vertices of convex sums the depth builds (about 80 bytes each with their frames
-#: and sort keys: 2.4 GB). Beyond, the depth is refused with an error, not killed by
-#: the system for want of memory.
-MAX_SUM_VERTICES = 30_000_000
-
-
-
-
 # -- many pairs (classify_many's distances) ------------------------------------------------
 
 
 @njit(cache=True, nogil=True)
-def _same_body(x, ls, bs, f, p, q):
+def _samebody(x, ls, bs, f, p, q):
     """Whether bodies p and q of a packed batch are equal (loops, orientation, vertices)."""
     if f[p] != f[q] or bs[p + 1] - bs[p] != bs[q + 1] - bs[q]:
         return False
@@ -523,7 +438,7 @@ def distinct_bodies(x, ls, bs, f, ids):
             k = order[u]
             rep[k] = k
             for v in range(m):
-                if _same_body(x, ls, bs, f, ids[reps[v]], ids[k]):
+                if _samebody(x, ls, bs, f, ids[reps[v]], ids[k]):
                     rep[k] = reps[v]
                     break
             if rep[k] == k:
@@ -587,36 +502,43 @@ def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, rxy, rst,
-                    rfirst, rcount, slot_b, bxy, bst, bfirst, bcount, max_vertices):
+def depths_of_pairs(batch, pairs, eps, slot_a, pieces_a, slot_b, pieces_b, max_vertices):
     """Penetration depths ``(P, 3)`` (depth, dx, dy; NaNs as in
-    :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, in
-    parallel: pair k's A has the pieces of −A number ``slot_a[k]`` of
-    ``(rxy, rst, rfirst, rcount)`` (see :func:`pieces_of_bodies`), its B those number
-    ``slot_b[k]`` of ``(bxy, bst, bfirst, bcount)``; ``eps`` per pair."""
+    :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, ``batch`` =
+    ``(xa, lsa, bsa, fa, xb, lsb, bsb, fb)`` (the form of
+    :mod:`polycontact._kernels.relation_many`), in parallel: pair k's A has the pieces
+    of −A number ``slot_a[k]`` of ``pieces_a`` = ``(rxy, rst, rfirst, rcount)`` (see
+    :func:`pieces_of_bodies`), its B those number ``slot_b[k]`` of ``pieces_b``;
+    ``eps`` per pair."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
+    rxy, rst, rfirst, rcount = pieces_a
+    bxy, bst, bfirst, bcount = pieces_b
     n = pairs.shape[0]
     out = np.empty((n, 3))
     for k in prange(n):
         p = pairs[k]
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
-        ya = _oriented(ya, sa, fa[p])
-        yb = _oriented(yb, sb, fb[p])
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
+        ya = oriented(ya, sa, fa[p])
+        yb = oriented(yb, sb, fb[p])
         ra = rfirst[slot_a[k]]
         rb = bfirst[slot_b[k]]
-        bound, bdx, bdy = first_escape(ya, yb)
         out[k, 0], out[k, 1], out[k, 2] = depth_from_pieces(
-            ya, sa, yb, sb, bxy, bst[rb : rb + bcount[slot_b[k]] + 1], rxy,
-            rst[ra : ra + rcount[slot_a[k]] + 1], bound, bdx, bdy, eps[k], max_vertices)
+            (ya, sa), (yb, sb), (bxy, bst[rb : rb + bcount[slot_b[k]] + 1]),
+            (rxy, rst[ra : ra + rcount[slot_a[k]] + 1]), first_escape(ya, yb), eps[k],
+            max_vertices)
     return out
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
-    """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches by
+def contact_depths(batch, pairs, eps):
+    """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches
+    (``batch``: as for :func:`depths_of_pairs`) by
     :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
-    segments are split lazily: a nearer start saves less than it costs), in parallel; a row of NaNs where that kernel does not decide (the caller takes
+    segments are split lazily: a nearer start saves less than it costs), in parallel; a
+    row of NaNs where that kernel does not decide (the caller takes
     :func:`depths_of_pairs`); ``eps`` per pair."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     n = pairs.shape[0]
     out = np.full((n, 3), np.nan)
     for k in prange(n):
@@ -624,95 +546,12 @@ def contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps):
         if (lsa[bsa[p + 1] - 1] - lsa[bsa[p]] + lsb[bsb[p + 1] - 1] - lsb[bsb[p]]
                 > FEW_VERTICES):
             continue
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
-        ya = _oriented(ya, sa, fa[p])
-        yb = _oriented(yb, sb, fb[p])
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
+        ya = oriented(ya, sa, fa[p])
+        yb = oriented(yb, sb, fb[p])
         bound, bdx, bdy = box_escape(ya, yb)
         got = contact_depth(ya, sa, yb, sb, bound, bdx, bdy, eps[k])
         if got[3]:
             out[k, 0], out[k, 1], out[k, 2] = got[0], got[1], got[2]
     return out
-
-
-def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
-                  ids: np.ndarray, negate: bool) -> tuple[np.ndarray, ...]:
-    """:func:`pieces_of_bodies`, with the bodies it leaves decomposed by
-    :func:`polycontact.nfp._pieces_packed` (GEOS) and appended."""
-    from ..nfp import _EAR_CLIPPING_MAX, _pieces_packed
-    from ..tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
-
-    xy, st, first, count, ok = pieces_of_bodies(x, ls, bs, f, ids, negate,
-                                                RELATIVE_TOLERANCE, ROUNDING_ULPS,
-                                                _EAR_CLIPPING_MAX)
-    if ok.all():
-        return xy, st, first, count
-    more_xy, more_st = [xy], [st]
-    rows, at = len(xy), len(st)
-    for k in np.flatnonzero(~ok):
-        y, s = _body(x, ls, bs, ids[k])
-        if f[ids[k]] < 0.0:  # a raw clockwise ring
-            y = y[::-1].copy()
-        pxy, pst = _pieces_packed(y, s)
-        more_xy.append(-pxy if negate else pxy)
-        more_st.append(pst + rows)
-        first[k], count[k] = at, len(pst) - 1
-        rows += len(pxy)
-        at += len(pst)
-    return np.concatenate(more_xy), np.concatenate(more_st), first, count
-
-
-def _depths_by_pieces(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
-                      xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
-                      pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """:func:`depths_of_pairs` of the pairs ``pairs``, each distinct body decomposed once
-    (NaN rows as there)."""
-    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
-    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
-    ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
-    rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    return depths_of_pairs(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs, eps, slot_a, *ra,
-                           slot_b, *rb, MAX_SUM_VERTICES)
-
-
-def penetrations(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
-                 xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
-                 pairs: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """Penetration depths of the pairs ``pairs`` of two packed batches (the form of
-    :mod:`polycontact._kernels.relation_many`), in parallel: ``(P, 3)`` rows ``(depth,
-    dx, dy)``, each equal to :func:`penetration` of the pair; ``eps`` per pair.
-
-    Each distinct pair (the same two bodies and tolerance) is computed once: by
-    :func:`contact_depths`, then the pairs it leaves by :func:`depths_of_pairs`, each
-    distinct body among those decomposed once, in parallel.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> ls, bs, f = np.array([0, 4]), np.array([0, 2]), np.ones(1)
-    >>> penetrations(sq, ls, bs, f, sq + 0.5, ls, bs, f, np.array([0]), np.array([1e-12]))
-    array([[ 0.5, -0.5,  0. ]])
-    """
-    pairs = np.asarray(pairs, dtype=np.int64)
-    eps = np.ascontiguousarray(eps, dtype=np.float64)
-    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
-    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
-    # equal pairs (the same A, B and tolerance) have the same depth: one computation
-    order = np.lexsort((eps.view(np.int64), slot_b, slot_a))
-    key = np.c_[slot_a[order], slot_b[order], eps[order].view(np.int64)]
-    new = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
-    one = order[new]  # the first of each group of equal pairs
-    group = np.empty(len(pairs), np.int64)
-    group[order] = np.cumsum(new) - 1
-    out = contact_depths(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one], eps[one])
-    rest = np.flatnonzero(np.isnan(out[:, 0]))  # (large bodies, or undecided)
-    if rest.size:
-        out[rest] = _depths_by_pieces(xa, lsa, bsa, fa, xb, lsb, bsb, fb, pairs[one[rest]],
-                                      eps[one[rest]])
-    bad = np.flatnonzero(np.isnan(out[:, 0]))
-    if bad.size:
-        p = pairs[one[bad[0]]]
-        raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
-                         int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]))
-    return out[group]

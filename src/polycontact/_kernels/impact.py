@@ -25,11 +25,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .advance import STACK_SIZE, _line_time, edge_table, outward_normal, pair_step, window_kinematics
+from .advance import STACK_SIZE, edge_table, line_time, pair_step, window_kinematics
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
-from .relation import _scratch_views, _state_in, scratch_floats
-from .validate import closest_on_segment
-from .views import vector, view
+from .packs import scratch_floats, state_scratch_views, vector, view
+from .primitives import closest_on_segment, outward_normal
+from .relation import state_in
+
 
 NO_HIT = 0
 HIT = 1
@@ -178,23 +179,22 @@ WINDOW_GROWTH = 3.0
 
 
 @njit(cache=True, nogil=True)
-def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, day, eps, h, need,
-               first):
+def slide_time(v, e, j, kin, eps, h, need, first):
     """A time in [0, h] (0 as soon as it is known to be below ``need``; V's vertex
     ``first``, the touching one, is looked at before the rest) during which the
-    interiors of V (vertices ``xv``, centroid ``cv``) and E (``xe``, ``ce``, bounding
-    radius ``le``) cannot come to overlap by more than 2 ``eps``, certified by the line
-    of E's edge j turning with E; 0 when the line does not separate them. ``mv``,
-    ``me`` are each body's ``(vx, vy, ω)`` now, ``kin`` the window tuple of V's
-    vertices against E's edges and ``(dax, day)`` their relative acceleration
-    (:func:`polycontact._kernels.advance.window_kinematics`).
+    interiors of V and E cannot come to overlap by more than 2 ``eps``, certified by the
+    line of E's edge j turning with E; 0 when the line does not separate them. Each body
+    is placed at the window's start, ``(x, c, m, r_len, nxt, radius)``: its vertices, its
+    centroid, its ``(vx, vy, ω)`` now, its vertices' distances from the centroid, the
+    next vertex of each, its bounding radius. ``kin`` is the window tuple of V's vertices
+    against E's edges (:func:`polycontact._kernels.advance.window_kinematics`).
 
     This is what lets a sliding contact (paper Fig. 16) be followed by long steps past
     corners: with n the outward normal of edge j and σ(x) = (x − x_j)·n, E lies in
     {σ <= eps} at all times if all its vertices do now (the line turns with E). Each
     edge of V is charged the time during which either both its ends keep
     σ >= −eps — each end by the second-order bound towards the turning line
-    (:func:`polycontact._kernels.advance._line_time`), and a segment lies on the side
+    (:func:`polycontact._kernels.advance.line_time`), and a segment lies on the side
     of its ends — or it stays outside E's bounding circle (its distance from E's
     centroid shrinks no faster than V + W_v max |r|, as in the pair bounds). Until the
     shortest of these times no edge of V meets W = {σ < −eps} ∩ (open circle), a convex
@@ -203,6 +203,8 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
     crosses V's boundary, so it stays outside V; hence W ∩ V stays empty (W is
     connected) and any overlap of the interiors lies in the band |σ| <= eps.
     """
+    xv, _, _, rv_len, nxt_v, _ = v
+    xe, ce, _, _, nxt_e, le = e
     j1 = nxt_e[j]
     ax = xe[j, 0]
     ay = xe[j, 1]
@@ -218,16 +220,13 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
     px = xv[first, 0]
     py = xv[first, 1]
     if (px - ce[0]) ** 2 + (py - ce[1]) ** 2 <= le * le and _end_time(
-            xv, cv, mv, rv_len, first, ax, ay, bx, by, ce, me, kin, dax, day, eps,
-            need) < need:
+            v, first, ax, ay, bx, by, e, kin, eps, need) < need:
         return 0.0
     best = h
     for k in range(xv.shape[0]):
         k1 = nxt_v[k]
-        t_edge = min(_end_time(xv, cv, mv, rv_len, k, ax, ay, bx, by, ce, me, kin, dax, day, eps,
-                               best),
-                     _end_time(xv, cv, mv, rv_len, k1, ax, ay, bx, by, ce, me, kin, dax, day, eps,
-                               best))
+        t_edge = min(_end_time(v, k, ax, ay, bx, by, e, kin, eps, best),
+                     _end_time(v, k1, ax, ay, bx, by, e, kin, eps, best))
         if t_edge < best:
             gap = np.sqrt(closest_on_segment(ce[0], ce[1], xv[k, 0], xv[k, 1], xv[k1, 0],
                                               xv[k1, 1])[2]) - le
@@ -241,59 +240,54 @@ def slide_time(xv, cv, mv, rv_len, nxt_v, xe, ce, me, nxt_e, le, j, kin, dax, da
 
 
 @njit(cache=True, nogil=True)
-def _end_time(xv, cv, mv, rv_len, m, ax, ay, bx, by, ce, me, kin, dax, day, eps, cap):
+def _end_time(v, m, ax, ay, bx, by, e, kin, eps, cap):
     """How long V's vertex m keeps σ >= −eps for the line of ab turning with E
-    (:func:`polycontact._kernels.advance._line_time`), up to ``cap``."""
+    (:func:`polycontact._kernels.advance.line_time`), up to ``cap`` (``v``, ``e``: as
+    for :func:`slide_time`)."""
+    xv, cv, mv, rv_len, _, _ = v
+    ce, me = e[1], e[2]
     x = xv[m, 0]
     y = xv[m, 1]
-    return _line_time(x, y, mv[0] - mv[2] * (y - cv[1]), mv[1] + mv[2] * (x - cv[0]), rv_len[m],
-                      ax, ay, bx, by, ce[0], ce[1], me[0], me[1], me[2], kin, -eps, cap, dax,
-                      day)
+    return line_time((x, y, mv[0] - mv[2] * (y - cv[1]), mv[1] + mv[2] * (x - cv[0]), rv_len[m]),
+                     ax, ay, bx, by, (ce[0], ce[1], me[0], me[1], me[2]), kin, -eps, cap)
 
 
 @njit(cache=True, nogil=True)
-def _slide_step(xa, ca, ra_len, nxa, la, xb, cb, rb_len, nxb, lb, ma, mb, t0, t1, crit, eps,
-                need):
+def _slide_step(pa, pb, ma, mb, t0, t1, crit, eps, need):
     """The longest :func:`slide_time` over [t0, t1] by the lines through the pair
     ``crit`` (vertex i of one body, edge j of the other): edge j, or either edge of the
-    vertex body at i (with the bodies' roles swapped); 0 if none reaches ``need``."""
+    vertex body at i (with the bodies' roles swapped); 0 if none reaches ``need``.
+    ``pa``, ``pb``: each body placed at t0, ``(x, c, r_len, nxt, radius)``."""
     mva, mvb, kin_ab, kin_ba = window_kinematics(ma, mb, t0, t1)
-    dax = ma[2] - mb[2]
-    day = ma[3] - mb[3]
+    xa, ca, ra_len, nxa, la = pa
+    xb, cb, rb_len, nxb, lb = pb
+    va = (xa, ca, mva, ra_len, nxa, la)
+    vb = (xb, cb, mvb, rb_len, nxb, lb)
     h = t1 - t0
     i = crit[1]
     j = crit[2]
     if crit[0] == 0:
-        best = slide_time(xa, ca, mva, ra_len, nxa, xb, cb, mvb, nxb, lb, j, kin_ab, dax, day,
-                          eps, h, need, i)
+        best = slide_time(va, vb, j, kin_ab, eps, h, need, i)
         for e in range(nxa.shape[0]):
             if best == 0.0 and (e == i or nxa[e] == i):
-                best = slide_time(xb, cb, mvb, rb_len, nxb, xa, ca, mva, nxa, la, e, kin_ba, dax,
-                                  day, eps, h, need, j)
+                best = slide_time(vb, va, e, kin_ba, eps, h, need, j)
         return best
-    best = slide_time(xb, cb, mvb, rb_len, nxb, xa, ca, mva, nxa, la, j, kin_ba, dax, day, eps, h,
-                      need, i)
+    best = slide_time(vb, va, j, kin_ba, eps, h, need, i)
     for e in range(nxb.shape[0]):
         if best == 0.0 and (e == i or nxb[e] == i):
-            best = slide_time(xa, ca, mva, ra_len, nxa, xb, cb, mvb, nxb, lb, e, kin_ab, dax, day,
-                              eps, h, need, j)
+            best = slide_time(va, vb, e, kin_ab, eps, h, need, j)
     return best
 
 
 @njit(cache=True, nogil=True)
-def state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t, eps, scratch):
-    """The state of the two bodies placed at time t (``xa``, ``xb`` and ``scratch``, a
-    :func:`polycontact._kernels.relation._scratch` tuple, are scratch)."""
-    place(ra, ca, ma, t, xa)
-    place(rb, cb, mb, t, xb)
-    return _placed_state(xa, sa, xb, sb, eps, scratch)
-
-
-@njit(cache=True, nogil=True)
-def _placed_state(xa, sa, xb, sb, eps, scratch):
-    """``relate_state`` of placed bodies, with the state kernel's scratch passed in."""
-    box, ids, touch, rays, rord = scratch
-    return _state_in(xa, sa, 1.0, xb, sb, 1.0, eps, box, ids, touch, rays, rord)
+def state_at(a, ma, b, mb, t, eps, placed):
+    """The state of the two bodies placed at time t: ``a``, ``b`` as for
+    :func:`exact_search`; ``placed`` = ``(xa, xb, scratch)`` is where they are placed and
+    the state kernel's scratch (:func:`polycontact._kernels.packs.state_scratch`)."""
+    xa, xb, scratch = placed
+    place(a[0], a[2], ma, t, xa)
+    place(b[0], b[2], mb, t, xb)
+    return state_in(xa, a[1], 1.0, xb, b[1], 1.0, eps, scratch)
 
 
 @njit(cache=True, nogil=True)
@@ -313,9 +307,12 @@ def work_floats(size):
 def _work_views(work, na, nb):
     """The buffers of a query on bodies of ``na`` and ``nb`` vertices as views of
     ``work`` (at least :func:`work_floats` (na + nb) floats; a shorter one raises):
-    ``(intervals (MAX_INTERVALS, 2), broad-phase scratch, pa, pb, crit (3, int64),
-    stack (STACK_SIZE, 2, int64), stau, xa (na, 2), xb (nb, 2), state scratch)``.
-    ``crit`` is set to −1 (what :func:`pair_step` expects before the first step)."""
+    ``(intervals (MAX_INTERVALS, 2), broad-phase scratch, placed, stepping)`` with
+    ``placed`` = ``(xa (na, 2), xb (nb, 2), state scratch)`` (see :func:`state_at`) and
+    ``stepping`` = ``(pa, pb, crit (3, int64), (stack (STACK_SIZE, 2, int64), stau))``:
+    the centroids, the critical pair and the traversal stack of
+    :func:`polycontact._kernels.advance.pair_step`. ``crit`` is set to −1 (what
+    :func:`polycontact._kernels.advance.pair_step` expects before the first step)."""
     size = na + nb
     if work.shape[0] < work_floats(size):
         raise ValueError("time of impact: the scratch buffer is too short for the bodies")
@@ -334,14 +331,20 @@ def _work_views(work, na, nb):
     xa = view(work, k, na, 2, np.float64)
     xb = view(work, k + 2 * na, nb, 2, np.float64)
     k += 2 * size
-    return (iv, bw, pa, pb, crit, stack, stau, xa, xb,
-            _scratch_views(work[k:k + scratch_floats(size)], size))
+    placed = (xa, xb, state_scratch_views(work[k:k + scratch_floats(size)], size))
+    return iv, bw, placed, (pa, pb, crit, (stack, stau))
 
 
 @njit(cache=True, nogil=True)
-def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, eps_rel, ulps, lam,
-                 max_iter):
+def exact_search(a, ma, b, mb, intervals, search):
     """Continuous search for the first penetration (conservative advancement).
+
+    ``a`` is the body A, ``(r, starts, c0, radius)``: its vertices relative to its area
+    centroid (packed loops), its centroid at t = 0 and its bounding radius; ``ma`` its
+    motion vector ``[vx, vy, ax, ay, ω, α]`` (likewise B). ``intervals`` (k, 2): the
+    broad-phase intervals searched. ``search`` is ``(time_tol, eps_rel, ulps, lam,
+    max_iter)``: the time tolerance, the terms of the distance tolerance, the contact
+    resolution asked for, the iteration budget.
 
     Returns ``(status, t_hi, t_lo, first_contact, iterations, t_reached)``: on a hit the
     bodies penetrate at ``t_hi`` and do not at ``t_lo`` (``t_hi − t_lo`` below the
@@ -353,9 +356,9 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     The distance tolerance and the contact resolution are local (:func:`local_tolerances`
     from ``eps_rel``, ``ulps`` and ``lam``, the resolution asked for, over windows that
     end where the reach at most doubles, :func:`local_end`, whatever the length of the
-    broad-phase interval: a window as long as ``t_max`` would scale them by it); the resolution
-    also covers the float spacing of t: a probe moves t by at least a float, so λ is at
-    least S · ``TIME_ULPS`` · 2**-52 |t|.
+    broad-phase interval: a window as long as ``t_max`` would scale them by it); the
+    resolution also covers the float spacing of t: a probe moves t by at least a float,
+    so λ is at least S · ``TIME_ULPS`` · 2**-52 |t|.
 
     Invariant: no penetration has been skipped before ``t`` (see
     :func:`polycontact.time_of_impact` for the argument). From a non-penetrating time
@@ -389,27 +392,17 @@ def exact_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, time_tol, ep
     tolerance thus decides how precisely ``t_hi`` is reported, never whether a hit is
     found, nor how many probes are taken.
     """
-    return _prepared_exact_search(ra, sa, ca, ma, la, edge_table(ra, sa), rb, sb, cb, mb, lb,
-                                  edge_table(rb, sb), intervals, time_tol, eps_rel, ulps, lam,
-                                  max_iter)
+    return exact_search_tables(a, edge_table(a[0], a[1]), ma, b, edge_table(b[0], b[1]), mb,
+                               intervals, search)
 
 
 @njit(cache=True, nogil=True)
-def _prepared_exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
-                           eps_rel, ulps, lam, max_iter):
-    """:func:`exact_search` with each body's :func:`edge_table` given (built once per
-    shape by the caller)."""
-    _, _, pa, pb, crit, stack, stau, xa, xb, scratch = _work_views(
-        np.empty(work_floats(ra.shape[0] + rb.shape[0])), ra.shape[0], rb.shape[0])
-    return _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol,
-                         eps_rel, ulps, lam, max_iter, xa, xb, pa, pb, crit, stack, stau,
-                         scratch)
-
-
-@njit(cache=True, nogil=True)
-def _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
-    """The distance tolerance at time t (:func:`local_tolerances` on [t, t])."""
-    return max(eps_rel, ulps * max(_reach(ca, ma, la, t, t), _reach(cb, mb, lb, t, t)))
+def exact_search_tables(a, ea, ma, b, eb, mb, intervals, search):
+    """:func:`exact_search` with each body's :func:`polycontact._kernels.advance.edge_table`
+    given (``ea``, ``eb``: built once per shape by the caller)."""
+    _, _, placed, stepping = _work_views(np.empty(work_floats(a[0].shape[0] + b[0].shape[0])),
+                                         a[0].shape[0], b[0].shape[0])
+    return _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping)
 
 
 # The searches run without Numba's reference counting (``_nrt=False``): each step passes
@@ -417,13 +410,16 @@ def _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
 # the geometry of a small pair. Nothing in them may allocate (the compiler refuses if it
 # does): their callers pass every buffer in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, time_tol, eps_rel,
-                  ulps, lam0, max_iter, xa, xb, pa, pb, crit, stack, stau, scratch):
-    """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: :func:`edge_table`
-    of each body; ``pa``, ``pb``: the centroids; ``crit``: the critical pair; ``stack``,
-    ``stau``: :func:`traversal_stack`). The bodies are placed (``xa``, ``xb``) only to be
-    classified or for a slide: the steps read each vertex they need from the body
-    frame."""
+def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
+    """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: the
+    :func:`polycontact._kernels.advance.edge_table` of each body; ``placed``,
+    ``stepping``: see :func:`_work_views`). The bodies are placed only to be classified
+    or for a slide: the steps read each vertex they need from the body frame."""
+    time_tol, eps_rel, ulps, lam0, max_iter = search
+    ra, sa, ca, la = a
+    rb, sb, cb, lb = b
+    pa, pb, crit, traversal = stepping
+    xa, xb, _ = placed
     first_contact = -1.0
     t_guess = -1.0
     h_prev = np.inf
@@ -436,9 +432,9 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
         pa[0], pa[1] = centre(ca, ma, t)
         pb[0], pb[1] = centre(cb, mb, t)
         # after t = 0 an interval opens with the bounding circles just touching: apart
-        if t == 0.0 and state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
-                                 _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
-                                 scratch) == _PENETRATING:
+        if t == 0.0 and state_at(a, ma, b, mb, t,
+                                 tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
+                                 placed) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
         window = t2 - t
         while True:
@@ -458,9 +454,9 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             # time found within lam is at most a probe late; then closer
             # once touching, a touching pair is held to its edge's line instead (a slide
             # is stepped over, see pair_step)
-            d, h = pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam,
-                             lam if first_contact < 0.0 else lam_pair, crit, stack, stau,
-                             0.0 if first_contact < 0.0 else eps)
+            d, h = pair_step((ra, ea), pa, ma, (rb, eb), pb, mb, (t, t_end),
+                             (lam, lam if first_contact < 0.0 else lam_pair,
+                              0.0 if first_contact < 0.0 else eps), crit, traversal)
             if d <= lam and first_contact < 0.0:
                 first_contact = t
             if t >= t2 or s <= 0.0:
@@ -471,9 +467,9 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 # classification when the step is short or shrinking fast (the pair
                 # bounds converge quadratically near contact), once per guess.
                 t_guess = min(t + h + 0.99 * effective_time_tolerance(time_tol, t + h), t2)
-                if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_guess,
-                            _eps_at(ca, ma, la, cb, mb, lb, t_guess, eps_rel, ulps),
-                            scratch) == _PENETRATING:
+                if state_at(a, ma, b, mb, t_guess,
+                            tolerance_at(ca, ma, la, cb, mb, lb, t_guess, eps_rel, ulps),
+                            placed) == _PENETRATING:
                     return HIT, t_guess, t + h, first_contact if first_contact >= 0.0 else t + h, \
                         it, t_guess
             h_prev = h
@@ -483,13 +479,13 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
             if h < tau and first_contact < 0.0:
                 # about to touch: step the pairs to lam_pair instead, at most a probe
                 # at a time (so the first contact found is no later)
-                h = min(pair_step(ra, pa, ea, rb, pb, eb, ma, mb, t, t_end, lam, lam_pair, crit,
-                                  stack, stau, 0.0)[1], tau)
+                h = min(pair_step((ra, ea), pa, ma, (rb, eb), pb, mb, (t, t_end),
+                                  (lam, lam_pair, 0.0), crit, traversal)[1], tau)
             if h < tau and first_contact >= 0.0 and crit[0] >= 0:
                 # touching: a line through the touching features may separate them
                 place(ra, ca, ma, t, xa)
                 place(rb, cb, mb, t, xb)
-                h = max(h, _slide_step(xa, pa, ea[3], ea[0], la, xb, pb, eb[3], eb[0], lb,
+                h = max(h, _slide_step((xa, pa, ea[3], ea[0], la), (xb, pb, eb[3], eb[0], lb),
                                        ma, mb, t, t_end, crit, eps, tau))
             if h >= t_end - t:
                 h = t_end - t
@@ -511,33 +507,35 @@ def _exact_search(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, intervals, tim
                 continue
             pa[0], pa[1] = centre(ca, ma, t_new)
             pb[0], pb[1] = centre(cb, mb, t_new)
-            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t_new,
-                        _eps_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
-                        scratch) == _PENETRATING:
+            if state_at(a, ma, b, mb, t_new,
+                        tolerance_at(ca, ma, la, cb, mb, lb, t_new, eps_rel, ulps),
+                        placed) == _PENETRATING:
                 # the probe brackets the first penetration (no point moved more than
                 # lam in it); narrowed to the time tolerance by bisection
                 if first_contact < 0.0 or first_contact > t:
                     first_contact = t
-                lo, hi, it = _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, t, t_new,
-                                     time_tol, eps_rel, ulps, it, scratch)
+                lo, hi, it = _narrow(a, ma, b, mb, t, t_new, (time_tol, eps_rel, ulps), it,
+                                     placed)
                 return HIT, hi, lo, first_contact, it, hi
             t = t_new
     return NO_HIT, -1.0, -1.0, first_contact, it, t
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, lo, hi, time_tol, eps_rel, ulps, it,
-            scratch):
+def _narrow(a, ma, b, mb, lo, hi, tols, it, placed):
     """Bisect [lo, hi] (no penetration at lo, penetration at hi) until it is no longer
     than the effective time tolerance at hi; ``(lo, hi, it)``, each classification
-    counted in ``it``."""
+    counted in ``it``. ``tols``: ``(time_tol, eps_rel, ulps)``."""
+    time_tol, eps_rel, ulps = tols
+    ca, la = a[2], a[3]
+    cb, lb = b[2], b[3]
     while hi - lo > effective_time_tolerance(time_tol, hi):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
         it += 1
-        if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, mid,
-                    _eps_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps), scratch) == _PENETRATING:
+        if state_at(a, ma, b, mb, mid, tolerance_at(ca, ma, la, cb, mb, lb, mid, eps_rel, ulps),
+                    placed) == _PENETRATING:
             hi = mid
         else:
             lo = mid
@@ -545,9 +543,15 @@ def _narrow(ra, sa, ca, ma, la, xa, rb, sb, cb, mb, lb, xb, lo, hi, time_tol, ep
 
 
 @njit(cache=True, nogil=True)
-def sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n, eps_rel,
-                   ulps):
-    """The paper's §3 steps 3–6 on each interval, literally.
+def tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
+    """The distance tolerance at time t (:func:`local_tolerances` on [t, t])."""
+    return max(eps_rel, ulps * max(_reach(ca, ma, la, t, t), _reach(cb, mb, lb, t, t)))
+
+
+@njit(cache=True, nogil=True)
+def sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps):
+    """The paper's §3 steps 3–6 on each interval, literally (``a``, ``ma``, ``b``,
+    ``mb``, ``intervals``: as for :func:`exact_search`).
 
     n time points t_1 = T1, ..., t_n = T2 (spacing (T2 − T1)/(n − 1)); t0 is the first
     penetrating one; the next interval is [t0 − (T2 − T1)/n, t0]; stop when
@@ -556,16 +560,16 @@ def sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold,
     Returns ``(status, t_hi, t_lo, first_contact, evaluations)``; ``first_contact`` is
     the earliest sample in contact (−1 if none).
     """
-    _, _, _, _, _, _, _, xa, xb, scratch = _work_views(
-        np.empty(work_floats(ra.shape[0] + rb.shape[0])), ra.shape[0], rb.shape[0])
-    return _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n,
-                           eps_rel, ulps, xa, xb, scratch)
+    _, _, placed, _ = _work_views(np.empty(work_floats(a[0].shape[0] + b[0].shape[0])),
+                                  a[0].shape[0], b[0].shape[0])
+    return _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, placed)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold, n, eps_rel,
-                    ulps, xa, xb, scratch):
+def _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, placed):
     """:func:`sampled_search` with its buffers passed in (see :func:`_exact_search`)."""
+    ca, la = a[2], a[3]
+    cb, lb = b[2], b[3]
     first_contact = -1.0
     evals = 0
     for k in range(intervals.shape[0]):
@@ -573,9 +577,9 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
         hi = intervals[k, 1]
         if lo == 0.0:
             evals += 1
-            if state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, 0.0,
-                        _eps_at(ca, ma, la, cb, mb, lb, 0.0, eps_rel, ulps),
-                        scratch) == _PENETRATING:
+            if state_at(a, ma, b, mb, 0.0,
+                        tolerance_at(ca, ma, la, cb, mb, lb, 0.0, eps_rel, ulps),
+                        placed) == _PENETRATING:
                 return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, evals
         found = False
         while True:
@@ -583,8 +587,8 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
             for i in range(n):
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
-                st = state_at(ra, sa, ca, ma, xa, rb, sb, cb, mb, xb, t,
-                              _eps_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), scratch)
+                st = state_at(a, ma, b, mb, t,
+                              tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), placed)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
                     first_contact = t
                 if st == _PENETRATING:
@@ -604,19 +608,26 @@ def _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, intervals, threshold
 
 
 @njit(cache=True, nogil=True)
-def exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate, time_tol,
-                eps_rel, ulps, lam, max_iter, work):
+def exact_query(a, ea, ma, b, eb, mb, query, work):
     """Broad phase and :func:`exact_search` in one call (one dispatch from Python), with
-    each body's :func:`edge_table` given and every buffer a view of ``work`` (at least
-    :func:`work_floats` of both bodies' vertices; nothing is allocated). Returns
-    ``(n, status, t_hi, t_lo, first_contact, iterations, t_reached)``, the n broad-phase
-    intervals in ``work[:2 n]`` as (start, end) pairs."""
-    iv, bw, pa, pb, crit, stack, stau, xa, xb, scratch = _work_views(work, ra.shape[0],
-                                                                     rb.shape[0])
+    each body's :func:`polycontact._kernels.advance.edge_table` given and every buffer a
+    view of ``work`` (at least :func:`work_floats` of both bodies' vertices; nothing is
+    allocated).
+
+    ``query`` is ``(t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, samples)``:
+    the window [0, t_max], the broad phase's relative inflation of the radii, the time
+    tolerance, the terms of the distance tolerance, the contact resolution and the
+    iteration budget of the exact search, the samples of the sampled one (unused here).
+    Returns ``(n, status, t_hi, t_lo, first_contact, iterations, t_reached)``, the n
+    broad-phase intervals in ``work[:2 n]`` as (start, end) pairs."""
+    t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, _ = query
+    ra, _, ca, la = a
+    rb, _, cb, lb = b
+    iv, bw, placed, stepping = _work_views(work, ra.shape[0], rb.shape[0])
     n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
     code, hi, lo, contact, its, reached = _exact_search(
-        ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, iv[:n], time_tol, eps_rel, ulps, lam,
-        max_iter, xa, xb, pa, pb, crit, stack, stau, scratch)
+        a, ea, ma, b, eb, mb, iv[:n], (time_tol, eps_rel, ulps, lam, max_iter), placed,
+        stepping)
     return n, code, hi, lo, contact, its, reached
 
 
@@ -625,8 +636,8 @@ def pack_body(r, starts, centroid, radius, table):
     """One body's arguments of :func:`exact_query` in two arrays, for
     :func:`exact_call`: floats ``[cx, cy, radius, r (n, 2), circles (m, 4), r_len (n)]``
     and ints ``[n, len(starts), m, starts, nxt (n), links (m, 3)]`` (``table``: the
-    body's :func:`edge_table`, m nodes). Passing two arrays instead of eight costs a
-    call from Python less unboxing.
+    body's :func:`polycontact._kernels.advance.edge_table`, m nodes). Passing two arrays
+    instead of eight costs a call from Python less unboxing.
 
     >>> import numpy as np
     >>> sq = np.array([[-1.0, -1], [1, -1], [1, 1], [-1, 1]])
@@ -657,36 +668,45 @@ def pack_body(r, starts, centroid, radius, table):
 
 
 @njit(cache=True, nogil=True)
-def _unpack_body(f, i):
-    """``(r, starts, centroid, radius, table)`` of a :func:`pack_body`, as views."""
+def unpack_body(f, i):
+    """``(body, table)`` of a :func:`pack_body`, as views: ``body`` = ``(r, starts,
+    centroid, radius)`` (see :func:`exact_search`), ``table`` its
+    :func:`polycontact._kernels.advance.edge_table`."""
     n = i[0]
     k = i[1]
     m = i[2]
     table = (i[3 + k:3 + k + n], view(i, 3 + k + n, m, 3, np.int64),
              view(f, 3 + 2 * n, m, 4, np.float64), f[3 + 2 * n + 4 * m:3 + 3 * n + 4 * m])
-    return view(f, 3, n, 2, np.float64), i[3:3 + k], f[:2], f[2], table
+    return (view(f, 3, n, 2, np.float64), i[3:3 + k], f[:2], f[2]), table
 
 
+# The one kernel that takes its settings as plain numbers rather than as a record: it is
+# the call from Python, where unboxing a nested tuple and building it cost about 50 ns
+# (1 % of a small query) more than seven numbers.
 @njit(cache=True, nogil=True)
 def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter,
                work):
     """:func:`exact_query` with each body given as its :func:`pack_body` (the call
-    ``polycontact.time_of_impact`` makes)."""
-    ra, sa, ca, la, ea = _unpack_body(fa, ia)
-    rb, sb, cb, lb, eb = _unpack_body(fb, ib)
-    return exact_query(ra, sa, ca, ma, la, ea, rb, sb, cb, mb, lb, eb, t_max, inflate,
-                       time_tol, eps_rel, ulps, lam, max_iter, work)
+    ``polycontact.time_of_impact`` makes) and the query's settings one by one (as in
+    :func:`exact_query`'s record)."""
+    a, ea = unpack_body(fa, ia)
+    b, eb = unpack_body(fb, ib)
+    return exact_query(a, ea, ma, b, eb, mb,
+                       (t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, 0), work)
 
 
 @njit(cache=True, nogil=True)
-def sampled_query(ra, sa, ca, ma, la, rb, sb, cb, mb, lb, t_max, inflate, time_tol, eps_rel,
-                  ulps, samples, work):
-    """Broad phase and :func:`sampled_search` with ``samples`` points in one call; returns
-    what :func:`exact_query` does (``iterations``: the classifications; ``t_reached``:
-    t_hi on a hit, else t_max), with its buffers in ``work`` as there."""
-    iv, bw, _, _, _, _, _, xa, xb, scratch = _work_views(work, ra.shape[0], rb.shape[0])
+def sampled_query(a, ma, b, mb, query, work):
+    """Broad phase and :func:`sampled_search` with ``samples`` points in one call (``a``,
+    ``ma``, ``b``, ``mb``: as for :func:`exact_search`; ``query``: as for
+    :func:`exact_query`); returns what :func:`exact_query` does (``iterations``: the
+    classifications; ``t_reached``: t_hi on a hit, else t_max), with its buffers in
+    ``work`` as there."""
+    t_max, inflate, time_tol, eps_rel, ulps, _, _, samples = query
+    ra, _, ca, la = a
+    rb, _, cb, lb = b
+    iv, bw, placed, _ = _work_views(work, ra.shape[0], rb.shape[0])
     n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
-    code, hi, lo, contact, its = _sampled_search(ra, sa, ca, ma, la, rb, sb, cb, mb, lb,
-                                                 iv[:n], time_tol, samples, eps_rel, ulps,
-                                                 xa, xb, scratch)
+    code, hi, lo, contact, its = _sampled_search(a, ma, b, mb, iv[:n], time_tol, samples,
+                                                 eps_rel, ulps, placed)
     return n, code, hi, lo, contact, its, hi if code == HIT else t_max

@@ -28,13 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .relation import _bbox
-from .validate import _orient, _point_segment_distance
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _next(i, starts, k):
-    return i + 1 if i + 1 < starts[k + 1] else starts[k]
+from .primitives import bbox, loop_next, orient, point_segment_distance
 
 
 @njit(cache=True, nogil=True)
@@ -51,9 +45,9 @@ def where(px, py, x, starts, eps):
     inside = False
     for k in range(starts.shape[0] - 1):
         for i in range(starts[k], starts[k + 1]):
-            j = _next(i, starts, k)
+            j = loop_next(i, starts, k)
             ax, ay, bx, by = x[i, 0], x[i, 1], x[j, 0], x[j, 1]
-            if _point_segment_distance(px, py, ax, ay, bx, by) <= eps:
+            if point_segment_distance(px, py, ax, ay, bx, by) <= eps:
                 return 0
             if (ay > py) != (by > py):
                 if px < ax + (py - ay) * (bx - ax) / (by - ay):
@@ -67,9 +61,9 @@ def _on_same_way(px, py, ux, uy, x, starts, eps):
     (ux, uy) (interiors on the same side)."""
     for k in range(starts.shape[0] - 1):
         for i in range(starts[k], starts[k + 1]):
-            j = _next(i, starts, k)
+            j = loop_next(i, starts, k)
             ax, ay, bx, by = x[i, 0], x[i, 1], x[j, 0], x[j, 1]
-            if _point_segment_distance(px, py, ax, ay, bx, by) <= eps:
+            if point_segment_distance(px, py, ax, ay, bx, by) <= eps:
                 if (bx - ax) * ux + (by - ay) * uy > 0.0:
                     return True
     return False
@@ -107,11 +101,12 @@ def _sorted(ts, n):
 
 
 @njit(cache=True, nogil=True)
-def _pieces_by_midpoint(px, py, qx, qy, x, starts, eps, ts, n, first_side, ox, oy, acc):
-    """Add the pieces of edge p → q between the sorted cut parameters ``ts[:n]`` (0 and
-    1 included) that lie inside the other region ``(x, starts)``, classified by their
-    midpoints; a piece on its boundary counts when ``first_side`` (A's pass) and an
-    edge there runs the same way."""
+def _pieces_by_midpoint(edge, x, starts, eps, ts, n, first_side, ox, oy, acc):
+    """Add the pieces of edge p → q (``edge`` = ``(px, py, qx, qy)``) between the sorted
+    cut parameters ``ts[:n]`` (0 and 1 included) that lie inside the other region
+    ``(x, starts)``, classified by their midpoints; a piece on its boundary counts when
+    ``first_side`` (A's pass) and an edge there runs the same way."""
+    px, py, qx, qy = edge
     dx = qx - px
     dy = qy - py
     for q in range(n - 1):
@@ -146,17 +141,17 @@ def _near_cuts(px, py, qx, qy, x, starts, eps, ts, n):
         for i in range(starts[k], starts[k + 1]):
             ax, ay = x[i, 0], x[i, 1]
             if (ex0 <= ax <= ex1 and ey0 <= ay <= ey1
-                    and _point_segment_distance(ax, ay, px, py, qx, qy) <= eps):
+                    and point_segment_distance(ax, ay, px, py, qx, qy) <= eps):
                 ts[n] = min(1.0, max(0.0, ((ax - px) * dx + (ay - py) * dy) / ln2))
                 n += 1
-            j = _next(i, starts, k)
+            j = loop_next(i, starts, k)
             if not _edge_box_meets(x, i, j, ex0, ex1, ey0, ey1):
                 continue
             bx, by = x[j, 0], x[j, 1]
-            o1 = _orient(px, py, qx, qy, ax, ay)
-            o2 = _orient(px, py, qx, qy, bx, by)
-            o3 = _orient(ax, ay, bx, by, px, py)
-            o4 = _orient(ax, ay, bx, by, qx, qy)
+            o1 = orient(px, py, qx, qy, ax, ay)
+            o2 = orient(px, py, qx, qy, bx, by)
+            o3 = orient(ax, ay, bx, by, px, py)
+            o4 = orient(ax, ay, bx, by, qx, qy)
             if (o1 > 0.0) != (o2 > 0.0) and (o3 > 0.0) != (o4 > 0.0) and o3 != o4:
                 ts[n] = min(1.0, max(0.0, o3 / (o3 - o4)))
                 n += 1
@@ -170,17 +165,18 @@ def _edge_box_meets(x, i, j, wx0, wx1, wy0, wy1):
 
 
 @njit(cache=True, nogil=True)
-def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, boxes, ids):
-    """Proper crossings of A's and B's edges in the window: rows of ``cross`` =
-    ``(edge of A, edge of B, t along A's edge, t along B's edge, x, y)``; an edge with
-    an end within ``eps`` of an edge of the other body is marked in ``deg_a``/``deg_b``
-    (its pieces are classified by midpoints). ``boxes`` (rows of 4) and ``ids`` (one
-    per vertex of B) are scratch: B's edges in the window. Returns the count, or -1
-    when ``cross`` is too short."""
+def _crossings(xa, sa, xb, sb, eps, window, deg_a, deg_b, cross, boxes, ids):
+    """Proper crossings of A's and B's edges in the ``window`` (``(wx0, wx1, wy0,
+    wy1)``): rows of ``cross`` = ``(edge of A, edge of B, t along A's edge, t along B's
+    edge, x, y)``; an edge with an end within ``eps`` of an edge of the other body is
+    marked in ``deg_a``/``deg_b`` (its pieces are classified by midpoints). ``boxes``
+    (rows of 4) and ``ids`` (two per vertex of B) are scratch: B's edges in the window.
+    Returns the count, or -1 when ``cross`` is too short."""
+    wx0, wx1, wy0, wy1 = window
     m = 0
     for kb in range(sb.shape[0] - 1):
         for f in range(sb[kb], sb[kb + 1]):
-            f1 = _next(f, sb, kb)
+            f1 = loop_next(f, sb, kb)
             x0 = min(xb[f, 0], xb[f1, 0])
             x1 = max(xb[f, 0], xb[f1, 0])
             y0 = min(xb[f, 1], xb[f1, 1])
@@ -197,7 +193,7 @@ def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, box
     c = 0
     for ka in range(sa.shape[0] - 1):
         for e in range(sa[ka], sa[ka + 1]):
-            e1 = _next(e, sa, ka)
+            e1 = loop_next(e, sa, ka)
             px, py, qx, qy = xa[e, 0], xa[e, 1], xa[e1, 0], xa[e1, 1]
             ex0 = min(px, qx)
             ex1 = max(px, qx)
@@ -214,22 +210,22 @@ def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, box
                 f = ids[2 * g]
                 f1 = ids[2 * g + 1]
                 rx, ry, sx, sy = xb[f, 0], xb[f, 1], xb[f1, 0], xb[f1, 1]
-                o1 = _orient(px, py, qx, qy, rx, ry)
-                o2 = _orient(px, py, qx, qy, sx, sy)
+                o1 = orient(px, py, qx, qy, rx, ry)
+                o2 = orient(px, py, qx, qy, sx, sy)
                 far_pq = o1 * o1 > e_pq and o2 * o2 > e_pq
                 if far_pq and (o1 > 0.0) == (o2 > 0.0):
                     continue  # B's edge on one side of A's line, beyond eps
-                o3 = _orient(rx, ry, sx, sy, px, py)
-                o4 = _orient(rx, ry, sx, sy, qx, qy)
+                o3 = orient(rx, ry, sx, sy, px, py)
+                o4 = orient(rx, ry, sx, sy, qx, qy)
                 e_rs = eps * eps * ((sx - rx) ** 2 + (sy - ry) ** 2)
                 far_rs = o3 * o3 > e_rs and o4 * o4 > e_rs
                 if far_rs and (o3 > 0.0) == (o4 > 0.0):
                     continue
                 if not (far_pq and far_rs) and (
-                        _point_segment_distance(px, py, rx, ry, sx, sy) <= eps
-                        or _point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps
-                        or _point_segment_distance(rx, ry, px, py, qx, qy) <= eps
-                        or _point_segment_distance(sx, sy, px, py, qx, qy) <= eps):
+                        point_segment_distance(px, py, rx, ry, sx, sy) <= eps
+                        or point_segment_distance(qx, qy, rx, ry, sx, sy) <= eps
+                        or point_segment_distance(rx, ry, px, py, qx, qy) <= eps
+                        or point_segment_distance(sx, sy, px, py, qx, qy) <= eps):
                     deg_a[e] = True
                     deg_b[f] = True
                     continue
@@ -249,12 +245,18 @@ def _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, box
 
 
 @njit(cache=True, nogil=True)
-def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc, col,
-                     first_side, ts, ox, oy, acc, where_v):
+def _boundary_inside(xv, sv, xo, so, eps, bo, frame, deg, cross, col, sums, where_v):
     """Add the parts of body V's boundary inside body O (see the module docstring):
-    ``bo`` O's box, ``deg`` V's edges to classify by midpoints, ``cross[:nc]`` the
-    crossings with V's edge in column ``col`` and its parameter in ``col + 2``. Each
-    vertex's place goes to ``where_v`` (as :func:`where` gives it)."""
+    ``bo`` O's box, ``frame`` = ``(wx0, wx1, wy0, wy1, ox, oy)`` the window and the local
+    origin, ``deg`` V's edges to classify by midpoints, ``cross`` the crossings, with
+    V's edge in column ``col`` (0: V is A, whose pieces on O's boundary count) and its
+    parameter in ``col + 2``; ``sums`` = ``(ts, acc)``: the cut parameters' scratch and
+    the sums of :func:`_green`. Each vertex's place goes to ``where_v`` (as
+    :func:`where` gives it)."""
+    wx0, wx1, wy0, wy1, ox, oy = frame
+    ts, acc = sums
+    nc = cross.shape[0]
+    first_side = col == 0
     for k in range(sv.shape[0] - 1):
         s0 = sv[k]
         s1 = sv[k + 1]
@@ -271,7 +273,7 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
             status = where(xv[s0, 0], xv[s0, 1], xo, so, eps)
         e = start
         for _ in range(s1 - s0):
-            e1 = _next(e, sv, k)
+            e1 = loop_next(e, sv, k)
             px, py, qx, qy = xv[e, 0], xv[e, 1], xv[e1, 0], xv[e1, 1]
             if not _edge_box_meets(xv, e, e1, wx0, wx1, wy0, wy1):
                 status = -1  # outside O's box: outside, and so is its end
@@ -288,7 +290,7 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
                 ts[n] = 0.0
                 ts[n + 1] = 1.0
                 _sorted(ts, n + 2)
-                _pieces_by_midpoint(px, py, qx, qy, xo, so, eps, ts, n + 2, first_side, ox,
+                _pieces_by_midpoint((px, py, qx, qy), xo, so, eps, ts, n + 2, first_side, ox,
                                     oy, acc)
                 status = where(qx, qy, xo, so, eps)
             else:
@@ -308,40 +310,45 @@ def _boundary_inside(xv, sv, xo, so, eps, bo, wx0, wx1, wy0, wy1, deg, cross, nc
 
 
 @njit(cache=True, nogil=True)
-def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, ids, where_a,
-                    where_b):
+def overlap_scratch(na, nb, cap):
+    """Scratch of :func:`overlap_moments` for bodies of up to ``na`` and ``nb`` vertices
+    and ``cap`` crossings: ``(deg_a, deg_b, cross, ts, acc, boxes, ids, where_a,
+    where_b)``. After the call ``acc[4:6]`` holds a point of the intersection's
+    boundary (the midpoint of a piece of it) when ``acc[3]`` is 1, and ``where_a``,
+    ``where_b`` (int8, one per vertex) where each vertex of A and of B lies (as
+    :func:`where` gives it: 1 inside the other body by more than ``eps``), known from
+    the walk (not filled when ``cross`` is too short)."""
+    return (np.empty(na, np.bool_), np.empty(nb, np.bool_), np.empty((cap, 6)),
+            np.empty(cap + na + nb + 2), np.empty(6), np.empty((nb, 4)),
+            np.empty(2 * nb, np.int64), np.empty(na, np.int8), np.empty(nb, np.int8))
+
+
+@njit(cache=True, nogil=True)
+def overlap_moments(xa, sa, xb, sb, eps, scratch):
     """Area and centroid of A ∩ B: ``(area, cx, cy, crossings)``; the proper crossings
     of the boundaries are left in ``cross[:crossings]`` (rows as :func:`_crossings`
     writes them), -1 when ``cross`` is too short (nothing else computed).
 
-    ``deg_a``, ``deg_b`` (bool, one per vertex of A and of B), ``cross`` (rows of 6),
-    ``ts`` (at least the vertices of both bodies plus crossings plus 2), ``boxes`` (a
-    row of 4 per vertex of B) and ``ids`` (2 per vertex of B) are scratch; ``acc`` (6)
-    receives in ``acc[4:6]`` a point of the intersection's boundary (the midpoint of
-    a piece of it) when ``acc[3]`` is 1; ``where_a`` and ``where_b`` (int8, one per
-    vertex) where each vertex of A and of B lies (as :func:`where` gives it: 1 inside
-    the other body by more than ``eps``), known from the walk (not filled when
-    ``cross`` is too short).
-    The area is 0 (and the centroid NaN) when the interiors do not overlap by more
-    than the rounding.
+    ``scratch``: :func:`overlap_scratch` for at least the bodies' vertex counts (where
+    it leaves a point of the boundary and each vertex's place, see there). The area is
+    0 (and the centroid NaN) when the interiors do not overlap by more than the
+    rounding.
 
     Examples
     --------
     >>> import numpy as np
     >>> sq = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]])
     >>> st = np.array([0, 4])
-    >>> got = overlap_moments(sq, st, sq + 1.0, st, 1e-12, np.zeros(4, np.bool_),
-    ...                       np.zeros(4, np.bool_), np.empty((16, 6)), np.empty(32),
-    ...                       np.empty(6), np.empty((4, 4)), np.empty(8, np.int64),
-    ...                       np.empty(4, np.int8), np.empty(4, np.int8))
+    >>> got = overlap_moments(sq, st, sq + 1.0, st, 1e-12, overlap_scratch(4, 4, 16))
     >>> [float(v) for v in got]
     [1.0, 1.5, 1.5, 2.0]
     """
+    deg_a, deg_b, cross, ts, acc, boxes, ids, where_a, where_b = scratch
     acc[:] = 0.0
     na = sa[sa.shape[0] - 1]
     nb = sb[sb.shape[0] - 1]
-    ba = _bbox(xa, na)
-    bb = _bbox(xb, nb)
+    ba = bbox(xa, na)
+    bb = bbox(xb, nb)
     wx0 = max(ba[0], bb[0]) - eps
     wx1 = min(ba[1], bb[1]) + eps
     wy0 = max(ba[2], bb[2]) - eps
@@ -352,15 +359,16 @@ def overlap_moments(xa, sa, xb, sb, eps, deg_a, deg_b, cross, ts, acc, boxes, id
         return 0.0, np.nan, np.nan, 0
     deg_a[:na] = False
     deg_b[:nb] = False
-    nc = _crossings(xa, sa, xb, sb, eps, wx0, wx1, wy0, wy1, deg_a, deg_b, cross, boxes, ids)
+    window = (wx0, wx1, wy0, wy1)
+    nc = _crossings(xa, sa, xb, sb, eps, window, deg_a, deg_b, cross, boxes, ids)
     if nc < 0:
         return 0.0, np.nan, np.nan, -1
-    ox = 0.5 * (wx0 + wx1)
-    oy = 0.5 * (wy0 + wy1)
-    _boundary_inside(xa, sa, xb, sb, eps, bb, wx0, wx1, wy0, wy1, deg_a, cross, nc, 0,
-                     True, ts, ox, oy, acc, where_a)
-    _boundary_inside(xb, sb, xa, sa, eps, ba, wx0, wx1, wy0, wy1, deg_b, cross, nc, 1,
-                     False, ts, ox, oy, acc, where_b)
+    frame = (wx0, wx1, wy0, wy1, 0.5 * (wx0 + wx1), 0.5 * (wy0 + wy1))
+    _boundary_inside(xa, sa, xb, sb, eps, bb, frame, deg_a, cross[:nc], 0, (ts, acc),
+                     where_a)
+    _boundary_inside(xb, sb, xa, sa, eps, ba, frame, deg_b, cross[:nc], 1, (ts, acc),
+                     where_b)
     if not acc[0] > 0.0:
         return 0.0, np.nan, np.nan, nc
+    ox, oy = frame[4], frame[5]
     return 0.5 * acc[0], ox + acc[1] / (3.0 * acc[0]), oy + acc[2] / (3.0 * acc[0]), nc

@@ -7,7 +7,7 @@ stands: ``xy = pos + R(angle) (bxy - cen)``, element by element as
 :func:`polycontact._kernels.world.place` computes it, so that a pose set here and one
 set body by body give the same bits. Each body's box, default tolerance and cell of the
 broad-phase grid follow its rows; a body whose new box stays in its cell costs the grid
-nothing.
+nothing (:func:`polycontact._kernels.world.regrid`).
 
 The centroid is :attr:`polycontact.Shape.centroid`'s formula with NumPy's summation
 order (:func:`pairwise_sum`), so a body added from raw rings gets the centroid its
@@ -22,7 +22,6 @@ import numpy as np
 from numba import njit, prange
 
 from .tolerance import box_extent_magnitude, tolerance_for
-from .world import _LEVEL_OFFSET, _cell, _key, _level, grid_insert, grid_remove, place
 
 #: NumPy's pairwise summation: runs of up to this many terms are summed in 8 lanes.
 _BLOCK = 128
@@ -153,8 +152,12 @@ def centroids(xy, ls, bs, cen, rad):
 
 
 @njit(cache=True, nogil=True)
-def _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, k0, k1):
+def _pose_range(ids, poses, bodies, base, tolerance, k0, k1):
     """:func:`pose_rows` for ``ids[k0:k1]``."""
+    px, py, ang = poses
+    xy, ls, lo, nl, box, eps = bodies
+    bxy, cen = base
+    rel, ulps = tolerance
     for k in range(k0, k1):
         b = ids[k]
         f = ls[lo[b]]
@@ -188,19 +191,24 @@ def _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps,
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def pose_rows(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, chunks):
+def pose_rows(ids, poses, bodies, base, tolerance, chunks):
     """Rows, boxes (``x0, x1, y0, y1``) and default tolerances of the bodies ``ids`` at
-    the poses ``(px[k], py[k], ang[k])``: body b's rows of ``xy`` become those of
-    ``bxy`` turned about ``cen[b]`` and moved so that ``cen[b]`` goes to the position.
-    In parallel chunks (``chunks`` = 1: serial, no thread start). Returns the largest
-    |coordinate| and the largest tolerance written."""
+    the poses ``poses`` = ``(px, py, ang)`` (row k for body ``ids[k]``), written into
+    the World's ``bodies`` record (:mod:`polycontact._kernels.world`): body b's rows
+    of ``xy`` become its base rows turned about its base centroid and moved so that the
+    centroid goes to the position (``base`` = ``(bxy, cen)``: the rows as added and
+    each body's centroid). ``tolerance`` = ``(rel, ulps)``: the default tolerance's
+    terms (:func:`polycontact._kernels.tolerance.tolerance_for`). In parallel chunks
+    (``chunks`` = 1: serial, no thread start). Returns the largest |coordinate| and the
+    largest tolerance written."""
     n = ids.shape[0]
     if chunks == 1:
-        _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, 0, n)
+        _pose_range(ids, poses, bodies, base, tolerance, 0, n)
     else:
         for c in prange(chunks):
-            _pose_range(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps,
-                        n * c // chunks, n * (c + 1) // chunks)
+            _pose_range(ids, poses, bodies, base, tolerance, n * c // chunks,
+                        n * (c + 1) // chunks)
+    box, eps = bodies[4], bodies[5]
     big = 0.0
     emax = 0.0
     for k in range(n):
@@ -208,28 +216,6 @@ def pose_rows(ids, bxy, xy, ls, lo, nl, cen, px, py, ang, box, eps, rel, ulps, c
         big = max(big, -box[b, 0], box[b, 1], -box[b, 2], box[b, 3])
         emax = max(emax, eps[b])
     return big, emax
-
-
-@njit(cache=True, nogil=True)
-def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled):
-    """Move each body of ``ids`` (boxes already set) to the grid cell of its box, if it
-    left its own; stops before the table would be more than half full. Returns (cells
-    made, bodies done)."""
-    made = 0
-    limit = keys.shape[0] // 2
-    for k in range(ids.shape[0]):
-        b = ids[k]
-        idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
-        c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
-        ix = _cell(0.5 * (box[b, 0] + box[b, 1]) - origin[0], c)
-        iy = _cell(0.5 * (box[b, 2] + box[b, 3]) - origin[1], c)
-        if slot[b] >= 0 and keys[slot[b]] == _key(idx, ix, iy):
-            continue  # still in its cell: no index work
-        if filled + made + 1 > limit:
-            return made, k
-        grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
-        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
-    return made, ids.shape[0]
 
 
 @njit(cache=True, nogil=True)

@@ -3,7 +3,7 @@
 The state kernels are serial: for small pairs (about a microsecond each) a ``prange``
 version measured 2-3 times slower on a 2-core machine; the caller splits the pairs over
 threads instead (the kernels release the GIL). The signed distances use ``prange``;
-penetration depths are left to the caller (:func:`polycontact._kernels.depth.penetrations`).
+penetration depths are left to the caller (:func:`polycontact._depth.penetrations`).
 
 A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
 after body), ``ls`` int64 and ``bs`` int64 (P+1,): the loop starts of body p are
@@ -17,17 +17,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .relation import (
-    CONTACT,
-    SEPARATE,
-    _raw_ring,
-    _ring_is_simple_unswept,
-    _ring_summary,
-    _scratch,
-    _state_in,
-    closest_pair,
-    pair_tolerance,
-)
+from .distance import closest_pair
+from .packs import state_scratch
+from .primitives import point_segment_sq
+from .relation import CONTACT, SEPARATE, state_in
+from .rings import pair_tolerance, raw_ring, ring_is_simple_unswept, ring_summary
 from .tolerance import extent_magnitude, tolerance_for
 
 
@@ -36,63 +30,64 @@ def check_rings(xy, lo, n, rel, ulps, limit, floor):
     """Validate raw rings ``xy[lo[p]:lo[p] + n[p]]``; returns (vertices used or -1, sign).
 
     ``rel``, ``ulps``, ``limit``, ``floor``: as for
-    :func:`polycontact._kernels.relation._raw_ring`."""
+    :func:`polycontact._kernels.rings.raw_ring`."""
     p_count = lo.shape[0]
     used = np.empty(p_count, np.int64)
     sign = np.empty(p_count)
     for p in range(p_count):
-        u, s, _, _ = _raw_ring(xy[lo[p] : lo[p] + n[p]], rel, ulps, limit, floor)
+        u, s, _, _ = raw_ring(xy[lo[p] : lo[p] + n[p]], rel, ulps, limit, floor)
         used[p] = u
         sign[p] = s
     return used, sign
 
 
 #: State mark of :func:`_raw_states_into` for a pair with a long ring that only the
-#: sweep of :func:`polycontact._kernels.relation._ring_is_simple` can decide.
+#: sweep of :func:`polycontact._kernels.rings.raw_ring` can decide.
 _UNDECIDED = -2
 
 
+@njit(cache=True, nogil=True)
 def raw_states_outputs(p_count):
     """Empty arrays for the six results of :func:`raw_states` over ``p_count`` pairs."""
     return (np.empty(p_count, np.int8), np.zeros(p_count), np.empty(p_count, np.int64),
             np.empty(p_count), np.empty(p_count, np.int64), np.empty(p_count))
 
 
-def raw_states(xa, xb, tol, rel, ulps, limit, floor, out=None):
+@njit(cache=True, nogil=True)
+def raw_states(xa, xb, tol, rel, ulps, limit, floor, out):
     """Validate and classify P pairs of raw outer rings, ``xa`` (P, N, 2) against
-    ``xb`` (P, M, 2), in one pass over the pairs.
+    ``xb`` (P, M, 2), in one pass over the pairs, into ``out``.
 
-    Returns ``(states, eps, used_a, sign_a, used_b, sign_b)``: per pair the state
-    (int8; -1 when either ring is not valid as given), the tolerance, and per ring
-    the vertices used (a repeated closing point dropped; -1 if invalid) and the
-    orientation sign (see :func:`polycontact._kernels.relation._raw_ring`).
-    ``tol`` < 0 means per pair the default tolerance
-    (:func:`polycontact._kernels.relation.pair_tolerance` with ``rel`` and ``ulps``);
+    ``out`` is the tuple of arrays ``(states, eps, used_a, sign_a, used_b, sign_b)``
+    (P each; int8, float64, int64, float64, int64, float64), written and returned: per
+    pair the state (-1 when either ring is not valid as given), the tolerance, and per
+    ring the vertices used (a repeated closing point dropped; -1 if invalid) and the
+    orientation sign (see :func:`polycontact._kernels.rings.raw_ring`). ``tol`` < 0
+    means per pair the default tolerance
+    (:func:`polycontact._kernels.rings.pair_tolerance` with ``rel`` and ``ulps``);
     ``limit`` and ``floor`` bound the coordinates and extents accepted.
 
     The pass itself (:func:`_raw_states_into`) allocates nothing; the few pairs it
     leaves undecided (long rings that need a sorted sweep) are finished by
-    :func:`_finish_undecided`. (A plain function: it only allocates and dispatches.)
-    ``out``, if given, is that tuple of arrays to write into (views of larger ones, say).
+    :func:`_finish_undecided`.
     """
-    if out is None:
-        out = raw_states_outputs(xa.shape[0])
-    scratch = (*_scratch(xa.shape[1] + xb.shape[1]), np.zeros(2, np.int64),
-               np.zeros(2, np.int64))
-    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch):
-        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, *out, *scratch)
+    scratch = state_scratch(xa.shape[1] + xb.shape[1])
+    sa = np.zeros(2, np.int64)
+    sb = np.zeros(2, np.int64)
+    if _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
+        _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                      used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
+def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
     """Validate (with the sorted sweep) and classify the pairs marked ``_UNDECIDED``."""
+    states, eps, used_a, sign_a, used_b, sign_b = out
     for p in range(xa.shape[0]):
         if states[p] != _UNDECIDED:
             continue
-        na, fa, _, ba = _raw_ring(xa[p], rel, ulps, limit, floor)
-        nb, fb, _, bb = _raw_ring(xb[p], rel, ulps, limit, floor)
+        na, fa, _, ba = raw_ring(xa[p], rel, ulps, limit, floor)
+        nb, fb, _, bb = raw_ring(xb[p], rel, ulps, limit, floor)
         used_a[p] = na
         used_b[p] = nb
         sign_a[p] = fa
@@ -100,8 +95,8 @@ def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a,
         if na < 0 or nb < 0:
             states[p] = -1
             continue
-        states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel, ulps,
-                                        sa, sb, box, ids, touch, rays, rord)
+        states[p], eps[p] = _pair_state((xa[p], na, fa, ba), (xb[p], nb, fb, bb), tol, rel,
+                                        ulps, sa, sb, scratch)
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the pass creates a view
@@ -109,19 +104,19 @@ def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a,
 # updates of those cost about as much as classifying a pair of 12-gons (measured 0.27
 # against 0.16 us per pair). Nothing in it may allocate (the compiler refuses if it does).
 @njit(cache=True, nogil=True, _nrt=False)
-def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, sign_a,
-                     used_b, sign_b, box, ids, touch, rays, rord, sa, sb):
-    """:func:`raw_states`' pass over the pairs, into its arrays; a pair with a ring that
-    needs the sorted sweep is marked ``_UNDECIDED`` (returns whether any is)."""
+def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
+    """:func:`raw_states`' pass over the pairs, into its arrays ``out``; a pair with a
+    ring that needs the sorted sweep is marked ``_UNDECIDED`` (returns whether any is)."""
+    states, eps, used_a, sign_a, used_b, sign_b = out
     undecided = False
     for p in range(xa.shape[0]):
-        na, fa, ea, ba = _ring_summary(xa[p], rel, ulps, limit, floor)
-        nb, fb, eb, bb = _ring_summary(xb[p], rel, ulps, limit, floor)
-        ka = _ring_is_simple_unswept(xa[p], na, ea) if na > 0 else 0
-        kb = _ring_is_simple_unswept(xb[p], nb, eb) if nb > 0 else 0
+        na, fa, ea, ba = ring_summary(xa[p], rel, ulps, limit, floor)
+        nb, fb, eb, bb = ring_summary(xb[p], rel, ulps, limit, floor)
+        ka = ring_is_simple_unswept(xa[p], na, ea) if na > 0 else 0
+        kb = ring_is_simple_unswept(xb[p], nb, eb) if nb > 0 else 0
         used_a[p] = na if ka != 0 else -1
         used_b[p] = nb if kb != 0 else -1
-        sign_a[p] = fa if ka != 0 else 1.0     # as _raw_ring gives for an invalid ring
+        sign_a[p] = fa if ka != 0 else 1.0     # as raw_ring gives for an invalid ring
         sign_b[p] = fb if kb != 0 else 1.0
         if ka == 0 or kb == 0:
             states[p] = -1
@@ -129,25 +124,30 @@ def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, states, eps, used_a, 
             states[p] = _UNDECIDED
             undecided = True
         else:
-            states[p], eps[p] = _pair_state(xa[p], na, fa, ba, xb[p], nb, fb, bb, tol, rel,
-                                            ulps, sa, sb, box, ids, touch, rays, rord)
+            states[p], eps[p] = _pair_state((xa[p], na, fa, ba), (xb[p], nb, fb, bb), tol,
+                                            rel, ulps, sa, sb, scratch)
     return undecided
 
 
 @njit(cache=True, nogil=True)
-def _pair_state(ya, na, fa, ba, yb, nb, fb, bb, tol, rel, ulps, sa, sb, box, ids, touch,
-                rays, rord):
-    """``(state, eps)`` of two valid raw rings (their :func:`_ring_summary` values)."""
+def _pair_state(ring_a, ring_b, tol, rel, ulps, sa, sb, scratch):
+    """``(state, eps)`` of two valid raw rings, each ``(rows, n, sign, box)`` (its rows
+    and its :func:`polycontact._kernels.rings.ring_summary` values); ``sa``, ``sb``: two
+    loop-start arrays of 2 to write into."""
+    ya, na, fa, ba = ring_a
+    yb, nb, fb, bb = ring_b
     e = tol if tol >= 0.0 else pair_tolerance(ba, bb, rel, ulps)
     if ba[0] > bb[1] + e or bb[0] > ba[1] + e or ba[2] > bb[3] + e or bb[2] > ba[3] + e:
         return SEPARATE, e  # boxes apart: no call into the state kernel
     sa[1] = na
     sb[1] = nb
-    return _state_in(ya[:na], sa, fa, yb[:nb], sb, fb, e, box, ids, touch, rays, rord), e
+    return state_in(ya[:na], sa, fa, yb[:nb], sb, fb, e, scratch), e
 
 
 @njit(cache=True, nogil=True)
-def _body(xy, ls, bs, p):
+def body(xy, ls, bs, p):
+    """``(rows, starts)`` of body ``p`` of a packed batch: its rows of ``xy`` (a view)
+    and its loop starts relative to them (a new array)."""
     first = ls[bs[p]]
     starts = ls[bs[p] : bs[p + 1]] - first
     return xy[first : ls[bs[p + 1] - 1]], starts
@@ -155,7 +155,7 @@ def _body(xy, ls, bs, p):
 
 @njit(cache=True, nogil=True)
 def _body_into(xy, ls, bs, p, buf):
-    """:func:`_body` with the loop starts written into ``buf`` (no allocation)."""
+    """:func:`body` with the loop starts written into ``buf`` (no allocation)."""
     first = ls[bs[p]]
     m = bs[p + 1] - bs[p]
     for k in range(m):
@@ -187,7 +187,7 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel, ulps):
     eps = np.empty(p_count)
     va, ma = _largest(lsa, bsa)
     vb, mb = _largest(lsb, bsb)
-    box, ids, touch, rays, rord = _scratch(va + vb)
+    scratch = state_scratch(va + vb)
     buf_a = np.empty(ma, np.int64)
     buf_b = np.empty(mb, np.int64)
     for p in range(p_count):
@@ -200,12 +200,14 @@ def many_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, rel, ulps):
             eb, mb = extent_magnitude(yb)
             e = tolerance_for(max(ea, eb), max(ma, mb), rel, ulps)
         eps[p] = e
-        states[p] = _state_in(ya, sa, fa[p], yb, sb, fb[p], e, box, ids, touch, rays, rord)
+        states[p] = state_in(ya, sa, fa[p], yb, sb, fb[p], e, scratch)
     return states, eps
 
 
 @njit(cache=True, nogil=True)
-def _oriented(y, s, f):
+def oriented(y, s, f):
+    """A raw ring's rows with the interior on the left: ``y`` itself when ``f`` > 0,
+    else reversed (a copy)."""
     if f > 0.0:
         return y
     return y[::-1].copy()  # raw rings are single loops
@@ -216,21 +218,6 @@ def _oriented(y, s, f):
 #: with no allocation (measured 2.8 times faster than :func:`closest_pair`'s sorted
 #: sweep on separate 12-gon pairs); above it, the sweep.
 _BRUTE_GAP = 1024
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _point_segment_sq(px, py, ax, ay, bx, by):
-    """Squared distance from (px, py) to the segment from (ax, ay) to (bx, by)."""
-    ux = bx - ax
-    uy = by - ay
-    wx = px - ax
-    wy = py - ay
-    den = ux * ux + uy * uy
-    t = (wx * ux + wy * uy) / den if den > 0.0 else 0.0
-    t = min(max(t, 0.0), 1.0)
-    dx = wx - t * ux
-    dy = wy - t * uy
-    return dx * dx + dy * dy
 
 
 @njit(cache=True, nogil=True)
@@ -268,7 +255,7 @@ def _vertices_to_edges(xv, v0, v1, xe, ls, k0, k1, best):
                 dy = max(min(ay, by) - py, py - max(ay, by), 0.0)
                 if dx * dx + dy * dy >= best:
                     continue
-                best = min(best, _point_segment_sq(px, py, ax, ay, bx, by))
+                best = min(best, point_segment_sq(px, py, ax, ay, bx, by))
     return best
 
 
@@ -282,8 +269,8 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
     b0 = lsb[bsb[p]]
     b1 = lsb[bsb[p + 1] - 1]
     if (a1 - a0) * (b1 - b0) > _BRUTE_GAP:
-        ya, sa = _body(xa, lsa, bsa, p)
-        yb, sb = _body(xb, lsb, bsb, p)
+        ya, sa = body(xa, lsa, bsa, p)
+        yb, sb = body(xb, lsb, bsb, p)
         return closest_pair(ya, sa, yb, sb)[0]
     best = np.inf
     for i in range(a0, a1):
@@ -300,7 +287,7 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
 def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
     """Signed distances of P classified pairs: the boundary gap, or 0; NaN for the
     penetrating pairs, whose depth the caller computes (it needs convex pieces, see
-    :func:`polycontact._kernels.depth.penetrations`)."""
+    :func:`polycontact._depth.penetrations`)."""
     p_count = bsa.shape[0] - 1
     out = np.empty(p_count)
     for p in prange(p_count):

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .impact import _unpack_body, exact_query, sampled_query, work_floats
+from .impact import exact_query, sampled_query, unpack_body, work_floats
 
 
 @njit(cache=True, nogil=True)
@@ -167,43 +167,45 @@ def box_pairs(boxes, owner, n_bodies):
 
 
 @njit(cache=True, nogil=True)
-def impacts_chunk(todo, sa, sb, ma, mb, eps_rel, floats, f_off, ints, i_off, t_max, inflate,
-                  time_tol, ulps, contact_resolution, max_iter, exact, samples, code, t_hi,
-                  t_lo, contact, iters, reached, n_iv, iv):
+def impacts_chunk(todo, pairs, shapes, settings, out):
     """Time of impact of the pairs ``todo`` (indices into the pair arrays), results
     written in place at those indices.
 
-    Pair p is shape ``sa[p]`` moving with ``ma[p]`` against shape ``sb[p]`` moving with
-    ``mb[p]``, the size term of its distance tolerance ``eps_rel[p]`` (the kernels add
-    ``ulps`` times the largest |coordinate| at each time they examine). Shape s is
-    ``floats[f_off[s]:f_off[s + 1]]`` and ``ints[i_off[s]:i_off[s + 1]]``, its
-    :func:`polycontact._kernels.impact.pack_body` (vertices about its centroid, loop
-    starts, centroid, bounding radius, circle tree). Each pair runs ``exact_query``
-    (``exact``) or ``sampled_query`` with the same arguments as
-    ``polycontact.time_of_impact`` (contact resolution ``contact_resolution`` times the
-    sum of the radii); its outputs go to ``code``, ``t_hi``, ``t_lo``, ``contact``,
-    ``iters``, ``reached``, and its broad-phase intervals to ``iv[p, :n_iv[p]]``.
+    ``pairs`` is ``(sa, sb, ma, mb, eps_rel)``: pair p is shape ``sa[p]`` moving with
+    ``ma[p]`` against shape ``sb[p]`` moving with ``mb[p]``, the size term of its
+    distance tolerance ``eps_rel[p]`` (the kernels add ``ulps`` times the largest
+    |coordinate| at each time they examine). ``shapes`` is ``(floats, f_off, ints,
+    i_off)``: shape s is ``floats[f_off[s]:f_off[s + 1]]`` and
+    ``ints[i_off[s]:i_off[s + 1]]``, its :func:`polycontact._kernels.impact.pack_body`
+    (vertices about its centroid, loop starts, centroid, bounding radius, circle tree).
+    ``settings`` is ``(t_max, inflate, time_tol, ulps, contact_resolution, max_iter,
+    exact, samples)``. Each pair runs ``exact_query`` (``exact``) or ``sampled_query``
+    with the same arguments as ``polycontact.time_of_impact`` (contact resolution
+    ``contact_resolution`` times the sum of the radii); its outputs go to ``out`` =
+    ``(code, t_hi, t_lo, contact, iters, reached, n_iv, iv)``, its broad-phase intervals
+    to ``iv[p, :n_iv[p]]``.
     """
+    sa, sb, ma, mb, eps_rel = pairs
+    floats, f_off, ints, i_off = shapes
+    t_max, inflate, time_tol, ulps, contact_resolution, max_iter, exact, samples = settings
+    code, t_hi, t_lo, contact, iters, reached, n_iv, iv = out
     widest = 0
     for s in range(i_off.shape[0] - 1):
         widest = max(widest, ints[i_off[s]])
     work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
-        a = sa[p]
-        b = sb[p]
-        ra, sta, ca, la, ea = _unpack_body(floats[f_off[a]:f_off[a + 1]],
-                                           ints[i_off[a]:i_off[a + 1]])
-        rb, stb, cb, lb, eb = _unpack_body(floats[f_off[b]:f_off[b + 1]],
-                                           ints[i_off[b]:i_off[b + 1]])
+        a, ea = unpack_body(floats[f_off[sa[p]]:f_off[sa[p] + 1]],
+                            ints[i_off[sa[p]]:i_off[sa[p] + 1]])
+        b, eb = unpack_body(floats[f_off[sb[p]]:f_off[sb[p] + 1]],
+                            ints[i_off[sb[p]]:i_off[sb[p] + 1]])
+        query = (t_max, inflate, time_tol, eps_rel[p], ulps, contact_resolution * (a[3] + b[3]),
+                 max_iter, samples)
         if exact:
-            out = exact_query(ra, sta, ca, ma[p], la, ea, rb, stb, cb, mb[p], lb, eb, t_max,
-                              inflate, time_tol, eps_rel[p], ulps,
-                              contact_resolution * (la + lb), max_iter, work)
+            res = exact_query(a, ea, ma[p], b, eb, mb[p], query, work)
         else:
-            out = sampled_query(ra, sta, ca, ma[p], la, rb, stb, cb, mb[p], lb, t_max,
-                                inflate, time_tol, eps_rel[p], ulps, samples, work)
-        n, c, hi, lo, ct, its, got = out
+            res = sampled_query(a, ma[p], b, mb[p], query, work)
+        n, c, hi, lo, ct, its, got = res
         code[p] = c
         t_hi[p] = hi
         t_lo[p] = lo

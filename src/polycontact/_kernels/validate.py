@@ -5,62 +5,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .primitives import orient, point_segment_distance, segment_meet
+
+
 #: Defect codes returned by :func:`first_defect`.
 OK = 0
 SELF_INTERSECTION = 1  # two edges of one loop meet away from their shared vertex
 LOOPS_CROSS = 2  # edges of two different loops cross or overlap
 SPIKE = 3  # two consecutive edges fold back on each other
-
-
-@njit(cache=True, nogil=True)
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-
-
-@njit(cache=True, nogil=True)
-def closest_on_segment(px, py, ax, ay, bx, by):
-    """``(qx, qy, d2)``: the point q of the closed segment ab nearest p, and |p − q|²."""
-    dx = bx - ax
-    dy = by - ay
-    den = dx * dx + dy * dy
-    t = 0.0
-    if den > 0.0:
-        t = ((px - ax) * dx + (py - ay) * dy) / den
-        t = min(1.0, max(0.0, t))
-    qx = ax + t * dx
-    qy = ay + t * dy
-    return qx, qy, (px - qx) * (px - qx) + (py - qy) * (py - qy)
-
-
-@njit(cache=True, nogil=True)
-def _point_segment_distance(px, py, ax, ay, bx, by):
-    return np.sqrt(closest_on_segment(px, py, ax, ay, bx, by)[2])
-
-
-@njit(cache=True, nogil=True)
-def segment_meet(ax, ay, bx, by, cx, cy, dx, dy, eps):
-    """Whether closed segments ab and cd meet (within eps); returns (meets, x, y).
-
-    A proper crossing returns its crossing point; a touch returns the touching endpoint.
-    """
-    for px, py, sx, sy, tx, ty in (
-        (cx, cy, ax, ay, bx, by),
-        (dx, dy, ax, ay, bx, by),
-        (ax, ay, cx, cy, dx, dy),
-        (bx, by, cx, cy, dx, dy),
-    ):
-        if _point_segment_distance(px, py, sx, sy, tx, ty) <= eps:
-            return True, px, py
-    o1 = _orient(ax, ay, bx, by, cx, cy)
-    o2 = _orient(ax, ay, bx, by, dx, dy)
-    o3 = _orient(cx, cy, dx, dy, ax, ay)
-    o4 = _orient(cx, cy, dx, dy, bx, by)
-    if ((o1 > 0.0 and o2 < 0.0) or (o1 < 0.0 and o2 > 0.0)) and (
-        (o3 > 0.0 and o4 < 0.0) or (o3 < 0.0 and o4 > 0.0)
-    ):
-        s = o1 / (o1 - o2)
-        return True, cx + s * (dx - cx), cy + s * (dy - cy)
-    return False, 0.0, 0.0
 
 
 @njit(cache=True, nogil=True)
@@ -113,8 +65,8 @@ def first_defect(xy, starts, eps):
                 else:
                     px, py, qx, qy, rx, ry = cx, cy, dx, dy, bx, by
                 # p -> q -> r folds back if r lies on segment pq or p lies on qr.
-                if _point_segment_distance(rx, ry, px, py, qx, qy) <= eps or (
-                    _point_segment_distance(px, py, qx, qy, rx, ry) <= eps
+                if point_segment_distance(rx, ry, px, py, qx, qy) <= eps or (
+                    point_segment_distance(px, py, qx, qy, rx, ry) <= eps
                 ):
                     first = i if j == i1 else j
                     second = j if j == i1 else i
@@ -142,10 +94,10 @@ def _loops_cross_here(ax, ay, bx, by, cx, cy, dx, dy, eps):
     (an endpoint on the other segment) is accepted here; whether the loops then cross
     at that vertex is decided by the containment test of the caller.
     """
-    o1 = _orient(ax, ay, bx, by, cx, cy)
-    o2 = _orient(ax, ay, bx, by, dx, dy)
-    o3 = _orient(cx, cy, dx, dy, ax, ay)
-    o4 = _orient(cx, cy, dx, dy, bx, by)
+    o1 = orient(ax, ay, bx, by, cx, cy)
+    o2 = orient(ax, ay, bx, by, dx, dy)
+    o3 = orient(cx, cy, dx, dy, ax, ay)
+    o4 = orient(cx, cy, dx, dy, bx, by)
     la = np.hypot(bx - ax, by - ay)
     lc = np.hypot(dx - cx, dy - cy)
     t1 = eps * la

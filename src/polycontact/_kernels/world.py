@@ -15,6 +15,10 @@ adding, moving or removing a body touches one cell list (doubly linked through `
 and ``prv``). A box query visits, on every non-empty level, the cells whose widened
 bounds meet the box. Cell indices are clamped to ±2**25 about ``origin``: far cells
 merge (more candidates), never lose one.
+
+The kernels take the store as records: ``bodies`` = ``(xy, ls, lo, nl, box, eps)``, and
+the broad phase's ``grid`` = ``(keys, heads, nxt, level, lvl_count, levels, origin)``
+(``levels``: the level indices in use).
 """
 
 from __future__ import annotations
@@ -24,7 +28,10 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .relation import _bbox, _scratch, _state_in
+from .packs import state_scratch
+from .primitives import bbox
+from .relation import state_in
+
 
 #: Levels L = idx - 512, idx in [0, 1024): cells from 2**-512 to 2**511.
 _LEVEL_OFFSET = 512
@@ -46,14 +53,6 @@ def place(xy, cx, cy, px, py, angle, out):
 
 
 @njit(cache=True, nogil=True)
-def _tolerance(xy, n, rel, ulp_factor):
-    """:func:`polycontact.tolerances.default_tolerance` of one body's rows ``xy[:n]``."""
-    x0, x1, y0, y1 = _bbox(xy, n)
-    mag = max(max(-x0, x1), max(-y0, y1))
-    return max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
-
-
-@njit(cache=True, nogil=True)
 def _level(x0, x1, y0, y1):
     """Level index of a box: the smallest L with 2**L >= its larger side."""
     s = max(x1 - x0, y1 - y0)
@@ -66,12 +65,14 @@ def _level(x0, x1, y0, y1):
 
 @njit(cache=True, nogil=True)
 def _cell(v, c):
+    """The cell of side c holding coordinate v, clamped to ±2**25."""
     f = math.floor(v / c)
     return int(min(max(f, -_CELL_LIMIT), _CELL_LIMIT - 1.0))
 
 
 @njit(cache=True, nogil=True)
 def _key(idx, ix, iy):
+    """The hash key of cell (ix, iy) of level index ``idx``."""
     return (idx << 52) | ((ix + 33554432) << 26) | (iy + 33554432)
 
 
@@ -86,14 +87,20 @@ def _slot(keys, key):
     return h
 
 
-@njit(cache=True, nogil=True)
-def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
-    """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
+@njit(cache=True, nogil=True, inline="always")
+def _cell_key(box, b, origin):
+    """The level index of body ``b``'s box and the hash key of the cell that holds it."""
     idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
     c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
     ix = _cell(0.5 * (box[b, 0] + box[b, 1]) - origin[0], c)
     iy = _cell(0.5 * (box[b, 2] + box[b, 3]) - origin[1], c)
-    key = _key(idx, ix, iy)
+    return idx, _key(idx, ix, iy)
+
+
+@njit(cache=True, nogil=True)
+def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
+    """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
+    idx, key = _cell_key(box, b, origin)
     h = _slot(keys, key)
     made = 0
     if keys[h] == -1:
@@ -154,11 +161,31 @@ def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, ali
 
 
 @njit(cache=True, nogil=True)
-def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, low, n_ids,
-            cand):
-    """Bodies whose cell may hold a box meeting [q0, q1] x [q2, q3], on levels >= ``low``,
-    written into ``cand``; returns how many. A level whose cell range is larger than its
-    population is scanned body by body instead."""
+def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled):
+    """Move each body of ``ids`` (boxes already set) to the cell of its box, if it left
+    its own (a body that stays costs no index work), in a table holding ``filled``
+    cells; stops before it would be more than half full. Returns (cells made, bodies
+    done)."""
+    made = 0
+    limit = keys.shape[0] // 2
+    for k in range(ids.shape[0]):
+        b = ids[k]
+        key = _cell_key(box, b, origin)[1]
+        if slot[b] >= 0 and keys[slot[b]] == key:
+            continue
+        if filled + made + 1 > limit:
+            return made, k
+        grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
+        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
+    return made, ids.shape[0]
+
+
+@njit(cache=True, nogil=True)
+def _gather(grid, q0, q1, q2, q3, low, n_ids, cand):
+    """Bodies whose cell in ``grid`` may hold a box meeting [q0, q1] x [q2, q3], on levels
+    >= ``low``, written into ``cand``; returns how many. A level whose cell range is
+    larger than its population is scanned body by body instead."""
+    keys, heads, nxt, level, lvl_count, levels, origin = grid
     n = 0
     for li in range(levels.shape[0]):
         idx = levels[li]
@@ -194,14 +221,16 @@ def _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3, 
 
 @njit(cache=True, nogil=True)
 def _meet(box, b, q0, q1, q2, q3):
+    """Whether body b's box meets [q0, q1] x [q2, q3]."""
     return not (box[b, 0] > q1 or box[b, 1] < q0 or box[b, 2] > q3 or box[b, 3] < q2)
 
 
 @njit(cache=True, nogil=True)
-def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps, tol, alive,
-                    n_ids, margin):
+def candidate_pairs(grid, box, eps, tol, alive, n_ids, margin):
     """Pairs (i, j) of live bodies whose boxes come within their tolerance plus
-    ``margin``: i < j on a shared level, else i on the lower level. Returns (pi, pj)."""
+    ``margin``: i < j on a shared level, else i on the lower level. Returns (pi, pj).
+    ``grid`` is the broad phase's record (see the module's docstring)."""
+    level = grid[3]
     cap = 4 * alive.shape[0] + 16
     pi = np.empty(cap, np.int64)
     pj = np.empty(cap, np.int64)
@@ -220,8 +249,7 @@ def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps
         q1 = box[i, 1] + d
         q2 = box[i, 2] - d
         q3 = box[i, 3] + d
-        m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, q0, q1, q2, q3,
-                    level[i], n_ids, cand)
+        m = _gather(grid, q0, q1, q2, q3, level[i], n_ids, cand)
         for t in range(m):
             j = cand[t]
             if j == i or (level[j] == level[i] and j < i):
@@ -245,7 +273,7 @@ def candidate_pairs(keys, heads, nxt, level, lvl_count, levels, origin, box, eps
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _view(xy, ls, lo, nl, b, buf):
+def body_view(xy, ls, lo, nl, b, buf):
     """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
     first = ls[lo[b]]
     m = nl[b]
@@ -255,71 +283,75 @@ def _view(xy, ls, lo, nl, b, buf):
 
 
 @njit(cache=True, nogil=True)
-def _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, k0, k1, states, used):
-    box, ids, touch, rays, rord = _scratch(2 * vmax)
-    _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, ids, touch,
-                   rays, rord, np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+def _classify_range(bodies, tol, pi, pj, vmax, lmax, k0, k1, out):
+    """:func:`_classify_into` for the pairs ``k0:k1``, with buffers for bodies of up to
+    ``vmax`` vertices and ``lmax`` loops."""
+    _classify_into(bodies, tol, pi, pj, k0, k1, out, state_scratch(2 * vmax),
+                   np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): per pair it makes four
 # views and passes a dozen arrays to the state kernel, and their atomic reference counts
 # cost ~25 ns per pair. Nothing in it may allocate: the buffers are passed in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _classify_into(xy, ls, lo, nl, eps, tol, pi, pj, k0, k1, states, used, box, ids, touch,
-                   rays, rord, ba, bb):
-    """The loop of :func:`_classify_range` with its buffers (``ba``, ``bb``: loop starts
-    of the two bodies)."""
+def _classify_into(bodies, tol, pi, pj, k0, k1, out, scratch, ba, bb):
+    """The states and tolerances (``out``) of the pairs (pi[k], pj[k]), k in ``k0:k1``,
+    with the state kernel's ``scratch`` (``ba``, ``bb``: loop starts of the two
+    bodies)."""
+    xy, ls, lo, nl, _, eps = bodies
+    states, used = out
     for k in range(k0, k1):
         i = pi[k]
         j = pj[k]
-        ya, sa = _view(xy, ls, lo, nl, i, ba)
-        yb, sb = _view(xy, ls, lo, nl, j, bb)
+        ya, sa = body_view(xy, ls, lo, nl, i, ba)
+        yb, sb = body_view(xy, ls, lo, nl, j, bb)
         e = tol if tol >= 0.0 else max(eps[i], eps[j])
         used[k] = e
-        states[k] = _state_in(ya, sa, 1.0, yb, sb, 1.0, e, box, ids, touch, rays, rord)
+        states[k] = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def classify_pairs(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, chunks):
-    """States (int8) and tolerances of the pairs (pi[k], pj[k]), in parallel chunks
-    (``chunks`` = 1: serial, no thread start)."""
+def classify_pairs(bodies, tol, pi, pj, vmax, lmax, chunks):
+    """States (int8) and tolerances of the pairs (pi[k], pj[k]) of ``bodies`` (the
+    World's record, see the module's docstring), in parallel chunks (``chunks`` = 1:
+    serial, no thread start)."""
     k_count = pi.shape[0]
-    states = np.empty(k_count, np.int8)
-    used = np.empty(k_count)
+    out = (np.empty(k_count, np.int8), np.empty(k_count))
     if chunks == 1:
-        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax, 0, k_count, states,
-                        used)
-        return states, used
+        _classify_range(bodies, tol, pi, pj, vmax, lmax, 0, k_count, out)
+        return out
     for c in prange(chunks):
-        _classify_range(xy, ls, lo, nl, eps, tol, pi, pj, vmax, lmax,
-                        k_count * c // chunks, k_count * (c + 1) // chunks, states, used)
-    return states, used
+        _classify_range(bodies, tol, pi, pj, vmax, lmax, k_count * c // chunks,
+                        k_count * (c + 1) // chunks, out)
+    return out
 
 
 @njit(cache=True, nogil=True)
-def _container_state(ya, sa, bx0, bx1, by0, by1, e, hxy, hls, hlo, hnl, cbox, hbuf, box,
-                     ids, touch, rays, rord):
-    """0 inside, 1 touching the boundary, 2 outside or crossing: A (box bx0..by1) against
-    the hazards (the frame around the container's outer loop, and its holes)."""
-    if _off_box(bx0, bx1, by0, by1, e, cbox):
+def _container_state(ya, sa, qbox, e, hazards, hbuf, scratch):
+    """0 inside, 1 touching the boundary, 2 outside or crossing: A (box ``qbox``, as
+    ``(x0, x1, y0, y1)``) against the hazards (the frame around the container's outer
+    loop, and its holes)."""
+    if _off_box(qbox, e, hazards[4]):
         return 2
-    return _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, rord)
+    return _hazard_state(ya, sa, e, hazards, hbuf, scratch)
 
 
 @njit(cache=True, nogil=True)
-def _off_box(bx0, bx1, by0, by1, e, cbox):
-    """Does the box bx0..by1 leave the container's box by more than ``e``?"""
+def _off_box(qbox, e, cbox):
+    """Does the box ``qbox`` leave the container's box by more than ``e``?"""
+    bx0, bx1, by0, by1 = qbox
     return bx0 < cbox[0] - e or bx1 > cbox[1] + e or by0 < cbox[2] - e or by1 > cbox[3] + e
 
 
 @njit(cache=True, nogil=True)
-def _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, rord):
+def _hazard_state(ya, sa, e, hazards, hbuf, scratch):
     """Worst state of A against the container's hazards (its box not left: see
     :func:`_off_box`)."""
+    hxy, hls, hlo, hnl, _, _ = hazards
     worst = 0
     for h in range(hnl.shape[0]):
-        yh, sh = _view(hxy, hls, hlo, hnl, h, hbuf)
-        s = _state_in(ya, sa, 1.0, yh, sh, 1.0, e, box, ids, touch, rays, rord)
+        yh, sh = body_view(hxy, hls, hlo, hnl, h, hbuf)
+        s = state_in(ya, sa, 1.0, yh, sh, 1.0, e, scratch)
         if s > worst:
             worst = s
             if worst == 2:
@@ -328,50 +360,59 @@ def _hazard_state(ya, sa, e, hxy, hls, hlo, hnl, hbuf, box, ids, touch, rays, ro
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def container_states(xy, ls, lo, nl, box, eps, tol, alive, hxy, hls, hlo, hnl, cbox, ceps,
-                     vmax, lmax, hmax, chunks):
+def container_states(bodies, tol, alive, hazards, vmax, lmax, hmax, chunks):
     """Container state (0, 1, 2) of every live body, in parallel chunks."""
+    xy, ls, lo, nl, box, eps = bodies
+    hnl, ceps = hazards[3], hazards[5]
     n = alive.shape[0]
     out = np.empty(n, np.int8)
     for c in prange(chunks):  # few bodies: chunks = 1, one thread
-        bx, ids, touch, rays, rord = _scratch(vmax + hmax)
+        scratch = state_scratch(vmax + hmax)
         ba = np.empty(lmax + 1, np.int64)
         hb = np.empty(hnl.max() + 1, np.int64)
         for k in range(n * c // chunks, n * (c + 1) // chunks):
             b = alive[k]
-            ya, sa = _view(xy, ls, lo, nl, b, ba)
+            ya, sa = body_view(xy, ls, lo, nl, b, ba)
             e = tol if tol >= 0.0 else max(eps[b], ceps)
-            out[k] = _container_state(ya, sa, box[b, 0], box[b, 1], box[b, 2], box[b, 3], e,
-                                      hxy, hls, hlo, hnl, cbox, hb, bx, ids, touch, rays,
-                                      rord)
+            out[k] = _container_state(ya, sa, (box[b, 0], box[b, 1], box[b, 2], box[b, 3]),
+                                      e, hazards, hb, scratch)
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _state_against(qxy, qs, qbox, qeps, j, bodies, tol, buf, scratch):
+    """State of the placed shape ``(qxy, qs)`` (box ``qbox``, tolerance term ``qeps``)
+    against body j; 0 when their boxes are farther apart than the pair's tolerance."""
+    xy, ls, lo, nl, box, eps = bodies
+    x0, x1, y0, y1 = qbox
+    e = tol if tol >= 0.0 else max(qeps, eps[j])
+    if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
+        return 0
+    yb, sb = body_view(xy, ls, lo, nl, j, buf)
+    return state_in(qxy, qs, 1.0, yb, sb, 1.0, e, scratch)
+
+
 @njit(cache=True, nogil=True)
-def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, origin, xy, ls,
-                 lo, nl, box, eps, tol, emax, n_ids, vmax, lmax):
-    """Ids and states of the bodies the placed shape (qxy, qs) touches or penetrates."""
+def query_states(query, grid, bodies, tol, emax, n_ids, vmax, lmax):
+    """Ids and states of the bodies the placed shape ``query`` = ``(qxy, qs, qeps)``
+    (its packed loops and its default-tolerance term) touches or penetrates."""
+    qxy, qs, qeps = query
     n = qs[qs.shape[0] - 1]
-    x0, x1, y0, y1 = _bbox(qxy, n)
+    qbox = bbox(qxy, n)
+    x0, x1, y0, y1 = qbox
     cand = np.empty(n_ids, np.int64)
     e0 = tol if tol >= 0.0 else qeps
     d = e0 + (tol if tol >= 0.0 else emax)
-    m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d, x1 + d, y0 - d,
-                y1 + d, 0, n_ids, cand)
-    bx, ids, touch, rays, rord = _scratch(n + vmax)
+    m = _gather(grid, x0 - d, x1 + d, y0 - d, y1 + d, 0, n_ids, cand)
+    scratch = state_scratch(n + vmax)
     buf = np.empty(lmax + 1, np.int64)
     out_ids = np.empty(m, np.int64)
     out_st = np.empty(m, np.int8)
     k = 0
     for t in range(m):
-        j = cand[t]
-        e = tol if tol >= 0.0 else max(qeps, eps[j])
-        if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
-            continue
-        yb, sb = _view(xy, ls, lo, nl, j, buf)
-        s = _state_in(qxy, qs, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+        s = _state_against(qxy, qs, qbox, qeps, cand[t], bodies, tol, buf, scratch)
         if s > 0:
-            out_ids[k] = j
+            out_ids[k] = cand[t]
             out_st[k] = s
             k += 1
     order = np.argsort(out_ids[:k])
@@ -379,38 +420,59 @@ def query_states(qxy, qs, qeps, keys, heads, nxt, level, lvl_count, levels, orig
 
 
 @njit(cache=True, nogil=True)
-def query_container(qxy, qs, qeps, tol, hxy, hls, hlo, hnl, cbox, ceps):
-    """Container state of one placed shape (see :func:`_container_state`)."""
+def query_container(query, tol, hazards):
+    """Container state of one placed shape ``query`` = ``(qxy, qs, qeps)`` (see
+    :func:`_container_state`)."""
+    qxy, qs, qeps = query
+    _, hls, hlo, hnl, _, ceps = hazards
     n = qs[qs.shape[0] - 1]
-    x0, x1, y0, y1 = _bbox(qxy, n)
     hmax = 0
     for h in range(hnl.shape[0]):
         hmax = max(hmax, hls[hlo[h] + hnl[h]] - hls[hlo[h]])
-    bx, ids, touch, rays, rord = _scratch(n + hmax)
+    scratch = state_scratch(n + hmax)
     hb = np.empty(hnl.max() + 1, np.int64)
     e = tol if tol >= 0.0 else max(qeps, ceps)
-    return _container_state(qxy, qs, x0, x1, y0, y1, e, hxy, hls, hlo, hnl, cbox, hb, bx, ids,
-                            touch, rays, rord)
+    return _container_state(qxy, qs, bbox(qxy, n), e, hazards, hb, scratch)
 
 
 @njit(cache=True, nogil=True)
-def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
-                 level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax,
-                 lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, p0, p1, out):
+def _query_range(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out):
+    """:func:`query_many` for the poses ``p0:p1``, into ``out``: the buffers, then
+    :func:`_query_into`."""
+    ss = shape[1]
+    n_ids, vmax, lmax, hmax = settings[4], settings[5], settings[6], settings[8]
+    hnl = hazards[3]
     n = ss[ss.shape[0] - 1]
-    qxy = np.empty((n, 2))
-    cand = np.empty(n_ids, np.int64)
-    bx, ids, touch, rays, rord = _scratch(n + max(vmax, hmax))
-    buf = np.empty(lmax + 1, np.int64)
-    hb = np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64)
+    buffers = (np.empty((n, 2)), np.empty(n_ids, np.int64), state_scratch(n + max(vmax, hmax)),
+               np.empty(lmax + 1, np.int64),
+               np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64))
+    _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers)
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): per placement and
+# candidate body it reads the records' arrays and makes views of the body, and their
+# atomic reference counts cost as much as the test of a separate pair. Nothing in it may
+# allocate: the buffers are passed in.
+@njit(cache=True, nogil=True, _nrt=False)
+def _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers):
+    """The loop of :func:`_query_range` with its ``buffers``: ``(qxy, cand, scratch, buf,
+    hbuf)``, the placed shape, the grid's candidates, the state kernel's scratch and the
+    loop starts of a body and of a hazard."""
+    sxy, ss, cx, cy = shape
+    px, py, angles = poses
+    rel, ulp_factor, tol, emax, n_ids, _, _, has_container, _ = settings
+    cbox, ceps = hazards[4], hazards[5]
+    qxy, cand, scratch, buf, hb = buffers
+    n = ss[ss.shape[0] - 1]
     for p in range(p0, p1):
         place(sxy, cx, cy, px[p], py[p], angles[p], qxy)
-        x0, x1, y0, y1 = _bbox(qxy, n)
+        qbox = bbox(qxy, n)
+        x0, x1, y0, y1 = qbox
         mag = max(max(-x0, x1), max(-y0, y1))
         qeps = max(rel * max(x1 - x0, y1 - y0), ulp_factor * mag)
         worst = 0
         ec = tol if tol >= 0.0 else max(qeps, ceps)
-        if has_container and _off_box(x0, x1, y0, y1, ec, cbox):
+        if has_container and _off_box(qbox, ec, cbox):
             worst = 2
         # The bodies before the container's hazards: in a dense layout most placements
         # penetrate a body, and then the hazards (a state kernel call) are not needed.
@@ -421,45 +483,37 @@ def _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, he
                 m = scan.shape[0]
                 src = scan
             else:
-                m = _gather(keys, heads, nxt, level, lvl_count, levels, origin, x0 - d,
-                            x1 + d, y0 - d, y1 + d, 0, n_ids, cand)
+                m = _gather(grid, x0 - d, x1 + d, y0 - d, y1 + d, 0, n_ids, cand)
                 src = cand
             for t in range(m):
-                j = src[t]
-                e = tol if tol >= 0.0 else max(qeps, eps[j])
-                if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
-                    continue
-                yb, sb = _view(xy, ls, lo, nl, j, buf)
-                s = _state_in(qxy, ss, 1.0, yb, sb, 1.0, e, bx, ids, touch, rays, rord)
+                s = _state_against(qxy, ss, qbox, qeps, src[t], bodies, tol, buf, scratch)
                 if s > worst:
                     worst = s
                     if worst == 2:
                         break
         if has_container and worst < 2:
-            worst = max(worst, _hazard_state(qxy, ss, ec, hxy, hls, hlo, hnl, hb, bx, ids,
-                                             touch, rays, rord))
+            worst = max(worst, _hazard_state(qxy, ss, ec, hazards, hb, scratch))
         out[p] = worst
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def query_many(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt, level,
-               lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids, vmax, lmax,
-               has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, chunks):
-    """Worst state (int8) of the shape (sxy, ss) placed at each (px[p], py[p], angles[p])
-    over every body and the container (outside counts as 2); ``chunks`` = 1: serial.
-    ``scan``: the live bodies, to be tested box by box instead of through the grid (a
-    few bodies), or empty (use the grid)."""
-    p_count = px.shape[0]
+def query_many(shape, poses, grid, bodies, hazards, settings, scan, chunks):
+    """Worst state (int8) of ``shape`` = ``(sxy, ss, cx, cy)`` (its packed loops and the
+    point it turns about) placed at each of ``poses`` = ``(px, py, angles)`` over every
+    body and the container (outside counts as 2); ``chunks`` = 1: serial.
+
+    ``settings`` = ``(rel, ulp_factor, tol, emax, n_ids, vmax, lmax, has_container,
+    hmax)``: the default-tolerance rule (its relative and float-spacing factors), the
+    tolerance (< 0: each pair's default), the largest body term, the store's sizes
+    (ids, most vertices, most loops of a body), whether ``hazards`` is a container, and
+    the most vertices of a hazard. ``scan``: the live bodies, to be tested box by box
+    instead of through the grid (a few bodies), or empty (use the grid)."""
+    p_count = poses[0].shape[0]
     out = np.empty(p_count, np.int8)
     if chunks == 1:
-        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
-                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan, 0,
-                     p_count, out)
+        _query_range(shape, poses, grid, bodies, hazards, settings, scan, 0, p_count, out)
         return out
     for c in prange(chunks):
-        _query_range(sxy, ss, cx, cy, px, py, angles, rel, ulp_factor, tol, keys, heads, nxt,
-                     level, lvl_count, levels, origin, xy, ls, lo, nl, box, eps, emax, n_ids,
-                     vmax, lmax, has_container, hxy, hls, hlo, hnl, cbox, ceps, hmax, scan,
+        _query_range(shape, poses, grid, bodies, hazards, settings, scan,
                      p_count * c // chunks, p_count * (c + 1) // chunks, out)
     return out

@@ -27,16 +27,19 @@ from numba import njit, prange
 
 from .advance import edge_table
 from .contact_geometry import geometry_buffers, pair_geometry_into
-from .impact import _eps_at, _placed_state, exact_query, place, work_floats
-from .relation import _scratch_views, scratch_floats
+from .impact import exact_query, state_at, tolerance_at, work_floats
+from .packs import scratch_floats, state_scratch_views, view
 
 
 @njit(cache=True, nogil=True)
-def frame_tables(bxy, ls, lo, nl, cen, bodies, tint, tflt, tio, tfo):
-    """Build the circle tree of each body of ``bodies`` about its base rows (``bxy``
-    relative to ``cen``), into ``tint`` (``nxt`` then ``links``) from ``tio[b]`` and
-    ``tflt`` (``circles``) from ``tfo[b]``, offsets set by the caller (n vertices: n +
-    3 (2n − 1) ints, 4 (2n − 1) floats)."""
+def frame_tables(base, bodies, tables):
+    """Build the circle tree of each body of ``bodies`` about its base rows (``base`` =
+    ``(bxy, ls, lo, nl, cen)``: the rows as added, packed as the World's, and each
+    body's centroid) into ``tables`` = ``(tint, tflt, tio, tfo)``: ``tint`` (``nxt``
+    then ``links``) from ``tio[b]`` and ``tflt`` (``circles``) from ``tfo[b]``, offsets
+    set by the caller (n vertices: n + 3 (2n − 1) ints, 4 (2n − 1) floats)."""
+    bxy, ls, lo, nl, cen = base
+    tint, tflt, tio, tfo = tables
     for k in range(bodies.shape[0]):
         b = bodies[k]
         f = ls[lo[b]]
@@ -61,9 +64,14 @@ def frame_tables(bxy, ls, lo, nl, cen, bodies, tint, tflt, tio, tfo):
 
 
 @njit(cache=True, nogil=True)
-def _frame(b, turn, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, r, circles, r_len, st):
-    """Body b in its frame turned by ``turn``: its rows ``r`` and circles (written into
-    the given scratch), its starts and tables; returns ``(r, starts, table)``."""
+def _frame(b, turn, base, tables, scratch):
+    """Body b in its frame turned by ``turn``: its rows and circles written into
+    ``scratch`` = ``(r, circles, r_len, st)``; returns ``(r, starts, table)``, the
+    body and its :func:`polycontact._kernels.advance.edge_table` as
+    :func:`polycontact._kernels.impact.exact_query` takes them."""
+    bxy, ls, lo, nl, cen = base
+    tint, tflt, tio, tfo = tables
+    r, circles, r_len, st = scratch
     f = ls[lo[b]]
     n = ls[lo[b] + nl[b]] - f
     m = 2 * n - 1
@@ -92,25 +100,18 @@ def _frame(b, turn, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, r, circles, r_le
     for q in range(nl[b] + 1):
         st[q] = ls[lo[b] + q] - f
     io = tio[b]
-    links = tint[io + n:io + n + 3 * m].reshape((m, 3))
+    links = view(tint, io + n, m, 3, np.int64)
     return r[:n], st[:nl[b] + 1], (tint[io:io + n], links, circles[:m], r_len[:n])
 
 
 @njit(cache=True, nogil=True)
-def _frames_of(a, ta, b, tb, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, scratch):
-    """:func:`_frame` of bodies a and b (turned by ``ta``, ``tb``) into the two halves
-    of ``scratch``."""
-    ra, rb, ca, cb, la, lb, sta, stb = scratch
-    fa = _frame(a, ta, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, ra, ca, la, sta)
-    fb = _frame(b, tb, bxy, ls, lo, nl, cen, tint, tflt, tio, tfo, rb, cb, lb, stb)
-    return fa, fb
-
-
-@njit(cache=True, nogil=True)
 def _frame_scratch(vmax, lmax):
-    return (np.empty((vmax, 2)), np.empty((vmax, 2)), np.empty((2 * vmax, 4)),
-            np.empty((2 * vmax, 4)), np.empty(vmax), np.empty(vmax),
-            np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+    """Scratch of :func:`_frame` for two bodies of up to ``vmax`` vertices and ``lmax``
+    loops: one record for each."""
+    return ((np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
+             np.empty(lmax + 1, np.int64)),
+            (np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
+             np.empty(lmax + 1, np.int64)))
 
 
 #: Units of 2**-52 of the terms of the centres' paths allowed for the rounding of
@@ -147,28 +148,30 @@ def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
 
 
 @njit(cache=True, nogil=True)
-def _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
-                  tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
-                  max_iter, k0, k1, out):
+def _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, k0, k1, out):
+    """:func:`sweep_search` for the pairs ``k0:k1``, into ``out``."""
+    ids, pos, ang, rad, extent, motion = movers
+    t_max, inflate, time_tol, rel, ulps, resolution, max_iter = settings
     code, t_hi, t_contact, state = out
-    fs = _frame_scratch(vmax, lmax)
+    fa, fb = _frame_scratch(vmax, lmax)
     work = np.empty(work_floats(2 * vmax))
     for k in range(k0, k1):
         a = ids[pi[k]]
         b = ids[pj[k]]
-        if _circles_apart(pos[a], motion[pi[k]], rad[a], pos[b], motion[pj[k]], rad[b], t_max,
-                          inflate):
+        ma = motion[pi[k]]
+        mb = motion[pj[k]]
+        if _circles_apart(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate):
             code[k] = 0
             t_hi[k] = -1.0
             t_contact[k] = -1.0
             state[k] = 0
             continue
-        (r1, s1, e1), (r2, s2, e2) = _frames_of(a, ang[a], b, ang[b], bxy, ls, lo, nl, cen,
-                                                 tint, tflt, tio, tfo, fs)
-        got = exact_query(r1, s1, pos[a], motion[pi[k]], rad[a], e1, r2, s2, pos[b],
-                          motion[pj[k]], rad[b], e2, t_max, inflate, time_tol,
-                          rel * max(extent[a], extent[b]), ulps,
-                          resolution * (rad[a] + rad[b]), max_iter, work)
+        r1, s1, e1 = _frame(a, ang[a], base, tables, fa)
+        r2, s2, e2 = _frame(b, ang[b], base, tables, fb)
+        query = (t_max, inflate, time_tol, rel * max(extent[a], extent[b]), ulps,
+                 resolution * (rad[a] + rad[b]), max_iter, 0)
+        got = exact_query((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
+                          query, work)
         c = got[1]
         code[k] = c
         t_hi[k] = got[2]
@@ -180,53 +183,58 @@ def _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, moti
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def sweep_search(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint, tflt,
-                 tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps, resolution,
-                 max_iter, chunks):
+def sweep_search(pi, pj, movers, base, tables, settings, vmax, lmax, chunks):
     """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
-    ``ids[pj[k]]``), the bodies moving with the rows of ``motion`` (``[vx, vy, ax, ay,
-    ω, α]``, indexed like ``ids``) over [0, ``t_max``], in parallel chunks (``chunks``
-    = 1: serial). Returns ``(code, t_hi, t_contact, state)``: the search's status code
-    and penetration time (as ``exact_query``), the first contact time (0 when
-    penetrating at the start; the time reached by a search without a verdict; -1 when
-    they never touch), and 2 when they penetrate within the step, 1 when they only
-    touch, 0 when they never do."""
+    ``ids[pj[k]]``) over [0, ``t_max``], in parallel chunks (``chunks`` = 1: serial).
+
+    ``movers`` = ``(ids, pos, ang, rad, extent, motion)``: the World's ids of the
+    moving bodies, and by id each body's position (its centroid), angle, bounding
+    radius and box extent; ``motion`` holds the rows ``[vx, vy, ax, ay, ω, α]``,
+    indexed like ``ids``. ``base``, ``tables``: as for :func:`frame_tables`.
+    ``settings`` = ``(t_max, inflate, time_tol, rel, ulps, resolution, max_iter)``:
+    those of :func:`polycontact._kernels.impact.exact_query`, with the relative terms
+    of the distance tolerance and of the contact resolution (times each pair's larger
+    extent, and its sum of radii). ``vmax``, ``lmax``: the most vertices and loops of a
+    body.
+
+    Returns ``(code, t_hi, t_contact, state)``: the search's status code and
+    penetration time (as ``exact_query``), the first contact time (0 when penetrating
+    at the start; the time reached by a search without a verdict; -1 when they never
+    touch), and 2 when they penetrate within the step, 1 when they only touch, 0 when
+    they never do."""
     n = pi.shape[0]
     out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8))
     if chunks == 1:
-        _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
-                      tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
-                      resolution, max_iter, 0, n, out)
+        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, 0, n, out)
         return out
     for c in prange(chunks):
-        _search_range(pi, pj, ids, bxy, ls, lo, nl, cen, pos, ang, rad, extent, motion, tint,
-                      tflt, tio, tfo, vmax, lmax, t_max, inflate, time_tol, rel, ulps,
-                      resolution, max_iter, n * c // chunks, n * (c + 1) // chunks, out)
+        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, n * c // chunks,
+                      n * (c + 1) // chunks, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel, ma,
-                 mb, tint, tflt, tio, tfo, vmax, lmax, ulps, k0, k1, point, normal):
-    fs = _frame_scratch(vmax, lmax)
+def _event_range(events, base, tables, vmax, lmax, ulps, k0, k1, point, normal):
+    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``."""
+    pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb = events
+    fa, fb = _frame_scratch(vmax, lmax)
     xa = np.empty((vmax, 2))
     xb = np.empty((vmax, 2))
-    scratch = _scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
+    scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
     buffers = geometry_buffers(vmax)
     m = k1 - k0
     dist = np.empty(m)
     gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
             np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
     for k in range(k0, k1):
-        (r1, s1, _), (r2, s2, _) = _frames_of(pa[k], ta[k], pb[k], tb[k], bxy, ls, lo, nl,
-                                               cen, tint, tflt, tio, tfo, fs)
+        r1, s1, _ = _frame(pa[k], ta[k], base, tables, fa)
+        r2, s2, _ = _frame(pb[k], tb[k], base, tables, fb)
         t = times[k]
         ya = xa[:r1.shape[0]]
         yb = xb[:r2.shape[0]]
-        place(r1, ca[k], ma[k], t, ya)
-        place(r2, cb[k], mb[k], t, yb)
-        eps = _eps_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
-        now = _placed_state(ya, s1, yb, s2, eps, scratch)
+        eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
+        now = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t, eps,
+                       (ya, yb, scratch))
         pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
         if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
             normal[k, 0] = np.nan
@@ -234,23 +242,22 @@ def _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, ep
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def event_geometry(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel, ma,
-                   mb, tint, tflt, tio, tfo, vmax, lmax, ulps, chunks):
-    """The contact point and normal of bodies ``pa[k]`` and ``pb[k]`` at ``times[k]``,
-    each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]`` (``tb[k]``)
-    with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact search's
-    tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``) and described by
-    :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN normals where
-    the depth is left undecided. In parallel chunks."""
-    n = pa.shape[0]
+def event_geometry(events, base, tables, vmax, lmax, ulps, chunks):
+    """The contact point and normal of each event of ``events`` = ``(pa, pb, times, ca,
+    cb, ta, tb, la, lb, eps_rel, ma, mb)``: bodies ``pa[k]`` and ``pb[k]`` at
+    ``times[k]``, each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]``
+    (``tb[k]``) with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact
+    search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``) and
+    described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
+    normals where the depth is left undecided. ``base``, ``tables``: as for
+    :func:`frame_tables`. In parallel chunks."""
+    n = events[0].shape[0]
     point = np.full((n, 2), np.nan)
     normal = np.full((n, 2), np.nan)
     if chunks == 1:
-        _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel,
-                     ma, mb, tint, tflt, tio, tfo, vmax, lmax, ulps, 0, n, point, normal)
+        _event_range(events, base, tables, vmax, lmax, ulps, 0, n, point, normal)
         return point, normal
     for c in prange(chunks):
-        _event_range(pa, pb, times, bxy, ls, lo, nl, cen, ca, cb, ta, tb, la, lb, eps_rel,
-                     ma, mb, tint, tflt, tio, tfo, vmax, lmax, ulps, n * c // chunks,
+        _event_range(events, base, tables, vmax, lmax, ulps, n * c // chunks,
                      n * (c + 1) // chunks, point, normal)
     return point, normal

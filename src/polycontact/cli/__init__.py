@@ -20,7 +20,7 @@ import sys
 
 from .. import __version__
 from ..errors import PolycontactError
-from ._io import CommandError
+from ._errors import CommandError
 
 _SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "contacts",
                 "warmup")

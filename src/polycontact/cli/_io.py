@@ -7,12 +7,10 @@ from pathlib import Path
 from typing import Any
 
 from ..bodies import as_shape
-from ..errors import InvalidShapeError, PolycontactError
+from ..errors import InvalidShapeError
 from ..shape import Shape
-
-
-class CommandError(PolycontactError):
-    """A problem with what the user gave the command (file, option); exit status 2."""
+from ._errors import CommandError
+from ._progress import announced
 
 
 #: The forms of a body file, as messages and help texts name them.
@@ -41,8 +39,6 @@ def read_shape(path: str, *, repair: bool = False) -> Shape:
             data = raw.decode("utf-8")
         except UnicodeDecodeError:
             pass
-    from ._progress import announced
-
     try:
         with announced(f"reading {path} ({len(raw):,} bytes)"):
             return as_shape(data, str(path), repair=repair)

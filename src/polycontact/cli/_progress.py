@@ -2,7 +2,7 @@
 stderr, and how long it took when it ends (never on stdout, so ``--json`` stays
 parseable).
 
-The delay is :data:`NOTICE_AFTER` seconds, or the environment variable
+The delay is :data:`polycontact.limits.NOTICE_AFTER` seconds, or the environment variable
 ``POLYCONTACT_NOTICE_AFTER`` (a number of seconds; ``inf`` silences the notices, ``0``
 prints them at once, before the step).
 
@@ -20,19 +20,18 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from ._io import CommandError
+from ..limits import NOTICE_AFTER
+from ._errors import CommandError
 
-__all__ = ["NOTICE_AFTER", "announced", "notice_delay"]
-
-#: Seconds a step may run before it says so on stderr.
-NOTICE_AFTER = 3.0
+__all__ = ["announced", "notice_delay"]
 
 _VARIABLE = "POLYCONTACT_NOTICE_AFTER"
 
 
 def notice_delay() -> float:
     """The delay before a notice: ``POLYCONTACT_NOTICE_AFTER`` if set, else
-    :data:`NOTICE_AFTER`; a :class:`CommandError` if the variable is not a number >= 0."""
+    :data:`polycontact.limits.NOTICE_AFTER`; a :class:`CommandError` if the variable is
+    not a number >= 0."""
     text = os.environ.get(_VARIABLE)
     if text is None:
         return NOTICE_AFTER

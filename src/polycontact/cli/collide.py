@@ -11,8 +11,9 @@ from typing import Any
 from .. import datasets
 from .._json import load_json
 from ..errors import InvalidSceneError
-from ._io import (CommandError, index_text, integer_at_least, plotting, positive_number,
-                  save_figure)
+from ..limits import SAMPLES, TIME_TOLERANCE
+from ._errors import CommandError
+from ._io import index_text, integer_at_least, plotting, positive_number, save_figure
 from ._progress import announced
 
 #: What a scene is, in one line (for the message about a body file given instead).
@@ -23,7 +24,7 @@ SCENE_IN_A_LINE = ('a JSON object {"t_max": ..., "bodies": [...]}: two or more b
 SCENE_FORMAT = """\
 scene format (JSON; lengths in any unit, times in any unit, used consistently):
   {"t_max": 20,                   end of the time window searched, from t = 0
-   "time_tolerance": 1e-4,        optional: accuracy of the time (default 1e-4)
+   "time_tolerance": 1e-4,        optional: accuracy of the time (default %g)
    "description": "...",          optional
    "bodies": [                    two or more, each moving rigidly about its
                                   area centroid:
@@ -45,7 +46,7 @@ example:
     {"name": "b", "vertices": [[3, 0], [4, 0], [4, 1], [3, 1]], "velocity": [-1, 0]}]}
   answers "collision at t = 1.00..." (each closes half the gap of 2 at speed 1). The
   paper's case 1 ships as the scene named paper-case-1 (examples/paper-case-1.json).
-"""
+""" % TIME_TOLERANCE
 
 
 def add_parser(subparsers: Any) -> None:
@@ -63,10 +64,10 @@ def add_parser(subparsers: Any) -> None:
                    + ", ".join(datasets.names("scenes")))
     p.add_argument("--method", choices=("exact", "sampled"), default="exact",
                    help="exact: continuous, never tunnels (default); sampled: the paper's")
-    p.add_argument("--samples", type=integer_at_least(2), default=10,
-                   help="time points per round of the sampled method (default 10)")
+    p.add_argument("--samples", type=integer_at_least(2), default=SAMPLES,
+                   help=f"time points per round of the sampled method (default {SAMPLES})")
     p.add_argument("--time-tolerance", type=positive_number, default=None,
-                   help="accuracy of the time (default: the scene's, else 1e-4)")
+                   help=f"accuracy of the time (default: the scene's, else {TIME_TOLERANCE:g})")
     p.add_argument("--repair", action="store_true",
                    help="repair invalid polygons with shapely.make_valid and say so")
     p.add_argument("--all", action="store_true",

@@ -11,7 +11,8 @@ from typing import Any
 from .. import datasets
 from .._json import load_json
 from ..errors import InvalidShapeError
-from ._io import CommandError, non_negative_number, plotting, save_figure
+from ._errors import CommandError
+from ._io import non_negative_number, plotting, save_figure
 from ._progress import announced
 
 

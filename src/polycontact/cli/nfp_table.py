@@ -9,7 +9,8 @@ import sys
 from typing import Any
 
 from .. import datasets
-from ._io import CommandError, integer_at_least
+from ._errors import CommandError
+from ._io import integer_at_least
 
 
 def _angle(text: str) -> float:

@@ -8,7 +8,10 @@ outside the data.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..shape import Shape
 
 #: Coordinates are in whatever length unit the caller used (consistent throughout).
 LENGTH_LABEL = "(length units)"
@@ -61,6 +64,12 @@ def label_axes(ax: Any) -> None:
     ax.set_xlabel(f"x {LENGTH_LABEL}")
     ax.set_ylabel(f"y {LENGTH_LABEL}")
     ax.set_aspect("equal")
+
+
+def draw_shape(ax: Any, shape: Shape, color: str, alpha: float, label: str | None) -> None:
+    """Fill every loop of ``shape`` (holes left open) in ``color`` on ``ax``."""
+    ax.add_patch(shape_patch(shape, facecolor=color, edgecolor=color, alpha=alpha, lw=1.0,
+                             label=label))
 
 
 def legend_outside(ax: Any, handles: Any = None) -> Any:

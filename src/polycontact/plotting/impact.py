@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..impact import Impact
 from ..motion import Motion
 from ..bodies import BodyLike, as_shape
-from ..shape import Shape
-from ._style import label_axes, legend_outside, new_axes, shape_patch
+from ._style import draw_shape, label_axes, legend_outside, new_axes
+
+if TYPE_CHECKING:  # (impact.py imports this module to plot: no cycle at run time)
+    from ..impact import Impact
 
 __all__ = ["plot_impact"]
 
@@ -20,11 +21,6 @@ def _event_time(impact: Impact) -> float:
         if t is not None:
             return t
     return impact.searched_to
-
-
-def _draw(ax: Any, shape: Shape, color: str, alpha: float, label: str | None) -> None:
-    ax.add_patch(shape_patch(shape, facecolor=color, edgecolor=color, alpha=alpha, lw=1.0,
-                             label=label))
 
 
 def plot_impact(
@@ -63,8 +59,8 @@ def plot_impact(
     ts = np.linspace(0.0, t_event, 200)
     for shape, motion, color, name in ((a, motion_a, "tab:red", names[0]),
                                        (b, motion_b, "tab:blue", names[1])):
-        _draw(ax, shape, color, 0.15, f"{name} at t = 0")
-        _draw(ax, shape.at(motion, t_event), color, 0.5, f"{name} at t = {t_event:.6g}")
+        draw_shape(ax, shape, color, 0.15, f"{name} at t = 0")
+        draw_shape(ax, shape.at(motion, t_event), color, 0.5, f"{name} at t = {t_event:.6g}")
         path = np.array([shape.centroid + motion.pose(t)[0] for t in ts])
         ax.plot(path[:, 0], path[:, 1], "--", color=color, lw=1.0,
                 label=f"{name}'s centroid path")

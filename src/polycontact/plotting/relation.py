@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._style import label_axes, legend_outside, new_axes
+from ._style import draw_shape, label_axes, legend_outside, new_axes
 
 __all__ = ["plot_relation"]
 
@@ -35,11 +35,9 @@ def plot_relation(relation: Any, ax: Any = None) -> Any:
         ax = new_axes((8, 6))
     from matplotlib.lines import Line2D
 
-    from .impact import _draw
-
     a, b = relation.shapes
-    _draw(ax, a, "tab:red", 0.45, "A")
-    _draw(ax, b, "tab:blue", 0.45, "B")
+    draw_shape(ax, a, "tab:red", 0.45, "A")
+    draw_shape(ax, b, "tab:blue", 0.45, "B")
     point, normal = relation.point, relation.normal
     if point is not None:
         ax.plot(*point, "*", color="gold", markeredgecolor="black", ms=13, zorder=5,

@@ -1,5 +1,6 @@
-"""Kernels' memory: views of a flat buffer as arrays of another shape or type, and
-scratch on the stack, with no allocation and no call into Numba's helpers.
+"""Kernels' memory: views of a flat buffer as arrays of another shape or type, scratch on
+the stack, the state kernel's scratch, and a shape's kernel pack, with no allocation and
+no call into Numba's helpers.
 
 A Numba ``reshape`` calls a helper of Numba's C library and ``view`` checks its
 arguments at run time: the dozen views that the state kernel of two 12-gons takes of
@@ -29,7 +30,7 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from numba import types
+from numba import njit, types
 from numba.core import cgutils, config
 from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
@@ -135,3 +136,75 @@ if config.DISABLE_JIT:  # the kernels run as Python: the same views by NumPy sli
     view, vector, stack_floats = _view_py, _vector_py, _stack_floats_py
 else:
     view, vector, stack_floats = _view, _vector, _stack_floats
+
+
+@njit(cache=True, nogil=True)
+def scratch_floats(size):
+    """Length of a float64 buffer that holds the scratch of the state kernel for pairs
+    of up to ``size`` vertices in all (see
+    :func:`polycontact._kernels.relation.relate_shapes_into`).
+
+    >>> scratch_floats(24)
+    554
+    """
+    r = size + 1
+    return 22 * r + (size + 8) // 8
+
+
+@njit(cache=True, nogil=True)
+def state_scratch(size):
+    """Scratch buffers for :func:`polycontact._kernels.relation.state_in` for up to
+    ``size`` vertices in all: edge boxes, edge ids, touch flags, and the rays at one
+    touch point with their order (views of one allocation)."""
+    return state_scratch_views(np.empty(scratch_floats(size)), size)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def state_scratch_views(buf, size):
+    """:func:`state_scratch`'s five buffers as views of ``buf`` (of at least
+    ``scratch_floats(size)`` floats): edge boxes (r, 4), edge ids (r, 4) int64, touch
+    flags, rays (2 r, 6), ray order (2 r) int64, with r = size + 1."""
+    r = size + 1
+    return (
+        view(buf, 0, r, 4, np.float64),
+        view(buf, 16 * r, r, 4, np.int64),
+        vector(buf, 22 * r, 8 * (scratch_floats(size) - 22 * r), np.bool_),
+        view(buf, 4 * r, 2 * r, 6, np.float64),
+        vector(buf, 20 * r, 2 * r, np.int64),
+    )
+
+
+#: Layout of a shape's kernel pack (``Shape._kernel``, built once per shape by
+#: :func:`polycontact.shape._kernel_pack`): one ``bytes`` object holding, as float64,
+#: the loop count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the shape's
+#: default-tolerance term (``Shape._tolerance``: the kernel takes the larger of the two
+#: shapes', so the caller reads no float object), the loop starts (int64 bit patterns,
+#: L + 1 of them) and then the packed coordinates row by row. A
+#: ``bytes`` object holds its data in itself: unboxing it reads one object, where an
+#: ndarray's header, shape and data are three allocations (0.26 against 0.43-0.52 us per
+#: call of two packs when other code has evicted the caches; the same when warm).
+PACK_HEAD = 6
+
+
+@njit(cache=True, nogil=True, inline="always")
+def unpack_shape(pack):
+    """``(xy, starts, box, tolerance)`` of a shape's kernel pack (views: nothing is
+    allocated), the box as ``(xmin, xmax, ymin, ymax)``, the shape's default-tolerance
+    term."""
+    pack = vector(pack, 0, len(pack) // 8, np.float64)
+    nl = int(pack[0])
+    starts = vector(pack, PACK_HEAD, nl + 1, np.int64)
+    n = starts[nl]
+    xy = view(pack, PACK_HEAD + nl + 1, n, 2, np.float64)
+    return xy, starts, (pack[1], pack[3], pack[2], pack[4]), pack[5]
+
+
+#: Vertices (both bodies together) of the pairs
+#: :func:`polycontact._kernels.relation.relate_shapes_into` classifies with its scratch
+#: on the stack (45 kB); larger pairs take
+#: :func:`polycontact._kernels.relation.relate_state`, whose allocation costs little
+#: beside their test.
+STACK_VERTICES = 256
+
+#: Floats of that stack scratch: :func:`scratch_floats` of :data:`STACK_VERTICES`.
+STACK_FLOATS = getattr(scratch_floats, "py_func", scratch_floats)(STACK_VERTICES)
