@@ -154,3 +154,17 @@ def test_the_example_that_needs_repair_says_so_in_its_description():
     description = json.loads((EXAMPLES / "paper-case-2.json").read_text())["description"]
     assert description.startswith("Run with --repair: ")
     assert "not simple" in description and "make_valid" in description
+
+
+@pytest.mark.parametrize("command", [["collide", str(EXAMPLES / "body-ell.json")],
+                                     ["classify", "missing-a.json", FRAME],
+                                     ["nfp", FRAME, "missing-b.json"]])
+def test_a_wrong_input_is_refused_before_any_compiling(monkeypatch, capsys, command):
+    from polycontact import compiling
+
+    compiled = []
+    monkeypatch.setattr(compiling, "is_warm", lambda families: False)
+    monkeypatch.setattr(compiling, "warmup", lambda *a, **k: compiled.append(a))
+    assert main(command) == 2
+    assert "error" in _error(capsys)
+    assert compiled == []

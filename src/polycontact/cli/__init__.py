@@ -8,8 +8,10 @@ the ``ValueError`` or ``TypeError`` with which the library refuses an argument: 
 argument comes from the user's files and options) and printed as one line on stderr
 with exit status 2, never as a traceback.
 
-Before a command whose kernels are not compiled yet (a first run), a notice and one line
-per kernel family go to stderr, never stdout, so ``--json`` output stays parseable.
+Once a command has read its input, and before it computes, kernels not compiled yet (a
+first run) are compiled with a notice and one line per kernel family on stderr, never
+stdout, so ``--json`` output stays parseable (:func:`._progress.compile_if_cold`); a
+wrong input is refused before any compiling.
 """
 
 from __future__ import annotations
@@ -25,15 +27,6 @@ from ._errors import CommandError
 _SUBCOMMANDS = ("classify", "entrance_block", "collide", "nfp", "nfp_table", "contacts",
                 "warmup")
 
-#: The kernel families (polycontact.compiling.FAMILIES) each command runs.
-_NEEDS = {
-    "classify": ("classification",),
-    "collide": ("classification", "time of impact", "many moving bodies"),
-    "entrance-block": ("classification", "entrance block"),
-    "nfp": ("no-fit polygon",),
-    "contacts": ("classification",),
-    "nfp-table": ("no-fit polygon",),
-}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -51,7 +44,6 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    _compile_if_cold(_NEEDS.get(args.command, ()))
     try:
         return int(args.func(args) or 0)
     except (CommandError, PolycontactError, ValueError, TypeError) as exc:
@@ -60,24 +52,6 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except BrokenPipeError:
         return 0
-
-
-def _compile_if_cold(families: tuple[str, ...]) -> None:
-    """Say on stderr that a first run compiles, and show each family as it compiles."""
-    if not families:
-        return
-    from ..compiling import cache_directory, is_warm, warmup
-    from .warmup import progress_line
-
-    if is_warm(families):
-        return
-    print(
-        "polycontact: compiling kernels, first run only, about a minute "
-        f"(cached in {cache_directory()})",
-        file=sys.stderr,
-        flush=True,
-    )
-    warmup(families, progress=progress_line)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from typing import Any
+
+from ._progress import progress_line
 
 
 def add_parser(subparsers: Any) -> None:
@@ -17,14 +18,6 @@ def add_parser(subparsers: Any) -> None:
         "lives in the per-user cache directory (NUMBA_CACHE_DIR overrides it).",
     )
     p.set_defaults(func=run, families=())
-
-
-def progress_line(family: str, k: int, n: int, seconds: float | None) -> None:
-    """One stderr line per stage of :func:`polycontact.compiling.warmup`."""
-    if seconds is None:
-        print(f"  [{k}/{n}] {family} ...", end="", file=sys.stderr, flush=True)
-    else:
-        print(f" {seconds:.1f} s", file=sys.stderr, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
