@@ -38,8 +38,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._checks import point as point_arg
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, default_tolerance, snap_grid
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]
@@ -304,7 +303,7 @@ class EntranceBlock:
 
 
 def entrance_block(
-    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, b: ShapeLike, reference: npt.ArrayLike | None = None, *,
     method: str = "swept"
 ) -> EntranceBlock:
     """The entrance block of A to B and its components (paper §2.3–2.4).

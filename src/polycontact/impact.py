@@ -31,8 +31,7 @@ from .broad_phase import (base_reach, check_motion, check_reach, check_t_max, in
                           reach_excess)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS,
                      RELATIVE_TOLERANCE, SAMPLES, TIME_TOLERANCE)
 from .tolerances import ROUNDING_FACTOR, check_range
@@ -308,9 +307,9 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
 
 
 def time_of_impact(
-    a: BodyLike,
+    a: ShapeLike,
     motion_a: Motion,
-    b: BodyLike,
+    b: ShapeLike,
     motion_b: Motion,
     *,
     t_max: float,
@@ -331,9 +330,9 @@ def time_of_impact(
 
     Parameters
     ----------
-    a, b : body
-        The bodies at t = 0, holes allowed, in any form :func:`polycontact.bodies.as_shape`
-        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, body mapping, WKT, WKB).
+    a, b : ShapeLike
+        The shapes at t = 0, holes allowed, in any form :func:`polycontact.shape.as_shape`
+        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, vertices mapping, WKT, WKB).
     motion_a, motion_b : Motion
         Their motions about their area centroids.
     t_max : float

@@ -51,11 +51,10 @@ import shapely.affinity
 from ._checks import finite_number
 from ._checks import point as point_arg
 from ._pieces import pieces_of_geometry, pieces_packed
-from .bodies import BodyLike, as_shape
 from .errors import InvalidShapeError, NfpTooLargeError
 from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR, MAX_SUM_VERTICES,
                      RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, snap_grid, tolerance_for
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
@@ -279,7 +278,7 @@ class NoFitPolygon:
 
 
 def no_fit_polygon(
-    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, b: ShapeLike, reference: npt.ArrayLike | None = None, *,
     tolerance: float | None = None
 ) -> NoFitPolygon:
     """No-fit polygon of ``a`` orbiting the fixed ``b``.
@@ -362,7 +361,7 @@ _set_dict = object.__setattr__
 
 
 def inner_fit_polygon(
-    a: BodyLike, container: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, container: ShapeLike, reference: npt.ArrayLike | None = None, *,
     tolerance: float | None = None
 ) -> Any:
     """Reference positions at which ``a`` lies inside ``container`` (touching allowed).

@@ -34,8 +34,7 @@ import numpy as np
 from ._checks import finite_number
 from ._dispatch import entry_point
 from .errors import InvalidShapeError
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,
@@ -508,7 +507,7 @@ _state_into: Callable[[bytes, bytes, float], int] = _bind_state_into
 _state_full: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], int] = (
     _bind_state_full)
 
-def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
+def classify(a: ShapeLike, b: ShapeLike, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
 
     Parameters
@@ -568,7 +567,7 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
     return _classify_other(a, b, tolerance)
 
 
-def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relation:
+def _classify_other(a: ShapeLike, b: ShapeLike, tolerance: float | None) -> Relation:
     """:func:`classify` of bodies that are not both Shapes (and its first call)."""
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     if (
@@ -817,7 +816,7 @@ def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[A
 
 
 def classify_many(
-    shapes_a: Sequence[BodyLike] | np.ndarray, shapes_b: Sequence[BodyLike] | np.ndarray, *,
+    shapes_a: Sequence[ShapeLike] | np.ndarray, shapes_b: Sequence[ShapeLike] | np.ndarray, *,
     tolerance: float | None = None
 ) -> RelationBatch:
     """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.

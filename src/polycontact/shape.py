@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import finite_number, is_real, point, real_array, shown
 from ._json import load_json
@@ -35,7 +36,7 @@ from .tolerances import (
     validation_tolerance,
 )
 
-__all__ = ["Shape"]
+__all__ = ["Shape", "ShapeLike", "GeoInterface", "as_shape", "SHAPE_FORMS"]
 
 ArrayLike = Any
 
@@ -86,38 +87,55 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
-def _whole_body(obj: Any) -> bool:
-    """Whether ``obj`` is a body in a form other than an array of vertices: a Shape, a
+def _whole_shape(obj: Any) -> bool:
+    """Whether ``obj`` is a shape in a form other than an array of vertices: a Shape, a
     Shapely geometry, anything with ``__geo_interface__``, a mapping, text or WKB."""
     return (isinstance(obj, (Shape, str, bytes, bytearray, memoryview, Mapping))
             or hasattr(obj, "__geo_interface__") or hasattr(obj, "geom_type"))
 
 
 def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
-    """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
-    through :func:`as_shape`; such a body carries its own holes."""
+    """The Shape of a shape given in a form other than an array (see
+    :func:`_whole_shape`), through :func:`as_shape`; such a form carries its own holes."""
     if len(list(holes)):
-        raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
+        raise TypeError(f"holes: a {type(obj).__name__} carries its own holes; pass "
                         "holes only with an array of vertices")
     return as_shape(obj, "vertices", repair=repair)
 
 
-#: The forms a body may take, as error messages list them.
-BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+#: The forms a shape may take, as error messages list them.
+SHAPE_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB"
 
-_BODY_KEYS = {"vertices", "holes", "name"}
+_MAPPING_KEYS = {"vertices", "holes", "name"}
 _HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
 
 
-def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
-    """``obj`` as a :class:`Shape`, whatever accepted form it takes (the forms
-    :mod:`polycontact.bodies` lists; offered to the package from there).
+def as_shape(obj: ShapeLike, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever form it is given in.
+
+    Everywhere polycontact takes a shape (the functions, :class:`Shape` itself,
+    ``classify_many``, worlds, scenes, the command line) it accepts the same forms:
+
+    - a :class:`Shape` (returned as it is);
+    - an array-like of shape (N, 2): the outer loop, closed or not, either orientation;
+    - a Shapely ``Polygon`` (or a ``MultiPolygon`` of exactly one part);
+    - anything with ``__geo_interface__`` (GeoPandas, other geometry libraries);
+    - a GeoJSON mapping: ``Polygon``, a ``MultiPolygon`` of one part, or a ``Feature``
+      holding one;
+    - a vertices mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
+      ``"name"`` is ignored), the form of the scene files' bodies;
+    - WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
+      above or of a list of vertices (``"[[0, 0], [1, 0], [0, 1]]"``), WKB bytes or hex
+      WKB text.
+
+    ``Shape(obj)`` takes every one of these forms too; ``as_shape`` names the argument
+    in its errors, which is what a function of your own wants.
 
     Parameters
     ----------
-    obj : body
-        One of the forms listed in :mod:`polycontact.bodies`.
-    what : str
+    obj : ShapeLike
+        One of the forms above.
+    what : str, default "shape"
         The argument's name, put at the start of every error message.
     repair : bool, default False
         Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
@@ -130,9 +148,27 @@ def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
     Raises
     ------
     TypeError
-        ``obj`` is of no accepted type.
+        ``obj`` is of no accepted type (the message names ``what``).
     InvalidShapeError
-        ``obj`` is of an accepted type but not a valid polygon.
+        ``obj`` is of an accepted type but not a valid polygon (a ``ValueError``).
+
+    Examples
+    --------
+    >>> import shapely
+    >>> forms = [
+    ...     [(0, 0), (1, 0), (1, 1), (0, 1)],
+    ...     shapely.box(0, 0, 1, 1),
+    ...     {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]},
+    ...     {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+    ...     "POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))",
+    ...     shapely.box(0, 0, 1, 1).wkb,
+    ... ]
+    >>> [as_shape(f).area for f in forms]
+    [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+    >>> as_shape(3, "a")
+    Traceback (most recent call last):
+    ...
+    TypeError: a: expected a shape (Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB), got int
     """
     if isinstance(obj, Shape):
         return obj
@@ -158,24 +194,24 @@ def _coerce(obj: Any, repair: bool) -> Shape:
         return _from_mapping(geo, repair)
     if isinstance(obj, (np.ndarray, list, tuple)):
         return Shape(obj, repair=repair)
-    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+    raise TypeError(f"expected a shape ({SHAPE_FORMS}), got {type(obj).__name__}")
 
 
 def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
     if "vertices" in data:
-        unknown = sorted(set(data) - _BODY_KEYS)
+        unknown = sorted(set(data) - _MAPPING_KEYS)
         if unknown:
             raise InvalidShapeError(
-                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
+                f"unknown key {unknown[0]!r} (a vertices mapping has 'vertices', 'holes', 'name')"
             )
         holes = data.get("holes", ())
         if holes is None or isinstance(holes, (str, bytes, Mapping)):
-            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+            raise InvalidShapeError("vertices mapping: 'holes' must be a list of rings")
         return Shape(data["vertices"], holes, repair=repair)
     if "type" in data:
         return Shape.from_geojson(dict(data), repair=repair)
     raise InvalidShapeError(
-        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        "expected a GeoJSON mapping (with 'type') or a vertices mapping (with 'vertices'), "
         f"got keys {sorted(map(str, data))}"
     )
 
@@ -183,7 +219,7 @@ def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
 def _from_text(text: str, repair: bool) -> Shape:
     stripped = text.strip()
     if not stripped:
-        raise InvalidShapeError("empty text: no body in it")
+        raise InvalidShapeError("empty text: no shape in it")
     if stripped.startswith(("{", "[")):
         try:
             data = load_json(text)
@@ -203,7 +239,7 @@ def _from_wkb(data: bytes) -> Any:
     import shapely
 
     if not data:
-        raise InvalidShapeError("empty WKB: no body in it")
+        raise InvalidShapeError("empty WKB: no shape in it")
     try:
         return shapely.from_wkb(data)
     except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
@@ -236,10 +272,10 @@ class Shape:
 
     Parameters
     ----------
-    vertices : array_like of shape (N, 2), or a whole body
-        The outer loop, closed or not, in either orientation. Or a body in any other
-        form polycontact takes (:mod:`polycontact.bodies`), holes included: a Shape, a
-        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or body
+    vertices : array_like of shape (N, 2), or a whole shape (ShapeLike)
+        The outer loop, closed or not, in either orientation. Or a shape in any other
+        form polycontact takes (:func:`as_shape`), holes included: a Shape, a
+        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or vertices
         mapping ``{"vertices": ..., "holes": ...}``, WKT or JSON text, WKB.
     holes : sequence of array_like of shape (M, 2), optional
         Hole loops, closed or not, in either orientation (None or empty: no holes).
@@ -262,7 +298,7 @@ class Shape:
         message then says which, how far apart, and the float spacing.
     TypeError
         Coordinates that are not real numbers (strings, booleans, complex numbers: the
-        message names the loop and the vertex), or ``holes`` with a body that carries
+        message names the loop and the vertex), or ``holes`` with a form that carries
         its own.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
@@ -300,7 +336,7 @@ class Shape:
     ) -> None:
         if holes is None:
             holes = ()
-        if _whole_body(vertices):
+        if _whole_shape(vertices):
             self._adopt(_other_form(vertices, holes, repair))
             return
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
@@ -381,7 +417,7 @@ class Shape:
         if not (a2 > 0.0 and extent > validation_tolerance(magnitude)):
             # (a rigid motion far from the origin rounded the body away)
             raise InvalidShapeError(
-                f"shape: coordinates up to {magnitude:g} cannot carry a body of size "
+                f"shape: coordinates up to {magnitude:g} cannot carry a shape of size "
                 f"{extent:g}: float64's spacing there ({validation_tolerance(magnitude):.3g}) "
                 "is not below it"
             )
@@ -775,6 +811,18 @@ def _input_maps(
                                "follow _clean_ring")
         maps.append(m)
     return frozen_ints(np.arange(len(maps))), frozen_ints(np.concatenate(maps))
+
+
+class GeoInterface(Protocol):
+    """Anything with ``__geo_interface__`` (the Python geo interface)."""
+
+    @property
+    def __geo_interface__(self) -> Mapping[str, Any]: ...
+
+
+#: The type of a shape argument: every form :func:`as_shape` takes (WKT and JSON text
+#: are ``str``, WKB ``bytes``; Shapely geometries have ``__geo_interface__``).
+ShapeLike = Union[Shape, GeoInterface, Mapping[str, Any], npt.ArrayLike]
 
 
 def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:

@@ -61,7 +61,7 @@ def _progress(entries: list[Any], progress: bool) -> Any:
 def read_layout(path: str, progress: bool = False) -> tuple[Any, list[Any], list[str]]:
     """(container Shape or None, bodies, names) of a layout file; errors name the file
     and the entry. ``progress``: a bar on stderr while a long layout is read."""
-    from ..bodies import as_shape
+    from ..shape import as_shape
 
     try:
         data = load_json(Path(path).read_bytes())

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..motion import Motion
-from ..bodies import BodyLike, as_shape
+from ..shape import ShapeLike, as_shape
 from ._style import draw_shape, label_axes, legend_outside, new_axes
 
 if TYPE_CHECKING:  # (impact.py imports this module to plot: no cycle at run time)
@@ -24,9 +24,9 @@ def _event_time(impact: Impact) -> float:
 
 
 def plot_impact(
-    a: BodyLike,
+    a: ShapeLike,
     motion_a: Motion,
-    b: BodyLike,
+    b: ShapeLike,
     motion_b: Motion,
     impact: Impact,
     *,
