@@ -32,7 +32,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple, cast
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -40,6 +40,12 @@ import numpy.typing as npt
 from ._checks import point as point_arg
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, default_tolerance, snap_grid
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
+
+    from .relation import Relation
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]
 
@@ -89,7 +95,7 @@ class Component:
 
     kind: str
     features: tuple[Element, ...]
-    geometry: Any
+    geometry: BaseGeometry
 
     @property
     def family(self) -> str:
@@ -157,7 +163,7 @@ class EntranceBlock:
             raise ValueError(f"family must be one of 'A2-B0', 'A0-B2', 'A1-B1', got {family!r}")
         return tuple(c for c in self.components if c.family == family)
 
-    def to_shapely(self) -> Any:
+    def to_shapely(self) -> BaseGeometry:
         """The entrance block as one shapely (Multi)Polygon: the union of the components.
 
         Zero-width components are left out: each lies in the union of the others (an
@@ -229,7 +235,7 @@ class EntranceBlock:
             "relation": self.classify(self.reference).to_dict(),
         }
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """Draw the entrance block; returns the matplotlib Axes of E(A, B).
 
         Without ``ax``, the four panels of :func:`polycontact.plotting.plot_entrance_block`
@@ -242,7 +248,7 @@ class EntranceBlock:
             return plot_entrance_block(self).axes[3]
         return plot_union(self, ax)
 
-    def classify(self, point: Any, *, tolerance: float | None = None) -> Any:
+    def classify(self, point: npt.ArrayLike, *, tolerance: float | None = None) -> Relation:
         """Relation of A, moved so that its reference point is at ``point``, to B.
 
         Exactly :func:`polycontact.classify` of ``a.moved(point - reference)`` and ``b``:
@@ -261,7 +267,7 @@ class EntranceBlock:
 
         return classify(self.a.moved(point_arg(point, "point") - self.reference), self.b, tolerance=tolerance)
 
-    def components_at(self, point: Any) -> ComponentsAt:
+    def components_at(self, point: npt.ArrayLike) -> ComponentsAt:
         """The components that hold ``point`` in their interior or on their boundary.
 
         This is the paper's reading of the cover (for teaching and for the features);

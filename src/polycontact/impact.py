@@ -36,6 +36,9 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS,
                      RELATIVE_TOLERANCE, SAMPLES, TIME_TOLERANCE)
 from .tolerances import ROUNDING_FACTOR, check_range
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
 
 _METHODS = ("exact", "sampled")
@@ -248,7 +251,7 @@ class Impact:
             "searched_to": self.searched_to,
         }
 
-    def plot(self, ax: Any = None, *, names: tuple[str, str] = ("A", "B")) -> Any:
+    def plot(self, ax: Axes | None = None, *, names: tuple[str, str] = ("A", "B")) -> Axes:
         """Draw both bodies at t = 0 and at the event, their centroid paths and the
         contact; returns the matplotlib Axes (see
         :func:`polycontact.plotting.plot_impact`)."""

@@ -57,6 +57,12 @@ from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR, MAX_S
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, snap_grid, tolerance_for
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
+
+    from .relation import State
+
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
 
 #: The empty exact fits and slides of most results, shared: read-only (and empty).
@@ -141,7 +147,7 @@ class NoFitPolygon:
         Absolute distance tolerance used.
     """
 
-    region: Any
+    region: BaseGeometry
     exact_fits: np.ndarray
     slides: np.ndarray
     reference: np.ndarray
@@ -207,7 +213,7 @@ class NoFitPolygon:
                 out.append(xy)
         return tuple(out)
 
-    def contains(self, point: Any, *, tolerance: float | None = None) -> Any:
+    def contains(self, point: npt.ArrayLike, *, tolerance: float | None = None) -> State:
         """How A placed with its reference at ``point`` relates to B: a ``State``.
 
         The answer of :func:`polycontact.classify` (same ``tolerance``) for A moved so
@@ -230,7 +236,7 @@ class NoFitPolygon:
         return classify(moved, self.b, tolerance=tolerance).state
 
     @property
-    def outline(self) -> Any:
+    def outline(self) -> BaseGeometry:
         """The region's boundary (every ring) as a shapely geometry."""
         return self.region.boundary
 
@@ -268,7 +274,8 @@ class NoFitPolygon:
             "tolerance": float(self.tolerance),
         }
 
-    def plot(self, ax: Any = None, *, placement: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None, *,
+             placement: npt.ArrayLike | None = None) -> Axes:
         """Draw B, the region with its holes, exact fits and slides, and A at
         ``placement``; returns the matplotlib Axes (see
         :func:`polycontact.plotting.plot_nfp`)."""

@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Generic, TypeVar, cast, overload
+from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast, overload
 
 import numpy as np
 
@@ -41,6 +41,9 @@ from .tolerances import (
     RELATIVE_TOLERANCE,
     ROUNDING_ULPS,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many"]
 
@@ -264,7 +267,7 @@ class Relation:
             "tolerance": float(self.tolerance),
         }
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """Draw both bodies, the witness point and the normal; returns the matplotlib Axes.
 
         Parameters

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any, Protocol, Union
+from typing import TYPE_CHECKING, Any, Protocol, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -35,6 +35,11 @@ from .tolerances import (
     tolerance_for,
     validation_tolerance,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely import Polygon
+    from shapely.geometry.base import BaseGeometry
 
 __all__ = ["Shape", "ShapeLike", "GeoInterface", "as_shape", "SHAPE_FORMS"]
 
@@ -644,7 +649,7 @@ class Shape:
 
     # -- interchange ----------------------------------------------------------------
     @classmethod
-    def from_shapely(cls, geom: Any, *, repair: bool = False) -> Shape:
+    def from_shapely(cls, geom: BaseGeometry, *, repair: bool = False) -> Shape:
         """Shape from a shapely Polygon (or a MultiPolygon of exactly one part).
 
         Examples
@@ -669,7 +674,7 @@ class Shape:
             repair=repair,
         )
 
-    def to_shapely(self) -> Any:
+    def to_shapely(self) -> Polygon:
         """The shape as a ``shapely.Polygon``."""
         import shapely
 
@@ -724,7 +729,7 @@ class Shape:
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
 
-    def plot(self, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+    def plot(self, ax: Axes | None = None, *, numbers: bool = False, **style: Any) -> Axes:
         """Draw the shape (solid filled, holes open); returns the matplotlib Axes.
 
         Parameters

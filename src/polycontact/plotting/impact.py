@@ -8,9 +8,11 @@ import numpy as np
 
 from ..motion import Motion
 from ..shape import ShapeLike, as_shape
-from ._style import draw_shape, label_axes, legend_outside, new_axes
+from ._style import draw_shape, label_axes, legend_outside, new_axes, xy
 
 if TYPE_CHECKING:  # (impact.py imports this module to plot: no cycle at run time)
+    from matplotlib.axes import Axes
+
     from ..impact import Impact
 
 __all__ = ["plot_impact"]
@@ -31,8 +33,8 @@ def plot_impact(
     impact: Impact,
     *,
     names: tuple[str, str] = ("A", "B"),
-    ax: Any = None,
-) -> Any:
+    ax: Axes | None = None,
+) -> Axes:
     """Draw both bodies at t = 0 (faint) and at the event, the centroid paths, the contact.
 
     The event is ``impact.time`` (collision), else ``impact.first_contact``, else the end
@@ -71,7 +73,7 @@ def plot_impact(
         if impact.normal is not None:
             # Long enough to clear the marker, drawn above it.
             size = 0.3 * max(a.bounding_radius, b.bounding_radius)
-            ax.annotate("", xy=impact.point + size * impact.normal, xytext=impact.point,
+            ax.annotate("", xy=xy(impact.point + size * impact.normal), xytext=xy(impact.point),
                         arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8},
                         zorder=6)
             ax.add_line(Line2D([], [], color="black", lw=1.8, marker=">", markevery=[1],
