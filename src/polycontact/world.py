@@ -33,7 +33,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -42,12 +42,16 @@ from ._checks import finite_number, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .bodies import BodyLike, as_shape
+from .impacts import PairImpact, first_impact, first_impacts
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
-                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SWEPT_ROUNDING_ULPS,
+                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, SWEPT_ROUNDING_ULPS,
                      TIME_TOLERANCE)
-from .shape import Shape, frozen_ints
+from .shape import Shape, ShapeLike, as_shape, frozen_ints
 from .tolerances import ROUNDING_FACTOR, check_range, default_tolerance
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
 
 __all__ = ["World", "WorldBody", "Contacts", "Query", "Sweep"]
 
@@ -314,7 +318,7 @@ class Contacts:
         return {"bodies": len(self.ids), "container": self.container is not None,
                 "contacts": pairs, "container_contacts": container}
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """Draw the bodies (penetrating ones red, those leaving the container orange),
         the container, the contact points and penetrations; returns the matplotlib Axes.
 
@@ -384,7 +388,7 @@ class Sweep:
     penetration_times : ndarray of shape (K,)
         The first penetration time (``time_of_impact(...).time``; 0 when penetrating at
         the start), NaN for a pair that only touches.
-    status : ndarray of shape (K,), int8
+    statuses : ndarray of shape (K,), int8
         The search's code: 0 no penetration, 1 hit, 2 penetrating at the start, 3 out of
         iterations (no verdict).
     dt : float
@@ -399,7 +403,7 @@ class Sweep:
     times: np.ndarray
     states: np.ndarray
     penetration_times: np.ndarray
-    status: np.ndarray
+    statuses: np.ndarray
     dt: float
     _events: tuple[Any, ...] = field(repr=False)  # what the points and normals come from
 
@@ -626,7 +630,7 @@ class World:
     _live: np.ndarray
     _stamp: np.ndarray
 
-    def __init__(self, container: BodyLike | None = None) -> None:
+    def __init__(self, container: ShapeLike | None = None) -> None:
         # id -> [name, base, motion, shape, version of shape]; base and shape are None
         # until asked for (bodies added by add_many are kept as coordinates); shape is
         # rebuilt when the body's pose version (_ver) has moved on.
@@ -739,7 +743,7 @@ class World:
         return _body_shape(xy, self._ls, self._lmap, self._vmap, int(self._lo[b]),
                            int(self._nl[b]), () if base is None else base.repairs)
 
-    def add(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
+    def add(self, shape: ShapeLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
         """Add a body; returns its id (ids are never reused).
 
@@ -1170,7 +1174,7 @@ class World:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
 
     # -- queries ---------------------------------------------------------------------
-    def contacts(self, tolerance: float | None = None, *, margin: float = 0.0) -> Contacts:
+    def contacts(self, *, tolerance: float | None = None, margin: float = 0.0) -> Contacts:
         """Every pair of bodies in contact or penetrating, with the geometry of each
         contact, and the bodies that touch or leave the container.
 
@@ -1237,7 +1241,7 @@ class World:
         return Contacts(pairs, states, used, c_ids, c_states, store,
                         None if tolerance is None else tol, alive, self._container, gap)
 
-    def query(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
+    def query(self, shape: ShapeLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
         """How ``shape``, placed like :meth:`add` would place it, lies among the bodies.
 
@@ -1264,7 +1268,7 @@ class World:
             cstate = int(k.query_container((qxy, qs, qeps), tol, self._hazards()))
         return Query(ids, states, cstate, placed)
 
-    def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
+    def query_many(self, shape: ShapeLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
                    tolerance: float | None = None) -> np.ndarray:
         """Worst state over every body and the container (outside counts as 2) of
         ``shape`` placed at each of P poses, in one compiled call.
@@ -1476,15 +1480,31 @@ class World:
                          (tint, tflt, tio, tfo))
         self._frames = (tint, tflt, tio, tfo, itop, ftop)
 
-    def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:
+    def first_impacts(self, *, t_max: float, method: str = "exact",
+                      time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
+                      max_iterations: int = MAX_ITERATIONS,
+                      threads: int | None = None) -> list[PairImpact]:
         """Every pair of bodies that meets within ``[0, t_max]`` as they follow their
-        motions (the ``motion`` given to :meth:`add`; a body without one stays put),
-        sorted by time: ``(id_a, id_b, impact)`` with ``id_a < id_b``.
+        motions, sorted by time.
 
-        ``impact`` equals :func:`polycontact.time_of_impact` of the two bodies as placed
-        now; only pairs whose swept bounds meet are searched
-        (:func:`polycontact.first_impacts`, whose ``options`` these are). The container
-        is not a moving hazard: leaving it is not reported here.
+        Each body follows the ``motion`` given to :meth:`add` (a body without one stays
+        put) from where it stands now; only pairs whose swept bounds meet are searched,
+        as by :func:`polycontact.first_impacts`. The container is not a moving hazard:
+        leaving it is not reported here.
+
+        Parameters
+        ----------
+        t_max : float
+            End of the time window (>= 0).
+        method, time_tolerance, samples, max_iterations, threads
+            As for :func:`polycontact.first_impacts`.
+
+        Returns
+        -------
+        list of PairImpact
+            ``(id_a, id_b, impact)`` with ``id_a < id_b`` the bodies' ids and ``impact``
+            what :func:`polycontact.time_of_impact` answers for the two bodies as placed
+            now.
 
         Examples
         --------
@@ -1493,31 +1513,58 @@ class World:
         >>> w = pc.World()
         >>> a = w.add(sq, (0.5, 0.5), motion=pc.Motion(velocity=(1, 0)))
         >>> b = w.add(sq, (3.5, 0.5))
-        >>> [(i, j, round(imp.time, 3)) for i, j, imp in w.first_impacts(5)]
+        >>> [(e.i, e.j, round(e.impact.time, 3)) for e in w.first_impacts(t_max=5)]
         [(0, 1, 2.0)]
         """
-        from .impacts import first_impacts
-
         ids, shapes, motions = self._moving()
-        return [(ids[e.i], ids[e.j], e.impact)
-                for e in first_impacts(shapes, motions, t_max, **options)]
+        return [PairImpact(ids[e.i], ids[e.j], e.impact)
+                for e in first_impacts(shapes, motions, t_max=t_max, method=method,
+                                       time_tolerance=time_tolerance, samples=samples,
+                                       max_iterations=max_iterations, threads=threads)]
 
-    def first_impact(self, t_max: float, **options: Any) -> tuple[int, int, Any] | None:
-        """The first event among the moving bodies, ``(id_a, id_b, impact)``: the
-        earliest collision, else the earliest touch; None when no pair meets (the order
-        of :func:`polycontact.first_impact`, whose ``options`` these are)."""
-        from .impacts import first_impact
+    def first_impact(self, *, t_max: float, method: str = "exact",
+                     time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
+                     max_iterations: int = MAX_ITERATIONS,
+                     threads: int | None = None) -> PairImpact | None:
+        """The first event among the moving bodies: the earliest collision, else the
+        earliest touch (the order of :func:`polycontact.first_impact`).
 
+        Parameters
+        ----------
+        t_max, method, time_tolerance, samples, max_iterations, threads
+            As for :meth:`first_impacts`.
+
+        Returns
+        -------
+        PairImpact or None
+            ``(id_a, id_b, impact)``, or None when no pair meets.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> w = pc.World()
+        >>> ids = [w.add(sq, (0.5, 0.5), motion=pc.Motion(velocity=(1, 0))),
+        ...        w.add(sq, (3.5, 0.5)), w.add(sq, (0.5, 3.0))]
+        >>> e = w.first_impact(t_max=5)
+        >>> e.i, e.j, e.impact.status.value
+        (0, 1, 'hit')
+        >>> w.remove(ids[1])
+        >>> w.first_impact(t_max=5) is None
+        True
+        """
         ids, shapes, motions = self._moving()
-        e = first_impact(shapes, motions, t_max, **options)
-        return None if e is None else (ids[e.i], ids[e.j], e.impact)
+        e = first_impact(shapes, motions, t_max=t_max, method=method,
+                         time_tolerance=time_tolerance, samples=samples,
+                         max_iterations=max_iterations, threads=threads)
+        return None if e is None else PairImpact(ids[e.i], ids[e.j], e.impact)
 
     def _moving(self) -> tuple[list[int], list[Shape], list[Motion]]:
         ids = sorted(self._records)
         bodies = [self.body(k) for k in ids]
         return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
 
-    def plot(self, ax: Any = None, *, labels: bool | None = None) -> Any:
+    def plot(self, ax: Axes | None = None, *, labels: bool | None = None) -> Axes:
         """Draw the bodies where they stand, with their ids, and the container; returns
         the matplotlib Axes. ``world.contacts().plot()`` draws the contacts too.
 
@@ -1545,7 +1592,7 @@ class World:
 
         return plot_world(self, ax, labels=labels)
 
-    def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
+    def feasible_region(self, shape: ShapeLike, angle: float = 0.0) -> BaseGeometry:
         """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
         the container and penetrates no body: the container's inner-fit polygon minus
         the union of the bodies' no-fit polygons, with exact fits and slides kept.

@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     with announced(f"finding the contacts of {len(bodies)} bodies"):
         world.add_many(bodies, names=names)
         try:
-            contacts = world.contacts(args.tolerance)
+            contacts = world.contacts(tolerance=args.tolerance)
         except ValueError as exc:
             raise CommandError(str(exc)) from None
         rep = contacts.to_dict(names)
