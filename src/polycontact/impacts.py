@@ -1,17 +1,21 @@
 """Time of impact for many pairs, and the first impacts among many moving bodies.
 
-:func:`time_of_impact_many` answers a list of pairs the caller chose; :func:`first_impacts`
-finds, among N moving bodies, every pair that meets within ``[0, t_max]`` without
-looking at all N(N − 1)/2 pairs: each body's swept region over ``[0, t_max]`` is bounded
-by space–time boxes (its bounding circle along its centroid's path, one box per time
-slice, :func:`polycontact._kernels.swept.swept_boxes`), a compiled sort-and-sweep lists
-the pairs whose boxes meet, and only those go to the exact search. Both run the pairs on
-threads (the compiled searches release the GIL), and every answer agrees with the one
-:func:`polycontact.time_of_impact` gives for that pair: the same kernel with the same
-arguments (the same status and state, times within the time tolerance; usually equal bit
-for bit, but the kernel compiled inside the batch loop may round a last place
-differently, which can take a search down another, equally valid path), and pairs the boxes leave out are pairs whose bounding circles never meet in
-``[0, t_max]`` (``time_of_impact`` reports nothing for them either).
+:func:`time_of_impact_many` answers a list of pairs the caller chose;
+:func:`first_impacts` finds, among N moving bodies, every pair that meets within
+``[0, t_max]`` without looking at all N(N − 1)/2 pairs (swept bounds, then a
+sort-and-sweep: :func:`candidate_pairs`). Both run the pairs on threads, and every
+answer agrees with the one :func:`polycontact.time_of_impact` gives for that pair (the
+same status and state, times within the time tolerance; the theory page of the
+documentation says why, under "Many moving bodies").
+
+Examples
+--------
+>>> from polycontact import Motion, Shape
+>>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+>>> [(e.i, e.j) for e in first_impacts([sq, sq.moved((3, 0)), sq.moved((0, 9))],
+...                                    [Motion(velocity=(1, 0)), Motion(), Motion()],
+...                                    t_max=5)]
+[(0, 1)]
 """
 
 from __future__ import annotations
@@ -72,7 +76,31 @@ class ImpactBatch:
 
     def impact(self, k: int) -> Impact:
         """The :class:`~polycontact.Impact` of pair ``k``, agreeing with what
-        :func:`polycontact.time_of_impact` returns for it (see the module docstring)."""
+        :func:`polycontact.time_of_impact` returns for it (see the module docstring).
+
+        Parameters
+        ----------
+        k : int
+            A pair index, from ``-len(batch)`` to ``len(batch) - 1``.
+
+        Returns
+        -------
+        Impact
+
+        Raises
+        ------
+        IndexError
+            ``k`` is not a pair index.
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> batch = time_of_impact_many([sq], [Motion(velocity=(1, 0))],
+        ...                             [sq.moved((3, 0))], [Motion()], t_max=5)
+        >>> batch.impact(0).status.value, batch.impact(-1).collides
+        ('hit', True)
+        """
         n = len(self)
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
             raise IndexError(f"k: expected a pair index in [0, {n}), got {k!r}")
