@@ -205,11 +205,10 @@ class Relation:
         Penetrating only: the smallest translation of A that ends the overlap.
     """
 
-    # Built by classify with four slot stores (a frozen dataclass's instance dict cost
-    # 0.15-0.2 us more per call, a sixth of classify on two prebuilt 12-gons taking
-    # turns with GEOS); nothing can be changed: ``state`` and ``tolerance`` are
-    # properties without setters, the lazy parts are cached in ``_cache`` and there is
-    # no instance dict to add attributes to. ``_a`` and ``_b`` are the bodies (a Shape,
+    # Built by classify with four slot stores (a frozen dataclass's instance dict is a
+    # noticeable part of the cost of classify on two small prebuilt shapes); nothing can
+    # be changed: ``state`` and ``tolerance`` are properties without setters, the lazy
+    # parts are cached in ``_cache`` and there is no instance dict to add attributes to. ``_a`` and ``_b`` are the bodies (a Shape,
     # or the bytes, vertex count and orientation of a raw ring).
     __slots__ = ("_state", "_tolerance", "_a", "_b", "_cache")
     _state: State
@@ -553,8 +552,8 @@ def classify(a: ShapeLike, b: ShapeLike, *, tolerance: float | None = None) -> R
         # types: see polycontact._dispatch) with one bytes object per shape (its kernel
         # pack, which holds its bounding box and its default-tolerance term too: -1.0
         # asks the kernel for the larger of the two, so that no float object of the
-        # shapes is read here; reading them cost 0.1 us when GEOS had emptied the
-        # caches); its scratch is on its stack (nothing allocated).
+        # shapes is read here: reading them is slow when GEOS has emptied the caches);
+        # its scratch is on its stack (nothing allocated).
         eps = -1.0 if tolerance is None else _check_tolerance(tolerance)
         code = _state_into(a._kernel, b._kernel, eps)
         if code < 0:  # more vertices than the stack scratch holds
@@ -715,8 +714,8 @@ def _classify_arrays(
 class _BufferPool:
     """Float64 buffers for the copies of :func:`classify_many`'s ring arrays, reused once
     the batch that held one is gone. A fresh array of tens of megabytes has its pages
-    mapped on first touch, which cost a fifth of a batch's classification (100 000 pairs
-    of 12-gons: 7 of 35 ms); a loop of batches reuses the same few buffers instead.
+    mapped on first touch, a sizeable part of a batch's classification; a loop of
+    batches reuses the same few buffers instead.
 
     >>> pool = _BufferPool()
     >>> b = pool.take(10); pool.give(b); pool.take(8) is b

@@ -889,7 +889,7 @@ def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndar
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
     patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
     state kernel: one object to unbox per shape, immutable and holding its data in
-    itself (about 2 us per shape)."""
+    itself."""
     return np.concatenate(
         ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
     ).tobytes()

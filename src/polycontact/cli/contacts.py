@@ -41,9 +41,9 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-#: Layouts with at least this many bodies show a progress bar while they are read
-#: (reading and validating takes about 30 µs per 12-gon; the contacts themselves
-#: take a few µs per body).
+#: Layouts with at least this many bodies show a progress bar while they are read:
+#: reading and validating the bodies takes longer than finding their contacts, long
+#: enough at this size to be worth showing.
 PROGRESS_MIN_BODIES = 10_000
 
 
