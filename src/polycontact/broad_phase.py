@@ -117,7 +117,7 @@ def broad_phase_intervals(
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
+    a, b : ShapeLike
         The bodies at t = 0.
     motion_a, motion_b : Motion
         Their motions (about their area centroids).

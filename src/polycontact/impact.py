@@ -45,7 +45,13 @@ _METHODS = ("exact", "sampled")
 
 
 class ImpactStatus(str, enum.Enum):
-    """How a time-of-impact search ended."""
+    """How a time-of-impact search ended.
+
+    Examples
+    --------
+    >>> ImpactStatus("hit") is ImpactStatus.HIT, ImpactStatus.NO_HIT.value
+    (True, 'no-hit')
+    """
 
     #: The bodies penetrate: ``time`` is the first instant (to the tolerance).
     HIT = "hit"
@@ -115,6 +121,16 @@ class Impact:
         Contact point at the moment of impact (or of first contact).
     normal : ndarray of shape (2,) or None
         Unit contact normal there, from A towards B.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(), t_max=5)
+    >>> hit.collides, hit.status.value, round(hit.time, 3), hit.normal.tolist()
+    (True, 'hit', 2.0, [1.0, 0.0])
+    >>> [round(t, 3) for t in hit.broad_phase[0]], hit.time_bracket[0] < hit.time
+    ([1.586, 4.414], True)
     """
 
     collides: bool
@@ -253,8 +269,28 @@ class Impact:
 
     def plot(self, ax: Axes | None = None, *, names: tuple[str, str] = ("A", "B")) -> Axes:
         """Draw both bodies at t = 0 and at the event, their centroid paths and the
-        contact; returns the matplotlib Axes (see
-        :func:`polycontact.plotting.plot_impact`)."""
+        contact.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (see
+            :func:`polycontact.plotting.plot_impact`).
+        names : (str, str), default ("A", "B")
+            The bodies' names in the legend.
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+        ...                      t_max=5)
+        >>> ax = hit.plot(names=("red", "blue"))
+        """
         from .plotting.impact import plot_impact
 
         a, ma, b, mb, _ = self._bodies

@@ -59,6 +59,16 @@ class ImpactBatch:
         First penetration time of a hit, NaN otherwise.
     first_contacts : ndarray of shape (P,), float64
         ``Impact.first_contact`` (0 when penetrating at the start), NaN when None.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
+    ...                             [sq.moved((3, 0)), sq.moved((0.5, 0))], [Motion()] * 2,
+    ...                             t_max=5)
+    >>> len(batch), batch.statuses.tolist(), batch.first_contacts.round(3).tolist()
+    (2, [1, 2], [2.0, 0.0])
     """
 
     statuses: np.ndarray

@@ -49,7 +49,16 @@ __all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classif
 
 
 class State(str, enum.Enum):
-    """How two bodies lie: apart, touching, or with overlapping interiors."""
+    """How two bodies lie: apart, touching, or with overlapping interiors.
+
+    Arrays of states use the codes 0 separate, 1 contact, 2 penetrating (the order of
+    the members).
+
+    Examples
+    --------
+    >>> [s.value for s in State], State("contact") is State.CONTACT
+    (['separate', 'contact', 'penetrating'], True)
+    """
 
     SEPARATE = "separate"
     CONTACT = "contact"
@@ -156,7 +165,12 @@ class Feature:
     own_edge: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The feature as a JSON-ready dict (``own_edge`` only for an edge crossing).
+        """The feature as a JSON-ready dict.
+
+        Returns
+        -------
+        dict
+            The attributes by name (``own_edge`` only for an edge crossing).
 
         Examples
         --------
@@ -203,13 +217,23 @@ class Relation:
         the direction opposite the smallest separating translation of A. Separate: None.
     escape : ndarray of shape (2,) or None
         Penetrating only: the smallest translation of A that ends the overlap.
+
+    Examples
+    --------
+    >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    >>> r = classify(sq, [(0.75, 0), (2, 0), (2, 1), (0.75, 1)])
+    >>> r
+    Relation(state='penetrating', tolerance=1.25e-12)
+    >>> r.distance, r.normal.tolist(), r.escape.tolist()
+    (-0.25, [1.0, 0.0], [-0.25, 0.0])
     """
 
     # Built by classify with four slot stores (a frozen dataclass's instance dict is a
     # noticeable part of the cost of classify on two small prebuilt shapes); nothing can
     # be changed: ``state`` and ``tolerance`` are properties without setters, the lazy
-    # parts are cached in ``_cache`` and there is no instance dict to add attributes to. ``_a`` and ``_b`` are the bodies (a Shape,
-    # or the bytes, vertex count and orientation of a raw ring).
+    # parts are cached in ``_cache`` and there is no instance dict to add attributes to.
+    # ``_a`` and ``_b`` are the bodies (a Shape, or the bytes, vertex count and
+    # orientation of a raw ring).
     __slots__ = ("_state", "_tolerance", "_a", "_b", "_cache")
     _state: State
     _tolerance: float
@@ -241,10 +265,14 @@ class Relation:
         """The relation as a JSON-ready dict: the object ``polycontact classify --json``
         prints.
 
-        Keys ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
-        ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``. Only what is
-        returned is computed: separate bodies have no features (nothing touches), so
-        their feature search is skipped.
+        Only what is returned is computed: separate bodies have no features (nothing
+        touches), so their feature search is skipped.
+
+        Returns
+        -------
+        dict
+            ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
+            ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``.
 
         Examples
         --------
@@ -611,6 +639,13 @@ class RelationBatch:
     distances : ndarray of shape (P,), float64
         Signed distances as in :attr:`Relation.distance`; computed (in parallel) on
         first access and cached.
+
+    Examples
+    --------
+    >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    >>> batch = classify_many([sq, sq], [[(1, 0), (2, 0), (2, 1)], [(3, 0), (4, 0), (4, 1)]])
+    >>> batch.states.tolist(), batch.distances.tolist(), batch.state(1)
+    ([1, 0], [0.0, 2.0], <State.SEPARATE: 'separate'>)
     """
 
     states: np.ndarray
@@ -621,7 +656,24 @@ class RelationBatch:
         return int(self.states.shape[0])
 
     def state(self, i: int) -> State:
-        """The :class:`State` of pair ``i``."""
+        """The :class:`State` of one pair.
+
+        Parameters
+        ----------
+        i : int
+            A pair index.
+
+        Returns
+        -------
+        State
+            ``State`` of ``states[i]``.
+
+        Examples
+        --------
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> classify_many([sq], [[(0.5, 0), (2, 0), (2, 1)]]).state(0)
+        <State.PENETRATING: 'penetrating'>
+        """
         return _STATES[int(self.states[i])]
 
     def __post_init__(self) -> None:

@@ -520,9 +520,18 @@ class Shape:
         return self._loops
 
     def input_loop(self, loop: int) -> int | None:
-        """The caller's index of stored loop ``loop``: the same index (0 the outer loop,
-        1.. the holes in the order given), or None for a loop that ``repair=True`` made
-        and that holds none of the caller's vertices.
+        """The caller's index of a stored loop.
+
+        Parameters
+        ----------
+        loop : int
+            A stored loop (0 the outer loop, 1.. the holes).
+
+        Returns
+        -------
+        int or None
+            The same index (the holes are kept in the order given), or None for a loop
+            that ``repair=True`` made and that holds none of the caller's vertices.
 
         Examples
         --------
@@ -534,11 +543,21 @@ class Shape:
         return None if k < 0 else k
 
     def input_vertex(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored vertex ``i`` of loop ``loop``.
+        """The caller's index of a stored vertex.
 
-        That is its position in the vertices as passed (0-based, repeated and closing
-        points counted), whatever the stored orientation; None for a vertex that
-        ``repair=True`` created (where the repair cut an edge).
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            A vertex of that loop as stored (:attr:`loops`).
+
+        Returns
+        -------
+        int or None
+            Its position in the vertices as passed (0-based, repeated and closing points
+            counted), whatever the stored orientation; None for a vertex that
+            ``repair=True`` created (where the repair cut an edge).
 
         Examples
         --------
@@ -549,13 +568,22 @@ class Shape:
         return self._lookup(loop, i, 0)
 
     def input_edge(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored edge ``i`` of loop ``loop``.
+        """The caller's index of a stored edge.
 
-        Stored edge ``i`` joins stored vertices ``i`` and ``i + 1``; the answer ``k`` is
-        the caller's edge joining their vertices ``k`` and ``k + 1`` (mod the number of
-        vertices passed) that holds it: where repeated points were dropped, the one edge
-        of non-zero length between them. None for an edge that ``repair=True`` made and
-        that lies on no single edge of the caller's.
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            An edge of that loop as stored: it joins stored vertices ``i`` and ``i + 1``.
+
+        Returns
+        -------
+        int or None
+            The caller's edge ``k``, joining their vertices ``k`` and ``k + 1`` (mod the
+            number of vertices passed), that holds it: where repeated points were
+            dropped, the one edge of non-zero length between them. None for an edge
+            that ``repair=True`` made and that lies on no single edge of the caller's.
 
         Examples
         --------
@@ -613,11 +641,26 @@ class Shape:
 
     # -- rigid motions ------------------------------------------------------------
     def moved(self, translation: ArrayLike = (0.0, 0.0), angle: float = 0.0) -> Shape:
-        """This shape rotated by ``angle`` (radians, CCW) about its centroid, then translated.
+        """This shape rotated by ``angle`` about its centroid, then translated.
 
-        ``translation`` is two real numbers and ``angle`` one, finite (strings, booleans
-        and complex numbers raise ``TypeError``, other bad values ``ValueError``, naming
-        the argument), and the moved coordinates must stay within ±1e100.
+        Parameters
+        ----------
+        translation : (dx, dy), default (0, 0)
+            Two finite real numbers.
+        angle : float, default 0
+            Radians, counter-clockwise.
+
+        Returns
+        -------
+        Shape
+            The moved shape (numbered as this one).
+
+        Raises
+        ------
+        TypeError
+            Strings, booleans or complex numbers, naming the argument.
+        ValueError
+            Other bad values, or moved coordinates beyond ±1e100.
 
         Examples
         --------
@@ -640,7 +683,27 @@ class Shape:
             raise InvalidShapeError(f"translation: the moved {exc}") from None
 
     def at(self, motion: Motion, t: float) -> Shape:
-        """The shape placed by ``motion`` at time ``t`` (see :class:`polycontact.Motion`)."""
+        """The shape placed by a motion at a time.
+
+        Parameters
+        ----------
+        motion : Motion
+            How the shape moves about its area centroid from where it is.
+        t : float
+            The time.
+
+        Returns
+        -------
+        Shape
+            ``self.moved(*motion.pose(t))``.
+
+        Examples
+        --------
+        >>> from polycontact import Motion
+        >>> sq = Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+        >>> sq.at(Motion(velocity=(1, 0), acceleration=(0, 2)), 3.0).centroid.tolist()
+        [4.0, 10.0]
+        """
         if not isinstance(motion, Motion):
             raise TypeError(f"motion: expected a polycontact.Motion, got "
                             f"{type(motion).__name__}")

@@ -120,6 +120,14 @@ class WorldBody:
         Turn about that centroid, radians, counter-clockwise.
     motion : Motion or None
         The motion given to :meth:`World.add` (not used by the static queries).
+
+    Examples
+    --------
+    >>> w = World()
+    >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), angle=0.5, name="plate")
+    >>> body = w.body(i)
+    >>> body.id, body.name, body.position.tolist(), body.angle
+    (0, 'plate', [5.0, 5.0], 0.5)
     """
 
     id: int
@@ -188,6 +196,16 @@ class Contacts:
         The world's container.
     margin : float
         The margin asked for.
+
+    Examples
+    --------
+    >>> w = World(container=[(0, 0), (2.5, 0), (2.5, 1), (0, 1)])
+    >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.25, 2.2)]
+    >>> c = w.contacts()
+    >>> c.pairs.tolist(), c.states.tolist(), c.overlap_areas.round(9).tolist()
+    ([[0, 1], [1, 2]], [2, 2], [0.25, 0.05])
+    >>> c.container_ids.tolist(), c.container_states.tolist()
+    ([0, 1, 2], [1, 1, 2])
     """
 
     pairs: np.ndarray
@@ -255,7 +273,24 @@ class Contacts:
 
     def relation(self, k: int) -> Relation:
         """The full :class:`~polycontact.Relation` of pair ``k`` (features, point,
-        normal, depth), as :func:`polycontact.classify` gives it."""
+        normal, depth), as :func:`polycontact.classify` gives it.
+
+        Parameters
+        ----------
+        k : int
+            A row of :attr:`pairs`.
+
+        Returns
+        -------
+        Relation
+
+        Examples
+        --------
+        >>> w = World()
+        >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.5)]
+        >>> w.contacts().relation(0).state.value
+        'contact'
+        """
         k = _integer(k, "k")
         if not 0 <= k < len(self.states):
             raise IndexError(f"k: pair {k} out of range (0..{len(self.states) - 1})")
@@ -269,7 +304,26 @@ class Contacts:
         return cast("np.ndarray", self.pairs[self.states == 2])
 
     def shape(self, id: int) -> Shape:
-        """The Shape of body ``id`` as it was when the contacts were found."""
+        """The shape of a body where it stood when the contacts were found.
+
+        Parameters
+        ----------
+        id : int
+            One of :attr:`ids`.
+
+        Returns
+        -------
+        Shape
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> c = w.contacts()
+        >>> w.move(i, (5, 5))
+        >>> c.shape(i).centroid.tolist()
+        [0.5, 0.5]
+        """
         id = _integer(id, "id")
         if id not in set(self.ids.tolist()):
             raise IndexError(f"id: no body {id} among the contacts' bodies")
@@ -320,9 +374,23 @@ class Contacts:
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """Draw the bodies (penetrating ones red, those leaving the container orange),
-        the container, the contact points and penetrations; returns the matplotlib Axes.
+        the container, the contact points and penetrations.
 
-        See :func:`polycontact.plotting.plot_contacts`.
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (see
+            :func:`polycontact.plotting.plot_contacts`).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> w = World()
+        >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.2)]
+        >>> ax = w.contacts().plot()
         """
         from .plotting.world import plot_contacts
 
@@ -346,6 +414,14 @@ class Query:
         Inside the container and penetrating no body (touching allowed).
     shape : Shape
         The shape as placed.
+
+    Examples
+    --------
+    >>> w = World()
+    >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> q = w.query([(0, 0), (1, 0), (1, 1), (0, 1)], (1.0, 0.5))
+    >>> q.ids.tolist(), q.states.tolist(), q.fits
+    ([0], [2], False)
     """
 
     ids: np.ndarray
@@ -397,6 +473,14 @@ class Sweep:
         Contact point and unit normal (from the first body of the pair towards the
         second) at ``times``, as :attr:`Contacts.points` and :attr:`Contacts.normals`
         give them for the bodies placed there.
+
+    Examples
+    --------
+    >>> w = World()
+    >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 3.5)]
+    >>> s = w.sweep(2.0, [(1.0, 0.0), (-1.0, 0.0)])
+    >>> s.pairs.tolist(), s.times.round(4).tolist(), s.statuses.tolist()
+    ([[0, 1]], [1.0], [1])
     """
 
     pairs: np.ndarray
@@ -598,7 +682,7 @@ class World:
 
     Parameters
     ----------
-    container : Shape, shapely Polygon or array_like of shape (N, 2), optional
+    container : ShapeLike, optional
         The region bodies must stay in (holes are defects to avoid). Without one,
         nothing is outside.
 
@@ -719,7 +803,31 @@ class World:
         return tuple(self.body(i) for i in sorted(self._records))
 
     def body(self, id: int) -> WorldBody:
-        """The body with this id (a read-only record)."""
+        """One body of the world, as a read-only record.
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+
+        Returns
+        -------
+        WorldBody
+            Its id, name, shape where it stands, shape as added, pose and motion.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), name="plate")
+        >>> b = w.body(i)
+        >>> b.name, b.position.tolist(), b.shape.centroid.tolist(), b.base.centroid.tolist()
+        ('plate', [5.0, 5.0], [5.0, 5.0], [1.0, 1.0])
+        """
         rec = self._record(id, "id")
         b = int(id)
         if rec[3] is None or rec[4] != self._ver[b]:
@@ -745,18 +853,32 @@ class World:
 
     def add(self, shape: ShapeLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
-        """Add a body; returns its id (ids are never reused).
+        """Add a body: a shape placed in the world (:meth:`add_many` adds many in one
+        call).
 
         Parameters
         ----------
-        shape : Shape, shapely Polygon or array_like of shape (N, 2)
+        shape : ShapeLike
+            The body's shape, in any form :func:`polycontact.shape.as_shape` takes.
         position : (x, y), optional
             Where the shape's area centroid goes; None keeps the shape where it is.
-        angle : float
+        angle : float, default 0
             Radians, counter-clockwise, about the centroid.
         motion : Motion, optional
-            Stored with the body for the moving-body queries.
+            Stored with the body for :meth:`first_impacts` and :meth:`first_impact`.
         name : str, optional
+
+        Returns
+        -------
+        int
+            The body's id (ids are never reused).
+
+        Examples
+        --------
+        >>> w = World()
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> w.add(sq), w.add(sq, (3, 0), angle=0.25, name="b")
+        (0, 1)
         """
         base = as_shape(shape, "shape")
         pos = None if position is None else point_arg(position, "position")
@@ -921,14 +1043,58 @@ class World:
         self._write_poses(idx, pos, ang)
 
     def poses(self, ids: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (area centroids, (P, 2)) and angles ((P,), radians) of the bodies
-        ``ids`` (default: every body, by id), as new arrays."""
+        """Where the bodies stand: their positions and angles, as new arrays.
+
+        Parameters
+        ----------
+        ids : array_like of int, shape (P,), optional
+            Bodies of this world; default every body, by id.
+
+        Returns
+        -------
+        positions : ndarray of shape (P, 2)
+            Where each body's area centroid is.
+        angles : ndarray of shape (P,)
+            Its turn about that centroid, radians, counter-clockwise.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), angle=0.5)
+        >>> positions, angles = w.poses()
+        >>> positions.tolist(), angles.tolist()
+        ([[5.0, 5.0]], [0.5])
+        """
         idx = self.ids if ids is None else self._ids(ids, "ids", unique=False)
         return self._pos[idx].copy(), self._ang[idx].copy()
 
-    def move(self, id: int, position: Any = None, angle: float | None = None) -> None:
-        """Put body ``id`` at a new pose (None keeps the current position or angle); the
-        pose applies to the shape as added."""
+    def move(self, id: int, position: npt.ArrayLike | None = None,
+             angle: float | None = None) -> None:
+        """Put one body at a new pose (:meth:`set_poses` moves many in one call).
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+        position : (x, y), optional
+            Where its area centroid goes; None keeps the current position.
+        angle : float, optional
+            Its turn (radians, counter-clockwise) from the shape as added; None keeps
+            the current angle.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)])
+        >>> w.move(i, (10, 0))
+        >>> w.body(i).shape.centroid.tolist()
+        [10.0, 0.0]
+        """
         self._record(id, "id")
         b = int(id)
         pos = self._pos[b].copy() if position is None else point_arg(position, "position")
@@ -939,7 +1105,25 @@ class World:
         self._write_poses(idx, pos[None], np.array([ang]))
 
     def remove(self, id: int) -> None:
-        """Take body ``id`` out of the world."""
+        """Take a body out of the world (its id is not given again).
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (0, 1)])
+        >>> w.remove(i); i in w, len(w)
+        (False, 0)
+        """
         self._record(id, "id")
         self._unindex(id)
         lo, nl = self._lo[id], self._nl[id]
@@ -1252,11 +1436,32 @@ class World:
               tolerance: float | None = None) -> Query:
         """How ``shape``, placed like :meth:`add` would place it, lies among the bodies.
 
+        Parameters
+        ----------
+        shape : ShapeLike
+            The shape to place (it is not added).
+        position : (x, y), optional
+            Where its area centroid goes; None keeps it where it is.
+        angle : float, default 0
+            Radians, counter-clockwise, about the centroid.
+        tolerance : float, optional
+            Absolute tolerance for every pair; default per pair as in
+            :func:`polycontact.classify`.
+
         Returns
         -------
         Query
             ``ids`` and ``states`` of the bodies it touches or penetrates,
             ``container_state``, ``inside_container`` and ``fits``.
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (4, 0), (4, 2), (0, 2)])
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> i = w.add(sq, (0.5, 0.5))
+        >>> q = w.query(sq, (1.5, 0.5))
+        >>> q.ids.tolist(), q.states.tolist(), q.container_state, q.fits
+        ([0], [1], 1, True)
         """
         base = as_shape(shape, "shape")
         pos = None if position is None else point_arg(position, "position")
@@ -1282,16 +1487,30 @@ class World:
 
         Parameters
         ----------
-        shape : Shape, shapely Polygon or array_like of shape (N, 2)
+        shape : ShapeLike
+            The shape to place (it is not added).
         positions : array_like of shape (P, 2)
             Where the shape's area centroid goes: real numbers (not strings, booleans
             or complex numbers), finite and within ±1e100.
-        angles : float or array_like of shape (P,)
+        angles : float or array_like of shape (P,), default 0
             Radians, about the centroid.
+        tolerance : float, optional
+            As for :meth:`query`.
 
         Returns
         -------
         ndarray of shape (P,), int8
+            0 where the placed shape is apart from everything, 1 where it touches a
+            body or the container's boundary, 2 where it penetrates a body or leaves the
+            container.
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (4, 0), (4, 2), (0, 2)])
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> i = w.add(sq, (0.5, 0.5))
+        >>> w.query_many(sq, [(2.5, 1.0), (1.5, 0.5), (1.2, 0.5), (3.9, 1.0)]).tolist()
+        [0, 1, 2, 2]
         """
         base = as_shape(shape, "shape")
         pos = points(positions, "positions")
@@ -1599,9 +1818,18 @@ class World:
         return plot_world(self, ax, labels=labels)
 
     def feasible_region(self, shape: ShapeLike, angle: float = 0.0) -> BaseGeometry:
-        """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
-        the container and penetrates no body: the container's inner-fit polygon minus
-        the union of the bodies' no-fit polygons, with exact fits and slides kept.
+        """Where a shape can go: the positions of its area centroid (turned by
+        ``angle``) where it lies in the container and penetrates no body.
+
+        The container's inner-fit polygon minus the union of the bodies' no-fit
+        polygons, with exact fits and slides kept.
+
+        Parameters
+        ----------
+        shape : ShapeLike
+            The shape to place.
+        angle : float, default 0
+            Its turn about its centroid, radians, counter-clockwise.
 
         Returns
         -------
@@ -1613,6 +1841,14 @@ class World:
         ------
         ValueError
             Without a container (the free region would be unbounded).
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (3, 0), (3, 1), (0, 1)])
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (0.5, 0.5))
+        >>> region = w.feasible_region([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> region.geom_type, [round(v, 6) for v in region.bounds]
+        ('LineString', [1.5, 0.5, 2.5, 0.5])
         """
         import shapely
         from shapely import affinity

@@ -38,7 +38,24 @@ def plot_impact(
     """Draw both bodies at t = 0 (faint) and at the event, the centroid paths, the contact.
 
     The event is ``impact.time`` (collision), else ``impact.first_contact``, else the end
-    of the search. Returns the matplotlib Axes.
+    of the search.
+
+    Parameters
+    ----------
+    a, b : ShapeLike
+        The bodies at t = 0, as given to :func:`polycontact.time_of_impact`.
+    motion_a, motion_b : Motion
+        Their motions.
+    impact : Impact
+        What :func:`polycontact.time_of_impact` answered for them.
+    names : (str, str), default ("A", "B")
+        The bodies' names in the legend.
+    ax : matplotlib Axes, optional
+        Drawn into a new figure when omitted.
+
+    Returns
+    -------
+    matplotlib Axes
 
     Examples
     --------
