@@ -121,9 +121,9 @@ class NoFitPolygon:
     ``region`` is built on first access and cached: :func:`no_fit_polygon` keeps the
     outline's rings as its kernel returned them (private arrays) and makes the Shapely
     geometry only when asked for it, as a nesting code that tests a few placements
-    against most of its no-fit polygons never needs. The object is immutable, so the cached geometry cannot go
-    stale; pickling and copying carry the built geometry. The coordinates are also
-    offered as data, without a geometry: :attr:`rings`.
+    against most of its no-fit polygons never needs. The object is immutable, so the
+    cached geometry cannot go stale; pickling and copying carry the built geometry. The
+    coordinates are also offered as data, without a geometry: :attr:`rings`.
 
     Attributes
     ----------

@@ -335,8 +335,9 @@ def relate_state(xa, sa, xb, sb, eps):
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
 # arrays it is called with and passes on cost as much as the test of a small separate
 # pair. Nothing in it allocates: the scratch is on its stack (a buffer passed in would
-# cost a thread-local look-up and one more array to unbox per call). It takes one bytes object per shape (see PACK_HEAD) and reads the bounding
-# boxes and tolerance terms cached in them.
+# cost a thread-local look-up and one more array to unbox per call). It takes one bytes
+# object per shape (see PACK_HEAD) and reads the bounding boxes and tolerance terms
+# cached in them.
 @njit(cache=True, nogil=True, _nrt=False)
 def relate_shapes_into(pa, pb, eps):
     """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),
