@@ -463,12 +463,9 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
 
     Parameters
     ----------
-    shapes : sequence of ShapeLike
-        The bodies at t = 0.
-    motions : sequence of Motion
-        One per body.
-    t_max : float
-        End of the time window (>= 0).
+    shapes, motions, t_max
+        As for :func:`first_impacts`: the bodies at t = 0, one motion per body, the end
+        of the time window.
 
     Returns
     -------
