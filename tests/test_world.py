@@ -310,7 +310,7 @@ def test_published_layouts_are_feasible(path):
     for k, item in enumerate(data["placed"]):
         world.add(pc.Shape(item["vertices"]), name=str(k))
     got = world.contacts()
-    assert not (got.states == 2).any(), got.penetrating.tolist()
+    assert not (got.states == 2).any(), got.penetrating_pairs.tolist()
     assert not (got.container_states == 2).any(), got.container_ids.tolist()
 
 

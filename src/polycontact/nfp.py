@@ -413,7 +413,7 @@ _set_dict = object.__setattr__
 def inner_fit_polygon(
     a: ShapeLike, container: ShapeLike, reference: npt.ArrayLike | None = None, *,
     tolerance: float | None = None
-) -> Any:
+) -> BaseGeometry:
     """Reference positions at which ``a`` lies inside ``container`` (touching allowed).
 
     The inner-fit polygon of nesting: with ``container`` a bin (or a hole, passed as a

@@ -299,8 +299,8 @@ class Contacts:
                         tolerance=self._tolerance)
 
     @property
-    def penetrating(self) -> np.ndarray:
-        """The pairs that penetrate, (P, 2)."""
+    def penetrating_pairs(self) -> np.ndarray:
+        """The pairs that penetrate, (P, 2): the rows of :attr:`pairs` whose state is 2."""
         return cast("np.ndarray", self.pairs[self.states == 2])
 
     def shape(self, id: int) -> Shape:

@@ -47,7 +47,7 @@ def plot_contacts(contacts: Contacts, ax: Axes | None = None) -> Axes:
     """
     if ax is None:
         ax = new_axes((11, 7))
-    pen = set(contacts.penetrating.ravel().tolist())
+    pen = set(contacts.penetrating_pairs.ravel().tolist())
     out = set(contacts.container_ids[contacts.container_states == 2].tolist())
     if contacts.container is not None:
         ax.add_patch(shape_patch(contacts.container, facecolor="none", edgecolor="0.2", lw=1.5,
