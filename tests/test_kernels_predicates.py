@@ -10,6 +10,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
+import pytest
 import shapely
 from exact_overlap import is_valid, orient
 from hypothesis import assume, example, given
@@ -55,16 +56,34 @@ def test_orientation_is_exact(points):
     assert kp.orientation(*points) == _exact(*points)
 
 
-def test_orientation_says_where_it_cannot_decide():
-    # c 1e-323 off the line through a and b, whose x and y both span 1 to 5e-324: the
-    # product 5e-324 x 5e-324 underflows
-    assert kp.orientation(5e-324, 1.0, 1.0, 5e-324, 0.5, 0.5) == kp.UNDECIDED
-    # one float spacing off a line, anywhere else: decided
-    assert kp.orientation(0.0, 0.0, 1.0, 0.0, 0.5, 5e-324) == 1
-    assert kp.orientation(0.0, 0.0, 1e-150, 1e-150, 3e-150, 3e-150) == 0
-    for far in ((1e100, 1e-300, -1e100, 3e-300, 0.0, 2e-300),
-                (1e100, 1e-300, -1e100, 3e-300, 0.0, (1e-300 + 3e-300) / 2)):
-        assert kp.orientation(*far) == _exact(*far)
+@pytest.mark.parametrize("points", [
+    (5e-324, 1.0, 1.0, 5e-324, 0.5, 0.5),      # 1 beside 5e-324, in x and in y
+    (0.0, 0.0, 1.0, 0.0, 0.5, 5e-324),         # one float spacing off a line
+    (0.0, 0.0, 1e-150, 1e-150, 3e-150, 3e-150),
+    (1e100, 1e-300, -1e100, 3e-300, 0.0, 2e-300),
+    (1e100, 1e-300, -1e100, 3e-300, 0.0, (1e-300 + 3e-300) / 2),
+    (5e-324, 1e-323, 1e100, 5e-324, 1e-323, 1e-323),
+])
+def test_orientation_is_exact_where_products_underflow(points):
+    assert kp.orientation(*points) == _exact(*points)
+
+
+@st.composite
+def extreme_points(draw):
+    """Three points whose coordinates are 0, subnormal, tiny or up to 1e100, with a
+    third point on or a float spacing off the line of the first two."""
+    mags = st.sampled_from([0.0, 5e-324, 1e-320, 1e-310, 1e-300, 1e-200, 1.0, 1e100])
+    ax, ay, bx, by = (draw(mags) * draw(st.sampled_from([1.0, -1.0, 3.0])) for _ in range(4))
+    t = draw(st.sampled_from([0.5, 0.25, 2.0, -1.0]))
+    cx = _nudge(ax + t * (bx - ax), draw(st.integers(-1, 1)))
+    cy = _nudge(ay + t * (by - ay), draw(st.integers(-1, 1)))
+    return ax, ay, bx, by, cx, cy
+
+
+@given(extreme_points())
+@examples(400)
+def test_orientation_is_exact_at_the_ends_of_the_range(points):
+    assert kp.orientation(*points) == _exact(*points)
 
 
 def _meet_exact(a, b, c, d) -> int:

@@ -31,7 +31,6 @@ from .tolerances import (
     EXTENT_FLOOR,
     check_range,
     default_tolerance,
-    snap_grid,
     tolerance_for,
 )
 
@@ -258,9 +257,7 @@ class Shape:
         (exact orientations): features are defects only where they truly meet, however
         close they come otherwise, so a polygon GEOS calls valid is accepted at every
         scale and position. Features closer than the tolerance are then decided as
-        touching by the functions that take the shape. (The one refusal of a polygon
-        that exact arithmetic would accept: nonzero coordinates that span more than
-        2**950 in magnitude, whose float64 products underflow; the message says so.)
+        touching by the functions that take the shape.
     TypeError
         Coordinates that are not real numbers (strings, booleans, complex numbers: the
         message names the loop and the vertex), or ``holes`` with a body that carries
@@ -421,35 +418,23 @@ class Shape:
         self._set(loops, repairs)
 
     def _init_repaired(self, vertices: ArrayLike, holes: Sequence[ArrayLike], why: str) -> None:
-        import shapely
+        from ._repair import repaired
+
+        def check(poly: Any) -> None:
+            _check_loops(_polygon_loops(poly))
 
         try:
-            rings = [np.asarray(r, dtype=float) for r in (vertices, *holes)]
-            raw = shapely.Polygon(rings[0], rings[1:])
-        except Exception as exc:  # shapely refuses rings it cannot even build
+            rings = [np.asarray(r, dtype=float).reshape(-1, 2) for r in (vertices, *holes)]
+        except (TypeError, ValueError) as exc:
             raise InvalidShapeError(f"cannot repair: {why} ({exc})") from None
-        poly = _one_polygon(shapely.make_valid(raw, method="structure", keep_collapsed=False),
-                            why)
-        notes = [f"made valid with shapely.make_valid(method='structure') because {why}"]
-        grid = 0.0
+        poly, grid, note = repaired(rings, why, check)
         try:
             loops = _polygon_loops(poly)
-            _check_loops(loops)
-        except InvalidShapeError as exc:
-            # GEOS's result still meets itself exactly (GEOS's arithmetic cannot resolve
-            # features that close): snap-rounded onto a grid far finer than the
-            # tolerance, GEOS's noding leaves no two features meeting but at vertices.
-            grid = snap_grid(default_tolerance(*rings))
-            poly = _one_polygon(shapely.set_precision(poly, grid), why)
-            loops = _polygon_loops(poly)
-            notes.append(f"snapped to a grid of {grid:.3g} (each vertex moved by at most "
-                         f"{grid * 0.5**0.5:.3g}, far below the tolerance) because {exc}")
-        change = f"now {sum(len(r) for r in loops)} vertices in {len(loops)} loop(s)"
-        if raw.is_valid:
-            change += f", area changed by {float(raw.area) - float(poly.area):g}"
-        notes.append(change)
-        try:
-            self._init_from_loops(loops, repairs=("; ".join(notes),))
+            note += f"; now {sum(len(r) for r in loops)} vertices in {len(loops)} loop(s)"
+            raw_area = _valid_area(rings)
+            if raw_area is not None:
+                note += f", area changed by {raw_area - float(poly.area):g}"
+            self._init_from_loops(loops, repairs=(note,))
         except InvalidShapeError as exc:
             raise InvalidShapeError(f"cannot repair: {why}; the repaired polygon: {exc}") from None
         self._input = _repaired_maps(self, rings, grid)
@@ -723,16 +708,12 @@ class Shape:
         return f"<Shape {len(self.exterior)} vertices{holes}, area {self._area:g}>"
 
 
-def _one_polygon(geom: Any, why: str) -> Any:
-    """The one polygon of positive area in a repair's result ``geom``; refuses others."""
+def _valid_area(rings: Sequence[np.ndarray]) -> float | None:
+    """The area of the loops as GEOS reads them, where GEOS calls them valid."""
     import shapely
 
-    polys = [g for g in shapely.get_parts(geom) if g.geom_type == "Polygon" and g.area > 0]
-    if len(polys) != 1:
-        raise InvalidShapeError(
-            f"cannot repair: {why}; shapely.make_valid gives {len(polys)} polygons, not one"
-        )
-    return polys[0]
+    raw = shapely.Polygon(rings[0], rings[1:])
+    return float(raw.area) if raw.is_valid else None
 
 
 def _polygon_loops(poly: Any) -> list[np.ndarray]:
@@ -920,14 +901,7 @@ def _check_loops(loops: list[np.ndarray]) -> np.ndarray:
             f"{_loop_name(kj)} crosses {'the ' if ki == 0 else ''}{_loop_name(ki)} at {at} "
             f"(edge {ej} of {_loop_name(kj)}, edge {ei} of {_loop_name(ki)})"
         )
-    signs = kv.loop_signs(xy, starts) if code == kv.OK else None
-    if signs is None or (signs == kv.UNDECIDED).any():
-        raise InvalidShapeError(
-            f"{_loop_name(ki)}: near {at}, coordinates that span more than 2**950 in "
-            "magnitude: their float64 products underflow, so whether its edges meet "
-            "cannot be decided exactly (round the tiny coordinates to zero)"
-        )
-    return np.asarray(signs)
+    return np.asarray(kv.loop_signs(xy, starts))
 
 
 def _area_rounding(x: np.ndarray, y: np.ndarray, nxt: np.ndarray, span: np.ndarray) -> float:

@@ -10,15 +10,16 @@ rounding, then added without rounding) and the sign read off its largest compone
 The exact sum needs each product of two nonzero coordinates and its rounding error to
 stay normal floats: the x and the y coordinates are first scaled apart by powers of two
 (which round nothing and leave the sign alone) so that the largest of each is near
-2**505, and the sum is exact when every such product is then above 2**-960: when the
-span of the nonzero x coordinates times that of the nonzero y coordinates is below
-about 2**1970 (a span of 2**985, 1e296, in both at once). Otherwise :data:`UNDECIDED`
-is returned and the caller says so.
+2**505. A product still below 2**-960 (coordinates spanning about 2**985 in x and in y
+at once, like 5e-324 beside 1) is summed apart, its factors lifted by 2**500 each;
+the two sums are compared, and added exactly where they are of one size. Coordinates
+up to 1e100 in magnitude (:data:`polycontact.limits.COORDINATE_LIMIT`) keep every
+step within float64's range.
 
 >>> orientation(0.0, 0.0, 1.0, 0.0, 0.5, 5e-324), orientation(0.0, 0.0, 1.0, 1.0, 3.0, 3.0)
 (1, 0)
->>> orientation(5e-324, 1.0, 1.0, 5e-324, 0.5, 0.5) == UNDECIDED  # 1 beside 5e-324, twice
-True
+>>> orientation(5e-324, 1.0, 1.0, 5e-324, 0.5, 0.5)  # 1 beside 5e-324, in x and in y
+-1
 """
 
 from __future__ import annotations
@@ -27,9 +28,6 @@ import math
 
 import numpy as np
 from numba import njit
-
-#: Returned by :func:`orientation` when its exact sum would underflow (see above).
-UNDECIDED = 3
 
 _EPS = 2.0**-53
 #: Shewchuk's bound on the rounding of the filtered determinant (relative to the sum
@@ -41,6 +39,8 @@ _SPLITTER = 2.0**27 + 1.0
 _TOP = 505
 #: Smallest product of two scaled coordinates whose rounding error is a normal float.
 _BOTTOM = 2.0**-960
+#: Power of two each factor of a smaller product is lifted by before it is multiplied.
+_LIFT = 500
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -69,6 +69,30 @@ def _two_product(a, b):
 
 
 @njit(cache=True, nogil=True)
+def _expansion(terms):
+    """The nonoverlapping expansion of the exact sum of ``terms`` (Shewchuk's
+    Grow-Expansion): components of increasing magnitude, zeros among them, whose sign
+    and magnitude are those of the last nonzero one (which is more than half the sum)."""
+    n = terms.shape[0]
+    h = np.zeros(n)
+    for k in range(n):
+        q = terms[k]
+        for i in range(k):
+            q, h[i] = _two_sum(q, h[i])
+        h[k] = q
+    return h
+
+
+@njit(cache=True, nogil=True)
+def _top(h):
+    """The last nonzero component of an expansion (0.0 if there is none)."""
+    for i in range(h.shape[0] - 1, -1, -1):
+        if h[i] != 0.0:
+            return h[i]
+    return 0.0
+
+
+@njit(cache=True, nogil=True)
 def _exact_orientation(ax, ay, bx, by, cx, cy):
     """The sign of the orientation summed exactly (see the module's docstring)."""
     mx = max(abs(ax), abs(bx), abs(cx))
@@ -86,40 +110,42 @@ def _exact_orientation(ax, ay, bx, by, cx, cy):
     v[4] = math.ldexp(cx, sx)
     v[5] = math.ldexp(cy, sy)
     # det = ax·by − ax·cy − ay·bx + ay·cx + bx·cy − by·cx
-    terms = np.empty(12)
+    big = np.zeros(12)
+    tiny = np.zeros(12)  # the products below 2**-960, each times 2**1000
     pairs = ((0, 3, 1.0), (0, 5, -1.0), (1, 2, -1.0), (1, 4, 1.0), (2, 5, 1.0), (3, 4, -1.0))
     m = 0
     for p, q, s in pairs:
         x, y = _two_product(v[p], v[q])
-        if x != 0.0 and abs(x) < _BOTTOM or x == 0.0 and v[p] != 0.0 and v[q] != 0.0:
-            return UNDECIDED  # (the product's rounding error would underflow)
-        terms[m] = s * x
-        terms[m + 1] = s * y
+        if abs(x) < _BOTTOM and v[p] != 0.0 and v[q] != 0.0:
+            x, y = _two_product(math.ldexp(v[p], _LIFT), math.ldexp(v[q], _LIFT))
+            tiny[m] = s * x
+            tiny[m + 1] = s * y
+        else:
+            big[m] = s * x
+            big[m + 1] = s * y
         m += 2
-    # Grow a nonoverlapping expansion one term at a time (Shewchuk's Grow-Expansion):
-    # its components increase in magnitude, so its sign is that of the last nonzero one.
-    h = np.zeros(12)
-    n = 0
-    for k in range(12):
-        q = terms[k]
-        for i in range(n):
-            q, h[i] = _two_sum(q, h[i])
-        h[n] = q
-        n += 1
-    for i in range(n - 1, -1, -1):
-        if h[i] > 0.0:
-            return 1
-        if h[i] < 0.0:
-            return -1
-    return 0
+    e = _expansion(big)
+    t = _expansion(tiny)
+    top = _top(e)
+    low = _top(t)
+    if top == 0.0 or low == 0.0:
+        top = top if top != 0.0 else low
+        return 0 if top == 0.0 else (1 if top > 0.0 else -1)
+    # |E| > |top| / 2 and |T| < 2 |low| 2**-1000: E decides unless it is as small as T
+    if math.ldexp(abs(top), 2 * _LIFT) > 4.0 * abs(low):
+        return 1 if top > 0.0 else -1
+    both = np.empty(24)  # (E is below 2**-955 here: lifting it by 2**1000 is exact)
+    for i in range(12):
+        both[i] = math.ldexp(e[i], 2 * _LIFT)
+        both[12 + i] = t[i]
+    top = _top(_expansion(both))
+    return 0 if top == 0.0 else (1 if top > 0.0 else -1)
 
 
 @njit(cache=True, nogil=True)
 def orientation(ax, ay, bx, by, cx, cy):
     """The exact sign of the orientation of a, b, c: 1 when c is left of the line from
-    a to b, -1 right, 0 on it; :data:`UNDECIDED` (3) when the nonzero x and y
-    coordinates both span more than about 2**985 in magnitude (see the module's
-    docstring)."""
+    a to b, -1 right, 0 on it."""
     left = (ax - cx) * (by - cy)
     right = (ay - cy) * (bx - cx)
     det = left - right
@@ -147,20 +173,15 @@ def segments_meet(ax, ay, bx, by, cx, cy, dx, dy):
 
     ``kind`` is 0 when they do not meet, 1 when they touch (an end of one lies on the
     other, collinear overlaps included), 2 when they cross properly (each has its ends
-    strictly on both sides of the other's line), and :data:`UNDECIDED` when an
-    orientation is (see :func:`orientation`). ``(x, y)`` is where: the touching end, or
-    the crossing point (rounded).
+    strictly on both sides of the other's line). ``(x, y)`` is where: the touching end,
+    or the crossing point (rounded).
     """
     o1 = orientation(ax, ay, bx, by, cx, cy)
     o2 = orientation(ax, ay, bx, by, dx, dy)
-    if o1 == UNDECIDED or o2 == UNDECIDED:
-        return UNDECIDED, 0.0, 0.0
     if o1 == o2 and o1 != 0:
         return 0, 0.0, 0.0
     o3 = orientation(cx, cy, dx, dy, ax, ay)
     o4 = orientation(cx, cy, dx, dy, bx, by)
-    if o3 == UNDECIDED or o4 == UNDECIDED:
-        return UNDECIDED, 0.0, 0.0
     if o3 == o4 and o3 != 0:
         return 0, 0.0, 0.0
     if o1 != 0 and o2 != 0 and o3 != 0 and o4 != 0:

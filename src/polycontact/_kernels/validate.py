@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .predicates import UNDECIDED, collinear_overlap, orientation, segments_meet
+from .predicates import collinear_overlap, orientation, segments_meet
 
 
 #: Defect codes returned by :func:`first_defect`.
@@ -19,8 +19,6 @@ SELF_INTERSECTION = 1  # two edges of one loop meet away from their shared verte
 LOOPS_CROSS = 2  # edges of two different loops cross or overlap
 SPIKE = 3  # two consecutive edges fold back on each other
 ZERO_AREA = 4  # every vertex of a loop lies on one line
-#: An orientation the exact sum cannot decide (coordinates spanning over 2**950).
-UNDECIDABLE = 5
 
 
 @njit(cache=True, nogil=True)
@@ -39,9 +37,8 @@ def _side(a, b):
 
 @njit(cache=True, nogil=True)
 def _collinear_loop(xy, s, e):
-    """``(code, k)``: code 1 when every vertex of the loop in rows ``s:e`` lies on the
-    line through its first vertex and its farthest one, 0 when not (then ``k`` is a
-    vertex off it), :data:`UNDECIDED` when some orientation is."""
+    """Every vertex of the loop in rows ``s:e`` lies on the line through its first
+    vertex and its farthest one."""
     ax, ay = xy[s, 0], xy[s, 1]
     far = s
     best = -1.0
@@ -52,12 +49,9 @@ def _collinear_loop(xy, s, e):
             far = i
     bx, by = xy[far, 0], xy[far, 1]
     for i in range(s + 1, e):
-        o = orientation(ax, ay, bx, by, xy[i, 0], xy[i, 1])
-        if o == UNDECIDED:
-            return UNDECIDED, i
-        if o != 0:
-            return 0, i
-    return 1, s
+        if orientation(ax, ay, bx, by, xy[i, 0], xy[i, 1]) != 0:
+            return False
+    return True
 
 
 @njit(cache=True, nogil=True)
@@ -66,8 +60,7 @@ def first_defect(xy, starts):
 
     Returns ``(code, loop_i, edge_i, loop_j, edge_j, x, y)`` with ``code`` one of
     ``OK``, ``SELF_INTERSECTION``, ``LOOPS_CROSS``, ``SPIKE``, ``ZERO_AREA`` (then
-    ``loop_i`` is the loop), ``UNDECIDABLE`` (edges ``edge_i`` and ``edge_j`` of the
-    loops named). Edges are swept in order of their smallest x, so the cost is
+    ``loop_i`` is the loop). Edges are swept in order of their smallest x, so the cost is
     O(E log E + pairs whose boxes overlap). Two loops may touch at isolated points
     (OGC-valid); one loop may touch itself nowhere, and no two consecutive edges may
     overlap (fold back). ``(x, y)`` is where (the touching vertex, or a crossing point
@@ -75,11 +68,8 @@ def first_defect(xy, starts):
     """
     n_loops = starts.shape[0] - 1
     for k in range(n_loops):
-        code, v = _collinear_loop(xy, starts[k], starts[k + 1])
-        if code == 1:
-            return ZERO_AREA, k, 0, k, 0, xy[v, 0], xy[v, 1]
-        if code == UNDECIDED:
-            return UNDECIDABLE, k, 0, k, v - starts[k], xy[v, 0], xy[v, 1]
+        if _collinear_loop(xy, starts[k], starts[k + 1]):
+            return ZERO_AREA, k, 0, k, 0, xy[starts[k], 0], xy[starts[k], 1]
     n_edges = xy.shape[0]
     loop_of = np.empty(n_edges, np.int64)
     xmin = np.empty(n_edges)
@@ -127,14 +117,10 @@ def first_defect(xy, starts):
                     first = i if j == i1 else j
                     second = j if j == i1 else i
                     return SPIKE, k, first - s, k, second - s, qx, qy
-                if o == UNDECIDED:
-                    return UNDECIDABLE, k, i - s, k, j - s, qx, qy
                 continue
             kind, x, y = segments_meet(ax, ay, bx, by, cx, cy, dx, dy)
             if kind == 0:
                 continue
-            if kind == UNDECIDED:
-                return UNDECIDABLE, k, i - s, kj, j - sj, ax, ay
             if kj == k:
                 a_, b_ = (i, j) if i < j else (j, i)
                 return SELF_INTERSECTION, k, a_ - s, k, b_ - s, x, y
@@ -159,8 +145,7 @@ def loop_signs(xy, starts):
     """The exact orientation of each loop (1 counter-clockwise, -1 clockwise), for
     loops that :func:`first_defect` found valid: the turn at the loop's lowest vertex
     (smallest y, then smallest x), which is a vertex of its convex hull and has no
-    straight angle there (the loop would fold back). :data:`UNDECIDED` where that
-    orientation is."""
+    straight angle there (the loop would fold back)."""
     n_loops = starts.shape[0] - 1
     out = np.empty(n_loops, np.int64)
     for k in range(n_loops):
