@@ -376,7 +376,7 @@ class Shape:
             nxt[s:e] = np.roll(np.arange(s, e), -1)
         cross = x * y[nxt] - x[nxt] * y
         a2 = float(cross.sum())
-        if a2 > _area_rounding(x, y, nxt, hi - lo):
+        if _area_clear(a2, x, y, nxt, hi - lo):
             centroid = [origin[0] + float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
                         origin[1] + float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
         else:  # a sliver, or a body rounded away: only the exact sums can tell
@@ -904,17 +904,21 @@ def _check_loops(loops: list[np.ndarray]) -> np.ndarray:
     return np.asarray(kv.loop_signs(xy, starts))
 
 
-def _area_rounding(x: np.ndarray, y: np.ndarray, nxt: np.ndarray, span: np.ndarray) -> float:
-    """A bound on the rounding of twice the area summed from ``x``, ``y`` (coordinates
-    less the first vertex's, which rounds them by 2**-53 of themselves) over the edges
-    i -> ``nxt[i]``: (n + 8) × 2**-52 × the sum of the products' magnitudes. ``span``
-    (the bounding box's sides) bounds that sum cheaply first."""
+def _area_clear(a2: float, x: np.ndarray, y: np.ndarray, nxt: np.ndarray,
+                span: np.ndarray) -> bool:
+    """Whether twice the area ``a2``, summed in floats from ``x``, ``y`` (coordinates less
+    the first vertex's, which rounds them by 2**-53 of themselves) over the edges
+    i -> ``nxt[i]``, is positive beyond its rounding: (n + 8) × 2**-52 × the sum of the
+    products' magnitudes, bounded first by the bounding box's sides ``span`` (two
+    multiplications), then, where that is not enough, summed."""
     n = len(x)
     unit = (n + 8) * 2.0**-52
     cheap = unit * 2.0 * n * float(span[0]) * float(span[1])
+    if a2 > cheap:
+        return True
     if cheap < 2.0**-1000:
-        return np.inf  # (products near underflow: the exact sums decide)
-    return min(cheap, unit * float(np.abs(x * y[nxt]).sum() + np.abs(x[nxt] * y).sum()))
+        return False  # (products near underflow: the exact sums decide)
+    return a2 > unit * float(np.abs(x * y[nxt]).sum() + np.abs(x[nxt] * y).sum())
 
 
 def _exact_area_centroid(xy: np.ndarray, nxt: np.ndarray) -> tuple[float, list[float]]:
