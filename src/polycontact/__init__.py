@@ -64,6 +64,7 @@ _LAZY = {
     "World": "world",
     "Contacts": "world",
     "Query": "world",
+    "Sweep": "world",
     # nesting instances and NFP tables
     "Instance": "esicup",
     "read_esicup": "esicup",

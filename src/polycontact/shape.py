@@ -726,10 +726,13 @@ def _polygon_loops(poly: Any) -> list[np.ndarray]:
 def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The map of loops already in the caller's numbering (see :func:`_input_maps`)."""
     local = np.arange(int(starts[-1]), dtype=np.int64) - np.repeat(starts[:-1], np.diff(starts))
-    return (_frozen(np.arange(len(starts) - 1)), _frozen(np.stack([local, local], axis=1)))
+    return (frozen_ints(np.arange(len(starts) - 1)),
+            frozen_ints(np.stack([local, local], axis=1)))
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
+def frozen_ints(a: np.ndarray) -> np.ndarray:
+    """``a`` as a C-contiguous int64 array (copied only when it is not one), made
+    read-only."""
     a = np.ascontiguousarray(a, dtype=np.int64)
     a.flags.writeable = False
     return a
@@ -773,7 +776,7 @@ def _input_maps(
             raise RuntimeError("internal error: the map to the caller's numbering does not "
                                "follow _clean_ring")
         maps.append(m)
-    return _frozen(np.arange(len(maps))), _frozen(np.concatenate(maps))
+    return frozen_ints(np.arange(len(maps))), frozen_ints(np.concatenate(maps))
 
 
 def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike], grid: float) -> tuple[Any, ...]:
@@ -810,7 +813,7 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike], grid: float) -> tup
                                            _to_segment(ring[(i + 1) % len(ring)], s, e)) <= eps:
                     rows[-1][i, 1] = c
                     break
-    return _frozen(np.array(loop_map)), _frozen(np.concatenate(rows))
+    return frozen_ints(np.array(loop_map)), frozen_ints(np.concatenate(rows))
 
 
 class _VertexFinder:

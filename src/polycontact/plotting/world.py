@@ -57,7 +57,7 @@ def plot_contacts(contacts: Any, ax: Any = None) -> Any:
     touch: list[Any] = []
     deep: list[Any] = []
     for k, state in enumerate(contacts.states.tolist()):
-        point = contacts.relation(k).point
+        point = contacts.relation(k).point if state else None  # (0: a pair near, apart)
         if point is not None:
             (touch if state == 1 else deep).append(point)
     if touch:
