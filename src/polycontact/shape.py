@@ -616,7 +616,7 @@ class Shape:
             number = np.array([0] + [k + 1 for k in kept])
             loops = shape._input[0]
             object.__setattr__(shape, "_input", (
-                _frozen(np.where(loops < 0, -1, number[np.maximum(loops, 0)])),
+                frozen_ints(np.where(loops < 0, -1, number[np.maximum(loops, 0)])),
                 shape._input[1]))
         return shape
 

@@ -163,9 +163,9 @@ def ring_is_simple_unswept(xy, n, eps):
 def _ring_is_simple(xy, n, eps):
     """No two edges of the ring come within eps of each other except consecutive ones
     at their shared vertex, and no two consecutive edges fold back within eps: the rules
-    of ``validate.first_defect`` for one loop, with a margin of eps. Rings certified by :func:`_star_ring_is_simple` (convex ones, and most
-    star-shaped ones) pass in O(n); other short rings test every pair, long ones sweep
-    edges sorted by xmin."""
+    of ``validate.first_defect`` for one loop, with a margin of eps. Rings certified by
+    :func:`_star_ring_is_simple` (convex ones, and most star-shaped ones) pass in O(n);
+    other short rings test every pair, long ones sweep edges sorted by xmin."""
     known = ring_is_simple_unswept(xy, n, eps)
     if known >= 0:
         return known == 1
