@@ -546,8 +546,9 @@ def classify(a: ShapeLike, b: ShapeLike, *, tolerance: float | None = None) -> R
         The bodies, in any form :func:`polycontact.shape.as_shape` takes. An array is an
         outer loop (closed or not, either orientation).
         C-contiguous float64 arrays take a lean path: one compiled call validates both
-        rings and classifies them; only an invalid ring goes through :class:`Shape`
-        (which explains the defect, or cleans repeated vertices).
+        rings and classifies them; a ring it cannot certify (an invalid one, or a valid
+        one with features closer than the tolerance) goes through :class:`Shape`, which
+        decides exactly, explains the defect, or cleans repeated vertices.
     tolerance : float, optional
         Absolute tolerance; distances up to it count as touching. Default:
         :func:`polycontact.default_tolerance` of both bodies: ``max(1e-12 × the larger
@@ -729,7 +730,8 @@ def _classify_arrays(
     arr_a: np.ndarray, arr_b: np.ndarray, tol: float
 ) -> RelationBatch | None:
     """:func:`classify_many` of two (P, N, 2) ring arrays in one kernel pass per thread;
-    None if some ring is not valid as given (the caller then explains through ``Shape``)."""
+    None if some ring is not certified valid as given (the caller then decides and
+    explains through ``Shape``)."""
     from ._kernels import relation_many as km
 
     out = km.raw_states_outputs(arr_a.shape[0])
