@@ -542,8 +542,9 @@ def classify(a: ShapeLike, b: ShapeLike, *, tolerance: float | None = None) -> R
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon, or array_like of shape (N, 2)
-        The bodies. An array is an outer loop (closed or not, either orientation).
+    a, b : ShapeLike
+        The bodies, in any form :func:`polycontact.shape.as_shape` takes. An array is an
+        outer loop (closed or not, either orientation).
         C-contiguous float64 arrays take a lean path: one compiled call validates both
         rings and classifies them; a ring it cannot certify (an invalid one, or a valid
         one with features closer than the tolerance) goes through :class:`Shape`, which
