@@ -82,6 +82,7 @@ def extreme_points(draw):
 
 @given(extreme_points())
 @examples(400)
+@example((5e-324, 1.0, 1.0, 5e-324, 0.5, 0.5000000000000001))  # huge and subnormal products together
 def test_orientation_is_exact_at_the_ends_of_the_range(points):
     assert kp.orientation(*points) == _exact(*points)
 
