@@ -109,7 +109,7 @@ def _check_packed(bxy, bst, r, ast):
     ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
     assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
     if len(cand):
-        cand = _exact_candidates(cand, int(n_pts), *kmink.convex_sums(bxy, bst, r, ast), eps)
+        cand = _exact_candidates(cand, int(n_pts), *kmink.convex_sums(bxy, bst, r, ast)[:2], eps)
     assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
     for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
                     (ring_xy, ring_starts, stats, cand)):

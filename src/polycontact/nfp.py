@@ -527,7 +527,7 @@ def _entrance_result(
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = _kernels().minkowski.convex_sums(*pieces())
+        sums, starts, _ = _kernels().minkowski.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     if not n_cand:
@@ -680,5 +680,9 @@ def _clean_degenerate(
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
+    if len(pts) > 1:
+        # the same exact fit, found on every edge through it, is verified once (the
+        # first of equal points is the one the selection would keep)
+        pts = pts[np.sort(np.unique(pts, axis=0, return_index=True)[1])]
     fits, slides = make_select()(pts, segs, HOLE_WIDTH_FACTOR * eps)
     return (fits if len(fits) else _NO_FITS), (slides if len(slides) else _NO_SLIDES)

@@ -41,7 +41,7 @@ from numba import njit, prange
 from .convolution import FEW_VERTICES, contact_depth, penetrates
 from .decompose import ring_pieces
 from .minkowski import (GRID, GRID_MIN_SUMS, boxes, clip_edge, frames, in_some_sum, lowest,
-                        sum_index, sum_into)
+                        no_flags, sum_index, sum_into)
 from .packs import scratch_floats
 from .primitives import bbox, origin_distance_sq_framed, origin_foot
 from .relation_many import body, oriented
@@ -122,11 +122,12 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     starts = np.empty(pairs.shape[0] + 1, np.int64)
     starts[0] = 0
     w = 0
+    flags = no_flags()
     for k in range(pairs.shape[0]):
         ps = bstarts[pairs[k, 0]]
         pe = bstarts[pairs[k, 0] + 1]
         w = sum_into(bxy, ps, pe, lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
-                     rstarts[pairs[k, 1] + 1], out, w)
+                     rstarts[pairs[k, 1] + 1], out, w, flags)
         starts[k + 1] = w
     return out[:w].copy(), starts
 
@@ -238,7 +239,7 @@ def _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_fr
     by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
     sums = (xy, starts, bb, fr)
-    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, grid_from)
+    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, eps, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = deepest
     found = False

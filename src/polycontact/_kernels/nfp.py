@@ -15,7 +15,7 @@ from numba import njit
 
 from .decompose import ring_pieces
 from .fits import degenerate_contacts, exact_candidates
-from .minkowski import boxes, convex_sums, frames
+from .minkowski import boxes, convex_sums, frames, mark_inner
 from .outline import (assemble_rings, closed_loops, edge_cover, ring_stats, tidy_rings,
                       without_collinear)
 from .tolerance import tolerance_of
@@ -51,7 +51,7 @@ def _finite(xy):
 @njit(cache=True, nogil=True)
 def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
-    sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
+    sums, starts, keep = convex_sums(bxy, bstarts, rxy, rstarts)
     if not _finite(sums):
         # error code, not a crash: the caller refuses the input
         meta = np.array([1.0, -1.0, 0.0])
@@ -69,6 +69,7 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
                 np.empty((0, 4)), meta)
     bb = boxes(sums, starts)
     fr = frames(sums, starts)
+    mark_inner(fr, keep)  # (edges off the reduced convolution: none of the outline)
     outline, loose = edge_cover(sums, starts, bb, fr, eps)
     ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
     ring_xy, ring_starts = tidy_rings(ring_xy, ring_starts, sums, eps)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .minkowski import GRID, clip_edge, sum_index
+from .minkowski import EDGE, GRID, clip_edge, sum_index
 from .primitives import append_part, closest_on_segment
 
 #: Outline coordinates within this many units of 2**-52 of the sums' largest
@@ -23,7 +23,8 @@ SNAP_ULPS = 4.0
 
 @njit(cache=True, nogil=True)
 def edge_cover(xy, starts, bb, fr, eps):
-    """Uncovered parts of the sums' edges.
+    """Uncovered parts of the sums' edges (those marked ``EDGE`` in the frames ``fr``:
+    an ``INNER_EDGE``, off the reduced convolution, has none).
 
     Returns ``(outline, loose)``, both (M, 4) segments x0, y0, x1, y1:
     ``outline`` are the parts in no other sum's interior and on no seam, each kept once:
@@ -43,7 +44,7 @@ def edge_cover(xy, starts, bb, fr, eps):
     gy0 = bb[:, 1].min()
     h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / GRID
     sums = (xy, starts, bb, fr)
-    index = sum_index(sums, gx0, gy0, h)
+    index = sum_index(sums, gx0, gy0, h, eps)
     lo1, hi1, lo0, hi0 = index[-4:]
     for p in range(k):
         s = starts[p]
@@ -52,7 +53,7 @@ def edge_cover(xy, starts, bb, fr, eps):
             j = i + 1 if i + 1 < e else s
             ax, ay = xy[i, 0], xy[i, 1]
             bx, by = xy[j, 0], xy[j, 1]
-            if ax == bx and ay == by:
+            if fr[i, 3] != EDGE or (ax == bx and ay == by):
                 continue
             n1, n0, hint = clip_edge(sums, index, p, ax, ay, bx, by, 0.0, 1.0, eps, hint)
             dx = bx - ax
