@@ -139,7 +139,7 @@ def bench_broad_phase(sizes: list[int], repeats: int) -> None:
         grid = w._grid()
 
         def ours():
-            return kw.candidate_pairs(grid, w._box, w._eps, -1.0, alive, w._next)
+            return kw.candidate_pairs(grid, w._box, w._eps, -1.0, alive, w._next, 0.0)
 
         box = np.ascontiguousarray(w._box[alive])
         ours()

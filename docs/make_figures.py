@@ -32,9 +32,13 @@ READABLE = {"font.size": 15, "axes.titlesize": 16, "axes.labelsize": 15,
             "xtick.labelsize": 13, "ytick.labelsize": 13, "savefig.bbox": "tight",
             "savefig.pad_inches": 0.1}
 
+#: (figure file, example script, its options): figures the examples draw themselves.
+SCRIPTS = [("dem-hopper.png", "dem_hopper.py", [])]
+
 
 def main(out: Path) -> None:
-    """Write every figure of :data:`FIGURES` into ``out`` (a directory)."""
+    """Write every figure of :data:`FIGURES` and :data:`SCRIPTS` into ``out`` (a
+    directory)."""
     import contextlib
     import io
 
@@ -49,6 +53,12 @@ def main(out: Path) -> None:
             status = cli(args)
         if status != 0:
             raise RuntimeError(f"polycontact {' '.join(args)} exited with {status}")
+    import runpy
+
+    for name, script, options in SCRIPTS:
+        example = runpy.run_path(str(EXAMPLES / script))
+        with contextlib.redirect_stdout(io.StringIO()):
+            example["main"]([*options, "--out", str(out / name)])
 
 
 if __name__ == "__main__":

@@ -98,16 +98,22 @@ _SQ = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 
 def test_contact_depth_refuses_segments_that_run_together_and_the_search_answers():
     # Two squares: the sides of B ⊕ (−A) are each made of two collinear segments that
-    # overlap (a slide: where their contacts part is known only to the rounding). From
-    # the box's escape (farther than those sides) the kernel refuses; the depth is then
-    # the search's, by the pairwise and the batch calls alike.
+    # overlap (a slide: where their contacts part is known only to the rounding). The
+    # nearest segment's foot is tried first: it escapes, so it is the depth, with no
+    # split. A square in an L's corner: the nearest foot does not escape, and splitting
+    # the collinear segments is refused; the depth is then the search's, by the
+    # pairwise and the batch calls alike.
     a, b = pc.Shape(_SQ), pc.Shape(_SQ + [0.75, 0.6])
-    assert np.isnan(_contact(a, b, 1e-12, (3.0, 3.0, 0.0))[0])
-    assert not _contact(a, b, 1e-12, (3.0, 3.0, 0.0))[3]
-    rel = pc.classify(a, b)
-    assert -rel.distance == pytest.approx(0.25, abs=2 * rel.tolerance)
-    batch = pc.classify_many([_SQ, _SQ], [_SQ + [0.75, 0.6], _SQ + [0.5, 0.1]])
-    assert batch.distances == pytest.approx([-0.25, -0.5], abs=2 * batch.tolerances.max())
+    got = _contact(a, b, 1e-12, (3.0, 3.0, 0.0))
+    assert got[3] and got[0] == pytest.approx(0.25, abs=1e-12)
+    ell = np.array([(0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)], float) - [1.0, 0.75]
+    assert not _contact(a, pc.Shape(ell), 1e-12, (3.0, 3.0, 0.0))[3]
+    for b_ring, depth in ((_SQ + [0.75, 0.6], 0.25), (ell, 0.25)):
+        rel = pc.classify(a, b_ring)
+        assert -rel.distance == pytest.approx(depth, abs=2 * rel.tolerance)
+    batch = pc.classify_many([_SQ, _SQ, _SQ], [_SQ + [0.75, 0.6], _SQ + [0.5, 0.1], ell])
+    assert batch.distances == pytest.approx([-0.25, -0.5, -0.25],
+                                            abs=2 * batch.tolerances.max())
 
 
 def test_contact_depth_refuses_a_first_escape_that_does_not_escape():

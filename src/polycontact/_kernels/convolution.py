@@ -40,7 +40,8 @@ import numpy as np
 from numba import njit
 
 from .packs import scratch_floats, state_scratch_views
-from .primitives import bbox, grow_rows, norm, origin_distance_sq, origin_foot
+from .primitives import (bbox, grow_rows, loop_next, loop_prev, norm, origin_distance_sq,
+                         origin_foot)
 from .relation import PENETRATING, state_in
 
 
@@ -59,60 +60,60 @@ _SIN_PARALLEL = 1.0 / 64.0
 _SIN_SLACK = 1e-6
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _next(i, starts, k):
-    return i + 1 if i + 1 < starts[k + 1] else starts[k]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _prev(i, starts, k):
-    return i - 1 if i > starts[k] else starts[k + 1] - 1
-
-
 @njit(cache=True, nogil=True)
-def _edges(x, st):
-    """Each edge's direction and length (rows ``(gx, gy, length)``, edge i from vertex
-    i to the next of its loop) and each vertex's successor."""
-    e = np.empty((x.shape[0], 3))
-    nxt = np.empty(x.shape[0], np.int64)
+def _edges_into(x, st, e, nxt):
+    """Each edge's direction and length (rows ``(gx, gy, length)`` of ``e``, edge i from
+    vertex i to the next of its loop) and each vertex's successor (``nxt``)."""
     for k in range(st.shape[0] - 1):
         for i in range(st[k], st[k + 1]):
-            j = _next(i, st, k)
+            j = loop_next(i, st, k)
             nxt[i] = j
             e[i, 0] = x[j, 0] - x[i, 0]
             e[i, 1] = x[j, 1] - x[i, 1]
             e[i, 2] = np.sqrt(e[i, 0] * e[i, 0] + e[i, 1] * e[i, 1])
-    return e, nxt
 
 
 @njit(cache=True, nogil=True)
-def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
+def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
     """Append the kept segments of the vertices of one body (``xv``, loop starts ``sv``,
-    edges ``ev`` of :func:`_edges`) against the edges of the other (``xe``, edges
+    edges ``ev`` of :func:`_edges_into`) against the edges of the other (``xe``, edges
     ``ee``, successors ``ne``) nearer than ``bound``: rows ``(x0, y0, x1, y1, squared
-    distance)`` of translations of A; ``sign`` +1 when the vertices are B's (``v − e``),
-    −1 when they are A's (``e − w``).
+    distance, side, vertex, edge)`` of translations of A; ``sign`` +1 when the vertices
+    are B's (``v − e``, side 1), −1 when they are A's (``e − w``, side 0).
 
     Kept: a vertex that may touch the edge (the other body's interior on its left)
     without overlap: convex, and both of its edges on the outer (right) side of the
     edge, each up to :data:`_SIN_SLACK` and ``slack`` (an absolute allowance for the
-    rounding of the coordinates) in the cross products.
+    rounding of the coordinates) in the cross products. ``near`` (one entry per vertex
+    of the other body) is scratch.
     """
     b2 = bound * bound
     # (the segments of vertex i lie in the box of v_i - (the other body's box))
     ex0, ex1, ey0, ey1 = bbox(xe, xe.shape[0])
+    # only the edges whose boxes come within bound of V's box can hold one: listed in
+    # ``near`` (the rest are farther than bound from every vertex of V)
+    vx0, vx1, vy0, vy1 = bbox(xv, xv.shape[0])
+    m = 0
+    for j in range(xe.shape[0]):
+        jj = ne[j]
+        if (min(xe[j, 0], xe[jj, 0]) < vx1 + bound and max(xe[j, 0], xe[jj, 0]) > vx0 - bound
+                and min(xe[j, 1], xe[jj, 1]) < vy1 + bound
+                and max(xe[j, 1], xe[jj, 1]) > vy0 - bound):
+            near[m] = j
+            m += 1
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
             gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])
             gapy = max(0.0, xv[i, 1] - ey1, ey0 - xv[i, 1])
             if gapx * gapx + gapy * gapy >= b2:
                 continue
-            p = _prev(i, sv, k)
+            p = loop_prev(i, sv, k)
             ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
             vx, vy, lv = ev[i, 0], ev[i, 1], ev[i, 2]
             if (ux * vy - uy * vx) < -(_SIN_SLACK * lu * lv + slack * (lu + lv)):
                 continue  # reflex: its wedge overlaps any edge it touches
-            for j in range(xe.shape[0]):
+            for t in range(m):
+                j = near[t]
                 gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
                 if ((gx * vy - gy * vx) > _SIN_SLACK * lg * lv + slack * (lg + lv)
                         or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
@@ -129,6 +130,9 @@ def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n):
                     seg[n, 2] = x1
                     seg[n, 3] = y1
                     seg[n, 4] = d
+                    seg[n, 5] = 0.5 + 0.5 * sign
+                    seg[n, 6] = i
+                    seg[n, 7] = j
                     n += 1
     return n
 
@@ -215,6 +219,20 @@ def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
 
 
 @njit(cache=True, nogil=True)
+def _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+    """Whether A moved by p = (px, py), a point at distance d of a contact segment, ends
+    the overlap, up to the tolerance: first tried 2 ``eps`` further along p (the bodies
+    apart there by about ``eps`` where p makes them touch: the state kernel's cheaper
+    case, no touch to look into), then at p itself. Every translation nearer than p
+    having been found to penetrate, either makes p the depth within 2 ``eps``."""
+    if d > 0.0:
+        f = 1.0 + 2.0 * eps / d
+        if not penetrates(xa, sa, xb, sb, px * f, py * f, eps, moved, scratch):
+            return True
+    return not penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch)
+
+
+@njit(cache=True, nogil=True)
 def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     """Penetration depth of A into B from the contact segments: ``(depth, dx, dy, ok)``.
 
@@ -247,38 +265,79 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
     nb = xb.shape[0]
     if m + nb > FEW_VERTICES:
         return np.nan, np.nan, np.nan, False
+    got = contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, 0.0, depth_buffers(m, nb))
+    return got[0], got[1], got[2], got[3]
+
+
+@njit(cache=True, nogil=True)
+def depth_buffers(m, n):
+    """Scratch of :func:`contact_depth_into` for bodies of up to ``m`` and ``n``
+    vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near)``."""
+    k = 2 * m * n
+    return (np.empty((k, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
+            np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 3)),
+            np.empty(m, np.int64), np.empty((n, 3)), np.empty(n, np.int64),
+            np.empty(max(m, n), np.int64))
+
+
+@njit(cache=True, nogil=True)
+def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
+    """:func:`contact_depth` with its scratch (:func:`depth_buffers`, for at least the
+    bodies' vertex counts) passed in, so that a loop over pairs allocates nothing, and
+    ``low``, a length below which every translation is known to leave the bodies
+    penetrating (their points nearer are not tested; 0: none known). Returns
+    ``(depth, dx, dy, ok, side, vertex, edge)``: with the depth, the contact segment it
+    lies on, the vertex of one body brought onto the edge of the other (side 0: a vertex
+    of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows of each
+    body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
+    seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near = buffers
+    m = xa.shape[0]
+    nb = xb.shape[0]
     tol = 4.0 * eps
-    ea, nxa = _edges(xa, sa)
-    eb, nxb = _edges(xb, sb)
-    seg = np.empty((2 * m * nb, 5))
-    n = _add_segments(xb, sb, eb, xa, ea, nxa, 1.0, bound, eps, seg, 0)
-    n = _add_segments(xa, sa, ea, xb, eb, nxb, -1.0, bound, eps, seg, n)
+    _edges_into(xa, sa, ea[:m], nxa[:m])
+    _edges_into(xb, sb, eb[:nb], nxb[:nb])
+    n = _add_segments(xb, sb, eb[:nb], xa, ea[:m], nxa[:m], 1.0, bound, eps, seg, 0, near)
+    n = _add_segments(xa, sa, ea[:m], xb, eb[:nb], nxb[:nb], -1.0, bound, eps, seg, n, near)
+    moved = moved[:m]
     # Segments and pieces are taken in increasing distance (a linear scan each time:
     # a few of each): a segment is split when it is the nearest thing left, each piece
     # then waits for its turn, and the first piece point that escapes is the depth.
     for s in range(n):
         seg[s, 4] = np.sqrt(seg[s, 4])
-    todo = np.ones(n, np.bool_)
-    cap = 8 * n + 8
-    pts = np.empty((cap, 4))  # rows (distance, x, y, 1.0 once tried)
+    # (pieces' "tried" flags: column 3; the segment index: column 4; a segment is done
+    # once its distance is set negative)
     c = 0
-    ts = np.empty(2 * n + 2)
-    moved = np.empty_like(xa)
-    scratch = np.empty(scratch_floats(m + nb))
+    # The nearest segment's foot first: the nearest point of all, so the depth if it
+    # escapes (it then needs no split, which nearly parallel segments running together,
+    # as a flat face pressed on another, would refuse). Else it is kept as tried.
+    s = -1
+    for q in range(n):
+        if s < 0 or seg[q, 4] < seg[s, 4]:
+            s = q
+    if s >= 0 and low <= seg[s, 4] < bound:
+        px, py, d = origin_foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
+        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+            return d, px, py, True, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
+        pts[0, 0] = d
+        pts[0, 1] = px
+        pts[0, 2] = py
+        pts[0, 3] = 1.0
+        pts[0, 4] = s
+        c = 1
     while True:
         s = -1
         for q in range(n):
-            if todo[q] and (s < 0 or seg[q, 4] < seg[s, 4]):
+            if seg[q, 4] >= 0.0 and (s < 0 or seg[q, 4] < seg[s, 4]):
                 s = q
         r = -1
         for q in range(c):
             if pts[q, 3] == 0.0 and (r < 0 or pts[q, 0] < pts[r, 0]):
                 r = q
         if s >= 0 and (r < 0 or seg[s, 4] <= pts[r, 0]):
-            todo[s] = False
             k = _splits(seg, n, s, tol, ts)
+            seg[s, 4] = -1.0 - seg[s, 4]
             if k < 0:
-                return np.nan, np.nan, np.nan, False
+                return np.nan, np.nan, np.nan, False, -1, -1, -1
             c = _pieces(seg, s, ts, k, bound, pts, c)
             if c < 0:  # (more rows needed)
                 pts = grow_rows(pts)
@@ -288,13 +347,14 @@ def contact_depth(xa, sa, xb, sb, bound, bdx, bdy, eps):
             break
         d, px, py = pts[r, 0], pts[r, 1], pts[r, 2]
         pts[r, 3] = 1.0
-        if _tried(pts, c, r):
-            continue  # (an end shared by several pieces is tried once)
-        if not penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch):
-            return d, px, py, True
+        if d < low or _tried(pts, c, r):
+            continue  # (known to penetrate; an end shared by several pieces is tried once)
+        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+            q = int(pts[r, 4])
+            return d, px, py, True, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
     if penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
-        return np.nan, np.nan, np.nan, False
-    return bound, bdx, bdy, True
+        return np.nan, np.nan, np.nan, False, -1, -1, -1
+    return bound, bdx, bdy, True, -1, -1, -1
 
 
 @njit(cache=True, nogil=True)
@@ -310,8 +370,8 @@ def _tried(pts, c, r):
 def _pieces(seg, s, ts, k, bound, pts, c):
     """Append to ``pts`` (from row c) the point nearest the origin of each piece of
     segment ``s`` between the ``k`` split parameters ``ts`` (and 0 and 1), when nearer
-    than ``bound``: the new row count, or ``-c - 1`` when ``pts`` is too small (nothing
-    written)."""
+    than ``bound``, as rows ``(distance, x, y, 0.0, s)``: the new row count, or
+    ``-c - 1`` when ``pts`` is too small (nothing written)."""
     ts[k] = 0.0
     ts[k + 1] = 1.0
     k += 2
@@ -337,7 +397,6 @@ def _pieces(seg, s, ts, k, bound, pts, c):
             pts[c, 1] = got[0]
             pts[c, 2] = got[1]
             pts[c, 3] = 0.0
+            pts[c, 4] = s
             c += 1
     return c
-
-

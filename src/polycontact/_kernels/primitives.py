@@ -2,8 +2,8 @@
 
 Orientation, norms and bounding boxes; the point of a segment nearest a point, and
 segment meets; the point of a segment nearest the origin (the depth kernels measure
-translations from it); a loop's next vertex; growing a row buffer. Each is the one
-copy the kernels share.
+translations from it); a loop's next and previous vertex; growing a row buffer. Each is
+the one copy the kernels share.
 
 >>> orient(0.0, 0.0, 1.0, 0.0, 0.0, 1.0), point_segment_distance(0.0, 1.0, -1.0, 0.0, 1.0, 0.0)
 (1.0, 1.0)
@@ -167,11 +167,22 @@ def origin_distance_sq_framed(ax, ay, bx, by, ux, uy, c):
     return c * c
 
 
+@njit(cache=True, nogil=True, inline="always")
+def loop_next(i, starts, k):
+    """The vertex after vertex i of loop k of packed loops ``starts``."""
+    return i + 1 if i + 1 < starts[k + 1] else starts[k]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def loop_prev(i, starts, k):
+    """The vertex before vertex i of loop k of packed loops ``starts``."""
+    return i - 1 if i > starts[k] else starts[k + 1] - 1
+
+
 @njit(cache=True, nogil=True)
 def next_vertex(i, starts, loop_of):
     """The vertex after vertex i in its loop (``loop_of``: :func:`loop_index`)."""
-    k = loop_of[i]
-    return i + 1 if i + 1 < starts[k + 1] else starts[k]
+    return loop_next(i, starts, loop_of[i])
 
 
 @njit(cache=True, nogil=True)

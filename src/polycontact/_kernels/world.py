@@ -15,6 +15,10 @@ adding, moving or removing a body touches one cell list (doubly linked through `
 and ``prv``). A box query visits, on every non-empty level, the cells whose widened
 bounds meet the box. Cell indices are clamped to ±2**25 about ``origin``: far cells
 merge (more candidates), never lose one.
+
+The kernels take the store as records: ``bodies`` = ``(xy, ls, lo, nl, box, eps)``, and
+the broad phase's ``grid`` = ``(keys, heads, nxt, level, lvl_count, levels, origin)``
+(``levels``: the level indices in use).
 """
 
 from __future__ import annotations
@@ -83,14 +87,20 @@ def _slot(keys, key):
     return h
 
 
-@njit(cache=True, nogil=True)
-def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
-    """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
+@njit(cache=True, nogil=True, inline="always")
+def _cell_key(box, b, origin):
+    """The level index of body ``b``'s box and the hash key of the cell that holds it."""
     idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
     c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
     ix = _cell(0.5 * (box[b, 0] + box[b, 1]) - origin[0], c)
     iy = _cell(0.5 * (box[b, 2] + box[b, 3]) - origin[1], c)
-    key = _key(idx, ix, iy)
+    return idx, _key(idx, ix, iy)
+
+
+@njit(cache=True, nogil=True)
+def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
+    """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
+    idx, key = _cell_key(box, b, origin)
     h = _slot(keys, key)
     made = 0
     if keys[h] == -1:
@@ -151,6 +161,26 @@ def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, ali
 
 
 @njit(cache=True, nogil=True)
+def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled):
+    """Move each body of ``ids`` (boxes already set) to the cell of its box, if it left
+    its own (a body that stays costs no index work), in a table holding ``filled``
+    cells; stops before it would be more than half full. Returns (cells made, bodies
+    done)."""
+    made = 0
+    limit = keys.shape[0] // 2
+    for k in range(ids.shape[0]):
+        b = ids[k]
+        key = _cell_key(box, b, origin)[1]
+        if slot[b] >= 0 and keys[slot[b]] == key:
+            continue
+        if filled + made + 1 > limit:
+            return made, k
+        grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
+        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
+    return made, ids.shape[0]
+
+
+@njit(cache=True, nogil=True)
 def _gather(grid, q0, q1, q2, q3, low, n_ids, cand):
     """Bodies whose cell in ``grid`` may hold a box meeting [q0, q1] x [q2, q3], on levels
     >= ``low``, written into ``cand``; returns how many. A level whose cell range is
@@ -196,10 +226,10 @@ def _meet(box, b, q0, q1, q2, q3):
 
 
 @njit(cache=True, nogil=True)
-def candidate_pairs(grid, box, eps, tol, alive, n_ids):
-    """Pairs (i, j) of live bodies whose boxes come within their tolerance: i < j on a
-    shared level, else i on the lower level. Returns (pi, pj). ``grid`` is the broad
-    phase's record (see the module's docstring)."""
+def candidate_pairs(grid, box, eps, tol, alive, n_ids, margin):
+    """Pairs (i, j) of live bodies whose boxes come within their tolerance plus
+    ``margin``: i < j on a shared level, else i on the lower level. Returns (pi, pj).
+    ``grid`` is the broad phase's record (see the module's docstring)."""
     level = grid[3]
     cap = 4 * alive.shape[0] + 16
     pi = np.empty(cap, np.int64)
@@ -213,7 +243,7 @@ def candidate_pairs(grid, box, eps, tol, alive, n_ids):
     n = 0
     for k in range(alive.shape[0]):
         i = alive[k]
-        ei = tol if tol >= 0.0 else eps[i]
+        ei = (tol if tol >= 0.0 else eps[i]) + margin
         d = ei + emax
         q0 = box[i, 0] - d
         q1 = box[i, 1] + d
@@ -243,7 +273,7 @@ def candidate_pairs(grid, box, eps, tol, alive, n_ids):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _view(xy, ls, lo, nl, b, buf):
+def body_view(xy, ls, lo, nl, b, buf):
     """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
     first = ls[lo[b]]
     m = nl[b]
@@ -273,8 +303,8 @@ def _classify_into(bodies, tol, pi, pj, k0, k1, out, scratch, ba, bb):
     for k in range(k0, k1):
         i = pi[k]
         j = pj[k]
-        ya, sa = _view(xy, ls, lo, nl, i, ba)
-        yb, sb = _view(xy, ls, lo, nl, j, bb)
+        ya, sa = body_view(xy, ls, lo, nl, i, ba)
+        yb, sb = body_view(xy, ls, lo, nl, j, bb)
         e = tol if tol >= 0.0 else max(eps[i], eps[j])
         used[k] = e
         states[k] = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
@@ -320,7 +350,7 @@ def _hazard_state(ya, sa, e, hazards, hbuf, scratch):
     hxy, hls, hlo, hnl, _, _ = hazards
     worst = 0
     for h in range(hnl.shape[0]):
-        yh, sh = _view(hxy, hls, hlo, hnl, h, hbuf)
+        yh, sh = body_view(hxy, hls, hlo, hnl, h, hbuf)
         s = state_in(ya, sa, 1.0, yh, sh, 1.0, e, scratch)
         if s > worst:
             worst = s
@@ -342,7 +372,7 @@ def container_states(bodies, tol, alive, hazards, vmax, lmax, hmax, chunks):
         hb = np.empty(hnl.max() + 1, np.int64)
         for k in range(n * c // chunks, n * (c + 1) // chunks):
             b = alive[k]
-            ya, sa = _view(xy, ls, lo, nl, b, ba)
+            ya, sa = body_view(xy, ls, lo, nl, b, ba)
             e = tol if tol >= 0.0 else max(eps[b], ceps)
             out[k] = _container_state(ya, sa, (box[b, 0], box[b, 1], box[b, 2], box[b, 3]),
                                       e, hazards, hb, scratch)
@@ -358,7 +388,7 @@ def _state_against(qxy, qs, qbox, qeps, j, bodies, tol, buf, scratch):
     e = tol if tol >= 0.0 else max(qeps, eps[j])
     if not _meet(box, j, x0 - e, x1 + e, y0 - e, y1 + e):
         return 0
-    yb, sb = _view(xy, ls, lo, nl, j, buf)
+    yb, sb = body_view(xy, ls, lo, nl, j, buf)
     return state_in(qxy, qs, 1.0, yb, sb, 1.0, e, scratch)
 
 

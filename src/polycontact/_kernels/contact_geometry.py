@@ -1,0 +1,420 @@
+"""Kernels: the geometry of many contacts at once — distance, normal, point, overlap.
+
+For each pair of bodies (packed as in :mod:`polycontact._kernels.world`), by its state:
+
+- **separate** (a near pair): the gap between the boundaries, the unit vector from A's
+  closest point to B's, their midpoint, and the vertex and edge that hold the gap;
+- **contact**: distance 0; the touch that :attr:`polycontact.Relation.normal` chooses
+  (a vertex within the tolerance of an edge of the other body, preferring one whose own
+  edges stay on their side of the edge, then the one farthest from the edge's ends),
+  its edge's normal from A towards B and the touching vertex;
+- **penetrating**: minus the penetration depth, the unit vector opposite A's smallest
+  escape, from the contact segment the escape lies on
+  (:func:`polycontact._kernels.convolution.contact_depth_into`), the vertex and edge of
+  that segment, the area and centroid of the overlap
+  (:func:`polycontact._kernels.overlap.overlap_moments`); the point is the segment's
+  vertex when it lies in the other body, else the crossing of the boundaries nearest
+  it. A pair whose depth that kernel cannot decide (bodies above
+  :data:`polycontact._kernels.convolution.FEW_VERTICES` vertices, contact segments that
+  run together) is left with a NaN distance, for the caller's search over convex sums.
+
+Vertices and edges come out as packed rows of each body; the caller maps them to its
+numbering. The bodies come as ``rows`` = ``(xy, ls, lo, nl)``, the packed rows of a
+World's bodies (the first four fields of its ``bodies`` record). The pairs run in
+parallel chunks (one chunk: serial, no thread start); each chunk allocates its scratch
+once.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from .convolution import FEW_VERTICES, contact_depth_into, depth_buffers
+from .depth import box_escape
+from .overlap import overlap_moments, overlap_scratch, where
+from .primitives import bbox, closest_on_segment, loop_next, loop_prev
+from .world import body_view
+
+SEPARATE = 0
+CONTACT = 1
+PENETRATING = 2
+
+
+@njit(cache=True, nogil=True)
+def closest_features(xa, sa, xb, sb):
+    """Closest points of the boundaries of two bodies that do not touch:
+    ``(gap, ax, ay, bx, by, side, vertex, edge)``, A's point (ax, ay) and B's (bx, by);
+    side 0 when the gap is from a vertex of A to an edge of B, 1 from a vertex of B to
+    an edge of A (packed rows). Vertices and edges whose boxes are farther than the
+    best gap found are skipped.
+
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> got = closest_features(sq, st, sq + np.array([3.0, 0.5]), st)
+    >>> [float(v) for v in got[:5]], got[5:]
+    ([2.0, 1.0, 1.0, 3.0, 1.0], (0, 2, 3))
+    """
+    best = np.inf
+    out = (np.inf, 0.0, 0.0, 0.0, 0.0, -1, -1, -1)
+    for side in range(2):
+        xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
+        nv = sv[sv.shape[0] - 1]
+        no = so[so.shape[0] - 1]
+        ox0, ox1, oy0, oy1 = bbox(xo, no)
+        for i in range(nv):
+            px = xv[i, 0]
+            py = xv[i, 1]
+            gx = max(0.0, px - ox1, ox0 - px)
+            gy = max(0.0, py - oy1, oy0 - py)
+            if gx * gx + gy * gy >= best * best:
+                continue
+            for ko in range(so.shape[0] - 1):
+                for f in range(so[ko], so[ko + 1]):
+                    f1 = loop_next(f, so, ko)
+                    ax, bx = xo[f, 0], xo[f1, 0]
+                    ay, by = xo[f, 1], xo[f1, 1]
+                    ex = max(0.0, px - max(ax, bx), min(ax, bx) - px)
+                    ey = max(0.0, py - max(ay, by), min(ay, by) - py)
+                    if ex * ex + ey * ey >= best * best:
+                        continue
+                    qx, qy, d2 = closest_on_segment(px, py, ax, ay, bx, by)
+                    d = np.sqrt(d2)
+                    if d < best:
+                        best = d
+                        if side == 0:
+                            out = (d, px, py, qx, qy, 0, i, f)
+                        else:
+                            out = (d, qx, qy, px, py, 1, i, f)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def touch(xa, sa, xb, sb, eps):
+    """The touch of two bodies in contact that :attr:`polycontact.Relation.normal`
+    chooses: ``(nx, ny, side, vertex, edge)``, the unit normal from A towards B (B's
+    inward normal under a vertex of A, A's outward normal under a vertex of B), or
+    ``side`` -1 when no vertex lies within ``eps`` of an edge of the other body.
+
+    Candidates are taken in the order of :func:`polycontact._kernels.relation.features`
+    (A's vertices, then B's; each against the other's edges) and scored as the Relation
+    does: first whether the touching vertex's own edges stay on their side (within
+    1e-9 of their length), then the distance of the touch from the edge's nearer end.
+    """
+    best_fits = False
+    best_t = -np.inf
+    out = (np.nan, np.nan, -1, -1, -1)
+    for side in range(2):
+        xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
+        sign = 1.0 if side == 0 else -1.0
+        no = so[so.shape[0] - 1]
+        ox0, ox1, oy0, oy1 = bbox(xo, no)
+        for kv in range(sv.shape[0] - 1):
+            for i in range(sv[kv], sv[kv + 1]):
+                px = xv[i, 0]
+                py = xv[i, 1]
+                if px < ox0 - eps or px > ox1 + eps or py < oy0 - eps or py > oy1 + eps:
+                    continue
+                ip = loop_prev(i, sv, kv)
+                inx = loop_next(i, sv, kv)
+                for ko in range(so.shape[0] - 1):
+                    for f in range(so[ko], so[ko + 1]):
+                        f1 = loop_next(f, so, ko)
+                        ax, ay, bx, by = xo[f, 0], xo[f, 1], xo[f1, 0], xo[f1, 1]
+                        if closest_on_segment(px, py, ax, ay, bx, by)[2] > eps * eps:
+                            continue
+                        ux = bx - ax
+                        uy = by - ay
+                        length = np.sqrt(ux * ux + uy * uy)
+                        nx = sign * -uy / length + 0.0
+                        ny = sign * ux / length + 0.0
+                        t = ((px - ax) * ux + (py - ay) * uy) / length
+                        fits = True
+                        for w in (ip, inx):
+                            rx = xv[w, 0] - px
+                            ry = xv[w, 1] - py
+                            if sign * (rx * nx + ry * ny) > 1e-9 * np.sqrt(rx * rx + ry * ry):
+                                fits = False
+                        score = min(t, length - t)
+                        if (fits and not best_fits) or (fits == best_fits and score > best_t):
+                            best_fits = fits
+                            best_t = score
+                            out = (nx, ny, side, i, f)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def carrier(xa, sa, xb, sb, dx, dy):
+    """The vertex-edge pair whose contact segment passes nearest the translation
+    (dx, dy) of A: ``(side, vertex, edge)`` as :func:`contact_depth_into` gives them
+    (side 0: A's vertex w, segment f − w; side 1: B's vertex v, segment v − e)."""
+    best = np.inf
+    out = (-1, -1, -1)
+    for side in range(2):
+        xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
+        # side 0: the point w + d of A on B's edge; side 1: v − d of B on A's edge
+        sx = dx if side == 0 else -dx
+        sy = dy if side == 0 else -dy
+        for i in range(sv[sv.shape[0] - 1]):
+            px = xv[i, 0] + sx
+            py = xv[i, 1] + sy
+            for ko in range(so.shape[0] - 1):
+                for f in range(so[ko], so[ko + 1]):
+                    f1 = loop_next(f, so, ko)
+                    d2 = closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[f1, 0],
+                                            xo[f1, 1])[2]
+                    if d2 < best:
+                        best = d2
+                        out = (side, i, f)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _penetrating(ya, sa, yb, sb, e, buffers):
+    """Geometry of a penetrating pair: ``(depth, nx, ny, px, py, area, cx, cy, side,
+    vertex, edge)``, NaN depth when undecided here (see the module docstring);
+    ``buffers`` = ``(depth, overlap)``: the scratch of
+    :func:`polycontact._kernels.convolution.contact_depth_into` and of
+    :func:`polycontact._kernels.overlap.overlap_moments`."""
+    na = ya.shape[0]
+    nb = yb.shape[0]
+    depth_buf, scratch = buffers
+    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
+    if nc < 0:  # more crossings than the scratch holds: a buffer of the bodies' size
+        big = na * nb + 1
+        scratch = (scratch[0], scratch[1], np.empty((big, 6)), np.empty(big + na + nb + 2),
+                   scratch[4], scratch[5], scratch[6], scratch[7], scratch[8])
+        area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
+    if na + nb > FEW_VERTICES:
+        return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
+    cross, acc, where_a, where_b = scratch[2], scratch[4], scratch[7], scratch[8]
+    bound, bdx, bdy = box_escape(ya, yb)
+    # A vertex inside the other body by more than a length keeps the bodies penetrating
+    # through any translation shorter than it (less the tolerance): no test there.
+    low = max(_deepest(ya, where_a, yb, sb), _deepest(yb, where_b, ya, sa)) - 2.0 * e
+    d, dx, dy, ok, side, v, f = contact_depth_into(ya, sa, yb, sb, bound, bdx, bdy, e, low,
+                                                   depth_buf)
+    if not ok:
+        return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
+    if side < 0:
+        side, v, f = carrier(ya, sa, yb, sb, dx, dy)
+    px, py = point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc)
+    nx, ny = normal_of(ya, sa, yb, sb, d, dx, dy, side, f)
+    return d, nx, ny, px, py, area, cx, cy, side, v, f
+
+
+@njit(cache=True, nogil=True)
+def _deepest(xv, where_v, xo, so):
+    """The largest distance from the other body's boundary ``(xo, so)`` of the vertices
+    of ``xv`` that ``where_v`` says lie inside it (0 when none does)."""
+    best = 0.0
+    for i in range(xv.shape[0]):
+        if where_v[i] != 1:
+            continue
+        px = xv[i, 0]
+        py = xv[i, 1]
+        near = np.inf
+        for k in range(so.shape[0] - 1):
+            for f in range(so[k], so[k + 1]):
+                g = loop_next(f, so, k)
+                near = min(near, closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0],
+                                                    xo[g, 1])[2])
+        best = max(best, near)
+    return np.sqrt(best)
+
+
+@njit(cache=True, nogil=True)
+def normal_of(ya, sa, yb, sb, d, dx, dy, side, f):
+    """The unit normal from A towards B of a penetration of depth ``d`` whose escape is
+    (dx, dy): opposite the escape, or for a zero escape the normal of the carrying
+    edge ``f`` (B's inward normal for side 0, A's outward one for side 1)."""
+    if d > 0.0:
+        return -dx / d + 0.0, -dy / d + 0.0
+    xo, so = (yb, sb) if side == 0 else (ya, sa)
+    ko = 0
+    while so[ko + 1] <= f:
+        ko += 1
+    f1 = loop_next(f, so, ko)
+    ux = xo[f1, 0] - xo[f, 0]
+    uy = xo[f1, 1] - xo[f, 1]
+    ln = np.sqrt(ux * ux + uy * uy)
+    sign = 1.0 if side == 0 else -1.0
+    return sign * -uy / ln + 0.0, sign * ux / ln + 0.0
+
+
+@njit(cache=True, nogil=True)
+def point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc):
+    """A point of the overlap's boundary for a penetrating pair: the carrying vertex
+    ``v`` (of A for side 0, of B for side 1) when it lies inside the other body, else
+    the boundaries' crossing nearest it (``cross[:nc]``, rows of
+    :func:`polycontact._kernels.overlap.overlap_moments`), else the point of the
+    boundary that kernel left in ``acc``."""
+    xv, xo, so = (ya, yb, sb) if side == 0 else (yb, ya, sa)
+    px = xv[v, 0]
+    py = xv[v, 1]
+    if where(px, py, xo, so, e) > 0:
+        return px, py
+    if nc == 0:
+        return (acc[4], acc[5]) if acc[3] == 1.0 else (px, py)
+    best = np.inf
+    qx = px
+    qy = py
+    for c in range(nc):
+        d = (cross[c, 4] - px) ** 2 + (cross[c, 5] - py) ** 2
+        if d < best:
+            best = d
+            qx = cross[c, 4]
+            qy = cross[c, 5]
+    return qx, qy
+
+
+@njit(cache=True, nogil=True)
+def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
+    """Row k of the outputs ``out`` = (distance, normal, point, area, centroid, side,
+    vertex, edge) for one pair in ``state`` (see the module docstring); ``buffers`` as
+    :func:`geometry_buffers` makes them."""
+    dist, normal, point, area, centroid, side, vert, edge = out
+    if state == PENETRATING:
+        d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, buffers)
+        dist[k] = -d
+    elif state == CONTACT:
+        nx, ny, s, v, f = touch(ya, sa, yb, sb, e)
+        if s < 0:  # (the state kernel's touch lies beyond eps by rounding)
+            g, ax, ay, bx, by, s, v, f = closest_features(ya, sa, yb, sb)
+            nx, ny = normal_of(ya, sa, yb, sb, 0.0, 0.0, 0.0, s, f)
+        xv = ya if s == 0 else yb
+        px = xv[v, 0]
+        py = xv[v, 1]
+        a = 0.0
+        cx = px
+        cy = py
+        dist[k] = 0.0
+    else:
+        g, ax, ay, bx, by, s, v, f = closest_features(ya, sa, yb, sb)
+        if g > 0.0:
+            nx = (bx - ax) / g
+            ny = (by - ay) / g
+        else:
+            nx, ny = normal_of(ya, sa, yb, sb, 0.0, 0.0, 0.0, s, f)
+        px = 0.5 * (ax + bx)
+        py = 0.5 * (ay + by)
+        a = 0.0
+        cx = px
+        cy = py
+        dist[k] = g
+    if not a > 0.0:  # no overlap (to the rounding): the centroid is the point
+        a = 0.0
+        cx = px
+        cy = py
+    normal[k, 0] = nx
+    normal[k, 1] = ny
+    point[k, 0] = px
+    point[k, 1] = py
+    area[k] = a
+    centroid[k, 0] = cx
+    centroid[k, 1] = cy
+    side[k] = s
+    vert[k] = v
+    edge[k] = f
+
+
+@njit(cache=True, nogil=True)
+def geometry_buffers(vmax):
+    """Scratch of :func:`pair_geometry_into` for bodies of up to ``vmax`` vertices."""
+    m = min(vmax, FEW_VERTICES)
+    return depth_buffers(m, m), overlap_scratch(vmax, vmax, 8 * vmax + 64)
+
+
+@njit(cache=True, nogil=True)
+def _geometry_range(rows, pairs, vmax, lmax, k0, k1, out):
+    """:func:`pair_geometry` for the pairs ``k0:k1``, into ``out``."""
+    xy, ls, lo, nl = rows
+    pi, pj, states, tols = pairs
+    buffers = geometry_buffers(vmax)
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    for k in range(k0, k1):
+        ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
+        yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
+        pair_geometry_into(ya, sa, yb, sb, states[k], tols[k], buffers, out, k)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pair_geometry(rows, pairs, vmax, lmax, chunks):
+    """Geometry of the pairs ``pairs`` = ``(pi, pj, states, tols)`` of a World's bodies
+    (``rows``, see the module docstring): bodies pi[k] and pj[k] in ``states[k]`` with
+    tolerance ``tols[k]``. Returns ``(distance, normal, point, area, centroid, side,
+    vertex, edge)`` (vertices and edges as packed rows of each body), in parallel chunks
+    (``chunks`` = 1: serial, no thread start); ``vmax``, ``lmax``: the most vertices
+    and loops of a body."""
+    n = pairs[0].shape[0]
+    out = (np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n), np.empty((n, 2)),
+           np.empty(n, np.int8), np.empty(n, np.int64), np.empty(n, np.int64))
+    if chunks == 1:
+        _geometry_range(rows, pairs, vmax, lmax, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _geometry_range(rows, pairs, vmax, lmax, n * c // chunks, n * (c + 1) // chunks, out)
+    return out
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def boundary_gaps(rows, pi, pj, lmax, chunks):
+    """The gap between the boundaries of each pair (pi[k], pj[k]) of a World's bodies
+    (``rows``; see :func:`closest_features`), in parallel chunks."""
+    n = pi.shape[0]
+    out = np.empty(n)
+    if chunks == 1:
+        _gaps_range(rows, pi, pj, lmax, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _gaps_range(rows, pi, pj, lmax, n * c // chunks, n * (c + 1) // chunks, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _gaps_range(rows, pi, pj, lmax, k0, k1, out):
+    """:func:`boundary_gaps` for the pairs ``k0:k1``, into ``out``."""
+    xy, ls, lo, nl = rows
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    for k in range(k0, k1):
+        ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
+        yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
+        out[k] = closest_features(ya, sa, yb, sb)[0]
+
+
+@njit(cache=True, nogil=True)
+def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
+    """Normal, point and carrying features of a penetration whose depth ``d`` and
+    escape (dx, dy) were found elsewhere (the search over convex sums):
+    ``(nx, ny, px, py, side, vertex, edge)``, as :func:`pair_geometry_into` gives them."""
+    side, v, f = carrier(xa, sa, xb, sb, dx, dy)
+    scratch = overlap_scratch(xa.shape[0], xb.shape[0], xa.shape[0] * xb.shape[0] + 1)
+    nc = overlap_moments(xa, sa, xb, sb, e, scratch)[3]
+    px, py = point_of(xa, sa, xb, sb, e, side, v, scratch[2], nc, scratch[4])
+    nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
+    return nx, ny, px, py, side, v, f
+
+
+@njit(cache=True, nogil=True)
+def caller_numbering(ls, lo, nl, lmap, vmap, bodies, rows, column):
+    """``(loop, index)`` in the caller's numbering of row ``rows[k]`` of body
+    ``bodies[k]`` (a vertex for ``column`` 0, the edge from it for 1; ``lmap``,
+    ``vmap``: each loop entry's and each row's map), (-1, -1) for a row -1."""
+    out = np.full((bodies.shape[0], 2), -1, np.int64)
+    for k in range(bodies.shape[0]):
+        if rows[k] < 0:
+            continue
+        b = bodies[k]
+        g = ls[lo[b]] + rows[k]
+        q = 0
+        while ls[lo[b] + q + 1] <= g:
+            q += 1
+        loop = lmap[lo[b] + q]
+        index = vmap[g, column]
+        if loop >= 0 and index >= 0:
+            out[k, 0] = loop
+            out[k, 1] = index
+    return out

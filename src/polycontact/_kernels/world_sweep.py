@@ -1,0 +1,263 @@
+"""Kernels: a World's swept step — which pairs meet while every body moves, and where.
+
+Each body of the World moves rigidly about its centroid (design.md §3) from its current
+pose: ``x(t) = c(t) + R(θ(t)) r`` with ``r`` its rows relative to its centroid turned by
+its current angle (``r = R(angle)(bxy − cen)``, so that ``pos + r`` are the stored rows
+to the bit). The candidate pairs come from the swept broad phase of
+:func:`polycontact.first_impacts` (:mod:`polycontact._kernels.swept`), and each pair runs
+``exact_query`` of :mod:`polycontact._kernels.impact` exactly as
+:func:`polycontact.time_of_impact` does.
+
+The circle tree of each body's edges (:func:`polycontact._kernels.advance.edge_table`)
+is built once, about the body's base rows (:func:`frame_tables`), and turned with the
+body at each step: a rigid turn moves the smallest circles with the points they hold
+(their radii keep their relative margin of 1e-12 over the rounding of the turn).
+
+At the first contact time of a pair (time 0 when it touches or penetrates at the
+start), both bodies are placed and classified, and the contact's point and normal are
+those of :func:`polycontact._kernels.contact_geometry.pair_geometry_into` in that state.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .advance import edge_table
+from .contact_geometry import geometry_buffers, pair_geometry_into
+from .impact import exact_query, state_at, tolerance_at, work_floats
+from .packs import scratch_floats, state_scratch_views, view
+
+
+@njit(cache=True, nogil=True)
+def frame_tables(base, bodies, tables):
+    """Build the circle tree of each body of ``bodies`` about its base rows (``base`` =
+    ``(bxy, ls, lo, nl, cen)``: the rows as added, packed as the World's, and each
+    body's centroid) into ``tables`` = ``(tint, tflt, tio, tfo)``: ``tint`` (``nxt``
+    then ``links``) from ``tio[b]`` and ``tflt`` (``circles``) from ``tfo[b]``, offsets
+    set by the caller (n vertices: n + 3 (2n − 1) ints, 4 (2n − 1) floats)."""
+    bxy, ls, lo, nl, cen = base
+    tint, tflt, tio, tfo = tables
+    for k in range(bodies.shape[0]):
+        b = bodies[k]
+        f = ls[lo[b]]
+        n = ls[lo[b] + nl[b]] - f
+        r = np.empty((n, 2))
+        for i in range(n):
+            r[i, 0] = bxy[f + i, 0] - cen[b, 0]
+            r[i, 1] = bxy[f + i, 1] - cen[b, 1]
+        st = np.empty(nl[b] + 1, np.int64)
+        for q in range(nl[b] + 1):
+            st[q] = ls[lo[b] + q] - f
+        nxt, links, circles, _ = edge_table(r, st)
+        m = 2 * n - 1
+        io = tio[b]
+        fo = tfo[b]
+        tint[io:io + n] = nxt
+        for q in range(m):
+            for c in range(3):
+                tint[io + n + 3 * q + c] = links[q, c]
+            for c in range(4):
+                tflt[fo + 4 * q + c] = circles[q, c]
+
+
+@njit(cache=True, nogil=True)
+def _frame(b, turn, base, tables, scratch):
+    """Body b in its frame turned by ``turn``: its rows and circles written into
+    ``scratch`` = ``(r, circles, r_len, st)``; returns ``(r, starts, table)``, the
+    body and its :func:`polycontact._kernels.advance.edge_table` as
+    :func:`polycontact._kernels.impact.exact_query` takes them."""
+    bxy, ls, lo, nl, cen = base
+    tint, tflt, tio, tfo = tables
+    r, circles, r_len, st = scratch
+    f = ls[lo[b]]
+    n = ls[lo[b] + nl[b]] - f
+    m = 2 * n - 1
+    cs = math.cos(turn)
+    sn = math.sin(turn)
+    cx = cen[b, 0]
+    cy = cen[b, 1]
+    for i in range(n):
+        dx = bxy[f + i, 0] - cx
+        dy = bxy[f + i, 1] - cy
+        x = dx * cs - dy * sn
+        y = dx * sn + dy * cs
+        r[i, 0] = x
+        r[i, 1] = y
+        r_len[i] = np.sqrt(x * x + y * y)
+    fo = tfo[b]
+    for q in range(m):
+        x = tflt[fo + 4 * q]
+        y = tflt[fo + 4 * q + 1]
+        u = x * cs - y * sn
+        v = x * sn + y * cs
+        circles[q, 0] = u
+        circles[q, 1] = v
+        circles[q, 2] = tflt[fo + 4 * q + 2]
+        circles[q, 3] = np.sqrt(u * u + v * v)
+    for q in range(nl[b] + 1):
+        st[q] = ls[lo[b] + q] - f
+    io = tio[b]
+    links = view(tint, io + n, m, 3, np.int64)
+    return r[:n], st[:nl[b] + 1], (tint[io:io + n], links, circles[:m], r_len[:n])
+
+
+@njit(cache=True, nogil=True)
+def _frame_scratch(vmax, lmax):
+    """Scratch of :func:`_frame` for two bodies of up to ``vmax`` vertices and ``lmax``
+    loops: one record for each."""
+    return ((np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
+             np.empty(lmax + 1, np.int64)),
+            (np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
+             np.empty(lmax + 1, np.int64)))
+
+
+#: Units of 2**-52 of the terms of the centres' paths allowed for the rounding of
+#: :func:`_circles_apart` (its few operations round by a few units each).
+_APART_ULPS = 64.0
+
+
+@njit(cache=True, nogil=True)
+def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
+    """Whether the bounding circles provably stay apart over [0, t_max], with the margin
+    the broad phase of ``exact_query`` gives them
+    (:func:`polycontact._kernels.broad_phase.overlap_intervals_into`) and more: then that
+    broad phase finds no interval, and the search reports nothing. The centres' distance
+    is at least the distance of their straight paths (closest approach at the initial
+    speeds) minus what the accelerations add, ``|Δa| t²/2``."""
+    dx = cb[0] - ca[0]
+    dy = cb[1] - ca[1]
+    vx = mb[0] - ma[0]
+    vy = mb[1] - ma[1]
+    ax = mb[2] - ma[2]
+    ay = mb[3] - ma[3]
+    v2 = vx * vx + vy * vy
+    t = 0.0
+    if v2 > 0.0:
+        t = min(max(-(dx * vx + dy * vy) / v2, 0.0), t_max)
+    px = dx + vx * t
+    py = dy + vy * t
+    acc = 0.5 * math.sqrt(ax * ax + ay * ay) * t_max * t_max
+    big = la + lb
+    terms = (abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + math.sqrt(v2) * t_max + acc
+             + big)
+    r = big * (1.0 + 2.0 * inflate) + _APART_ULPS * 2.0**-52 * terms
+    return math.sqrt(px * px + py * py) - acc > r
+
+
+@njit(cache=True, nogil=True)
+def _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, k0, k1, out):
+    """:func:`sweep_search` for the pairs ``k0:k1``, into ``out``."""
+    ids, pos, ang, rad, extent, motion = movers
+    t_max, inflate, time_tol, rel, ulps, resolution, max_iter = settings
+    code, t_hi, t_contact, state = out
+    fa, fb = _frame_scratch(vmax, lmax)
+    work = np.empty(work_floats(2 * vmax))
+    for k in range(k0, k1):
+        a = ids[pi[k]]
+        b = ids[pj[k]]
+        ma = motion[pi[k]]
+        mb = motion[pj[k]]
+        if _circles_apart(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate):
+            code[k] = 0
+            t_hi[k] = -1.0
+            t_contact[k] = -1.0
+            state[k] = 0
+            continue
+        r1, s1, e1 = _frame(a, ang[a], base, tables, fa)
+        r2, s2, e2 = _frame(b, ang[b], base, tables, fb)
+        query = (t_max, inflate, time_tol, rel * max(extent[a], extent[b]), ulps,
+                 resolution * (rad[a] + rad[b]), max_iter, 0)
+        got = exact_query((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
+                          query, work)
+        c = got[1]
+        code[k] = c
+        t_hi[k] = got[2]
+        t = got[4] if c != 2 else 0.0
+        if c == 3 and t < 0.0:
+            t = got[6]
+        t_contact[k] = t
+        state[k] = 0 if t < 0.0 else (2 if c == 1 or c == 2 else 1)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def sweep_search(pi, pj, movers, base, tables, settings, vmax, lmax, chunks):
+    """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
+    ``ids[pj[k]]``) over [0, ``t_max``], in parallel chunks (``chunks`` = 1: serial).
+
+    ``movers`` = ``(ids, pos, ang, rad, extent, motion)``: the World's ids of the
+    moving bodies, and by id each body's position (its centroid), angle, bounding
+    radius and box extent; ``motion`` holds the rows ``[vx, vy, ax, ay, ω, α]``,
+    indexed like ``ids``. ``base``, ``tables``: as for :func:`frame_tables`.
+    ``settings`` = ``(t_max, inflate, time_tol, rel, ulps, resolution, max_iter)``:
+    those of :func:`polycontact._kernels.impact.exact_query`, with the relative terms
+    of the distance tolerance and of the contact resolution (times each pair's larger
+    extent, and its sum of radii). ``vmax``, ``lmax``: the most vertices and loops of a
+    body.
+
+    Returns ``(code, t_hi, t_contact, state)``: the search's status code and
+    penetration time (as ``exact_query``), the first contact time (0 when penetrating
+    at the start; the time reached by a search without a verdict; -1 when they never
+    touch), and 2 when they penetrate within the step, 1 when they only touch, 0 when
+    they never do."""
+    n = pi.shape[0]
+    out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8))
+    if chunks == 1:
+        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, n * c // chunks,
+                      n * (c + 1) // chunks, out)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _event_range(events, base, tables, vmax, lmax, ulps, k0, k1, point, normal):
+    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``."""
+    pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb = events
+    fa, fb = _frame_scratch(vmax, lmax)
+    xa = np.empty((vmax, 2))
+    xb = np.empty((vmax, 2))
+    scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
+    buffers = geometry_buffers(vmax)
+    m = k1 - k0
+    dist = np.empty(m)
+    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
+            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
+    for k in range(k0, k1):
+        r1, s1, _ = _frame(pa[k], ta[k], base, tables, fa)
+        r2, s2, _ = _frame(pb[k], tb[k], base, tables, fb)
+        t = times[k]
+        ya = xa[:r1.shape[0]]
+        yb = xb[:r2.shape[0]]
+        eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
+        now = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t, eps,
+                       (ya, yb, scratch))
+        pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
+        if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
+            normal[k, 0] = np.nan
+            normal[k, 1] = np.nan
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def event_geometry(events, base, tables, vmax, lmax, ulps, chunks):
+    """The contact point and normal of each event of ``events`` = ``(pa, pb, times, ca,
+    cb, ta, tb, la, lb, eps_rel, ma, mb)``: bodies ``pa[k]`` and ``pb[k]`` at
+    ``times[k]``, each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]``
+    (``tb[k]``) with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact
+    search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``) and
+    described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
+    normals where the depth is left undecided. ``base``, ``tables``: as for
+    :func:`frame_tables`. In parallel chunks."""
+    n = events[0].shape[0]
+    point = np.full((n, 2), np.nan)
+    normal = np.full((n, 2), np.nan)
+    if chunks == 1:
+        _event_range(events, base, tables, vmax, lmax, ulps, 0, n, point, normal)
+        return point, normal
+    for c in prange(chunks):
+        _event_range(events, base, tables, vmax, lmax, ulps, n * c // chunks,
+                     n * (c + 1) // chunks, point, normal)
+    return point, normal
