@@ -17,8 +17,8 @@ Examples
 >>> import numpy as np
 >>> seg = np.array([[0.0, 0.0, 4.0, 0.0], [0.0, 3.0, 4.0, 3.0], [2.0, 0.0, 2.0, 3.0]])
 >>> grid = segment_grid(seg, np.array([[1.0, 0.1], [3.0, 2.9]]), 0.5)
->>> listed(grid, 1.0, 0.1).tolist(), listed(grid, 3.0, 2.9).tolist()
-([0], [1])
+>>> listed(grid, 1.0, 0.1).tolist(), listed(grid, 3.0, 2.9).tolist()  # (cells ~1 wide)
+([0, 2], [1, 2])
 """
 
 from __future__ import annotations
@@ -76,15 +76,15 @@ def _put(first, items, fill, cell, s, write):
 
 
 @njit(cache=True, nogil=True)
-def segment_grid(seg, points, margin):
+def segment_grid(seg, points, margin, side=0.0):
     """The cells over the box of ``points`` (P, 2) listing the segments ``seg`` (S, 4)
     rows ``(x0, y0, x1, y1)``, a point being a segment of length 0) within ``margin`` of
-    each (about P + S cells)."""
+    each (about P + S cells, none narrower than ``side``)."""
     x0 = points[:, 0].min()
     y0 = points[:, 1].min()
     w = points[:, 0].max() - x0
     ht = points[:, 1].max() - y0
-    h = _side(w, ht, points.shape[0] + seg.shape[0], margin)
+    h = max(_side(w, ht, points.shape[0] + seg.shape[0], margin), side)
     gx = int(w / h) + 1
     gy = int(ht / h) + 1
     first = np.zeros(gx * gy + 1, np.int64)

@@ -598,7 +598,7 @@ def sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, max_ite
     is classified with the distance tolerance at its time (:func:`local_tolerances`).
     Returns ``(status, t_hi, t_lo, first_contact, evaluations)``; ``first_contact`` is
     the earliest sample in contact (−1 if none); the status is ``OUT_OF_ITERATIONS``
-    (no verdict) when the budget is spent first.
+    (no verdict, ``t_lo`` the sample it stopped at) when the budget is spent first.
     """
     _, _, placed, _ = _work_views(np.empty(work_floats(a[0].shape[0] + b[0].shape[0])),
                                   a[0].shape[0], b[0].shape[0])
@@ -629,7 +629,8 @@ def _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, max_it
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
                 if evals > max_iter:
-                    return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, evals
+                    # (the samples before t were classified: t is how far it got)
+                    return OUT_OF_ITERATIONS, -1.0, t, first_contact, evals
                 st = state_at(a, ma, b, mb, t,
                               tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), placed)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
@@ -741,9 +742,10 @@ def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, 
 def sampled_query(a, ma, b, mb, query, work):
     """Broad phase and :func:`sampled_search` with ``samples`` points in one call (``a``,
     ``ma``, ``b``, ``mb``: as for :func:`exact_search`; ``query``: as for
-    :func:`exact_query`, its ``max_iter`` the budget of classifications); returns what :func:`exact_query` does (``iterations``: the
-    classifications; ``t_reached``: t_hi on a hit, else t_max), with its buffers in
-    ``work`` as there."""
+    :func:`exact_query`, its ``max_iter`` the budget of classifications); returns
+    what :func:`exact_query` does (``iterations``: the classifications;
+    ``t_reached``: t_hi on a hit, the sample it stopped at when out of iterations, else
+    t_max), with its buffers in ``work`` as there."""
     t_max, inflate, time_tol, eps_rel, ulps, _, max_iter, samples = query
     ra, _, ca, la = a
     rb, _, cb, lb = b
@@ -751,4 +753,5 @@ def sampled_query(a, ma, b, mb, query, work):
     n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
     code, hi, lo, contact, its = _sampled_search(a, ma, b, mb, iv[:n], time_tol, samples,
                                                  eps_rel, ulps, max_iter, placed)
-    return n, code, hi, lo, contact, its, hi if code == HIT else t_max
+    reached = hi if code == HIT else (lo if code == OUT_OF_ITERATIONS else t_max)
+    return n, code, hi, lo, contact, its, reached

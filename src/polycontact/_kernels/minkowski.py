@@ -431,6 +431,31 @@ def sum_index(sums, gx0, gy0, h, eps, grid_from=GRID_MIN_SUMS):
             np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
 
 
+@njit(cache=True, nogil=True)
+def clip_tests(sums, index, eps):
+    """An upper bound, known before any clipping, of the tests of an edge against a sum
+    that :func:`clip_edge` makes over every ``EDGE`` of the ``sums`` (``(xy, starts,
+    bb, fr)``), reading ``index`` (:func:`sum_index`): the sums listed in the cells
+    along each edge (the cover grid's and the hint's are among them); 0 without a grid,
+    for few sums. Costs the cells along the edges, no clipping."""
+    xy, starts, _, fr = sums
+    near, marks = index[8], index[9]
+    if index[3].shape[0] == 0:
+        return 0
+    cells = marks[0]
+    first = near[5]
+    total = 0
+    for p in range(starts.shape[0] - 1):
+        for i in range(starts[p], starts[p + 1]):
+            if fr[i, 3] != EDGE:
+                continue
+            j = i + 1 if i + 1 < starts[p + 1] else starts[p]
+            nc = segment_cells(near, xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], eps, cells)
+            for c in range(nc):
+                total += first[cells[c] + 1] - first[cells[c]]
+    return total
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0):
     """Take from the parts of edge (a, b) of sum p what sum q covers: of ``parts`` =

@@ -32,19 +32,33 @@ def edge_cover(xy, starts, bb, fr, eps):
     parts in no other open sum shrunk by eps, where exact fits and slides lie, less
     those lying within a longer outline part.
     """
-    k = starts.shape[0] - 1
-    n_edges = xy.shape[0]
-    outline = np.empty((4 * n_edges, 4))
-    loose = np.empty((4 * n_edges, 4))
-    no = 0
-    nl = 0
-    hint = -1
-    # the grid over all sums
+    return clip_edges(xy, starts, bb, fr, eps, outline_index(xy, starts, bb, fr, eps))
+
+
+@njit(cache=True, nogil=True)
+def outline_index(xy, starts, bb, fr, eps):
+    """The :func:`polycontact._kernels.minkowski.sum_index` that :func:`clip_edges`
+    reads: its cover grid spans every sum."""
     gx0 = bb[:, 0].min()
     gy0 = bb[:, 1].min()
     h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / GRID
+    return sum_index((xy, starts, bb, fr), gx0, gy0, h, eps)
+
+
+@njit(cache=True, nogil=True)
+def clip_edges(xy, starts, bb, fr, eps, index):
+    """:func:`edge_cover` with its index (:func:`outline_index`) given."""
+    k = starts.shape[0] - 1
+    cap = 4
+    for i in range(xy.shape[0]):
+        if fr[i, 3] == EDGE:
+            cap += 4  # (rows grow when needed)
+    outline = np.empty((cap, 4))
+    loose = np.empty((cap, 4))
+    no = 0
+    nl = 0
+    hint = -1
     sums = (xy, starts, bb, fr)
-    index = sum_index(sums, gx0, gy0, h, eps)
     lo1, hi1, lo0, hi0 = index[-4:]
     for p in range(k):
         s = starts[p]

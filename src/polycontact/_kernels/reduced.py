@@ -85,14 +85,14 @@ def piece_cones(xy, starts):
 
     Examples
     --------
-    An L cut into two squares: the cut is a diagonal, the inner corner reflex.
+    An L of three unit squares: the cuts are diagonals, the inner corner (1, 1) reflex.
 
     >>> import numpy as np
     >>> xy = np.array([(0, 0), (1, 0), (1, 1), (0, 1), (1, 0), (2, 0), (2, 1), (1, 1),
     ...                (0, 1), (1, 1), (1, 2), (0, 2)], float)
     >>> bd, cones = piece_cones(xy, np.array([0, 4, 8, 12]))
     >>> bd.astype(int).tolist()
-    [1, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1]
+    [1, 0, 0, 1, 1, 1, 1, 0, 0, 1, 1, 1]
     >>> cones[:, 0].tolist()
     [1.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 1.0]
     """
