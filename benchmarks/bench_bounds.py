@@ -38,12 +38,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import time
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))
+from bench_scaling import row_in_fresh_process  # noqa: E402
+from catalogue import interlocking_combs  # noqa: E402
 
 #: case name -> bound in seconds
 BOUNDS = {
@@ -70,20 +76,6 @@ def wavy(n: int, waves: int = 50, amplitude: float = 0.002) -> np.ndarray:
     return np.column_stack((r * np.cos(t), r * np.sin(t)))
 
 
-def combs(teeth: int) -> tuple[np.ndarray, np.ndarray]:
-    """A comb with its teeth down and one with its teeth up between them (4 teeth + 4
-    vertices each), each tooth exactly as wide as the other's gaps."""
-    w = 2 * teeth + 1
-    up = [(0, 0), (w, 0), (w, 2), (w - 1, 2)]
-    for i in range(teeth - 1, -1, -1):
-        up += [(2 * i + 2, 1), (2 * i + 1, 1), (2 * i + 1, 2), (2 * i, 2)]
-    down = [(0, 0), (w, 0), (w, 1)]
-    for i in range(teeth - 1, -1, -1):
-        down += [(2 * i + 2, 1), (2 * i + 2, 2), (2 * i + 1, 2), (2 * i + 1, 1)]
-    down += [(0, 1)]
-    return np.array(down, float) * [1.0, -1.0], np.array(up, float)
-
-
 def star(rng: np.random.Generator, n: int) -> np.ndarray:
     """The smooth concave stars of ``bench_classify.py``: radius 1 + 0.3 sin(k t + phase)
     with a jitter of half a vertex spacing."""
@@ -101,11 +93,12 @@ def setup(case: str) -> tuple[Callable[[], Any], Callable[[], Any]]:
 
     if case.startswith("nfp"):
         if case == "nfp combs 400":
-            a, b = combs(99)
+            a, b = interlocking_combs(99)
         else:
             a, b = circle(600, 0.3), wavy(60000)
         sa, sb = pc.Shape(a), pc.Shape(b)
-        small = pc.Shape(combs(3)[0]), pc.Shape(combs(3)[1])
+        # (rings past ear clipping, and sums enough for the grids: the same kernels)
+        small = pc.Shape(interlocking_combs(20)[0]), pc.Shape(interlocking_combs(20)[1])
 
         def nfp(x: Any, y: Any) -> Any:
             got = pc.no_fit_polygon(x, y, reference="origin")
@@ -204,17 +197,10 @@ def main() -> None:
         # the limit: each repetition within three times its bound, plus the set-up
         limit = 120.0 + 3.0 * bound * args.repeat
         cmd = [sys.executable, __file__, "--repeat", str(args.repeat), "--row", case]
-        try:
-            run = subprocess.run(cmd, capture_output=True, text=True, check=True,
-                                 timeout=limit)
-        except subprocess.TimeoutExpired:
-            print(f"{case:18} {bound:8.0f} {'> ' + str(int(limit)):>9}", flush=True)
+        row = row_in_fresh_process(cmd, limit)
+        if isinstance(row, str):
+            print(f"{case:18} {bound:8.0f} {row:>9}", flush=True)
             continue
-        except subprocess.CalledProcessError as err:
-            why = "killed (memory?)" if err.returncode < 0 else f"failed ({err.returncode})"
-            print(f"{case:18} {bound:8.0f} {why:>9}  {err.stderr.strip()[-200:]}", flush=True)
-            continue
-        row = json.loads(run.stdout.strip().splitlines()[-1])
         spread = f"{row['min']:.3f}..{row['max']:.3f}"
         print(f"{case:18} {bound:8.0f} {row['median']:9.3f} {spread:>15}  {row['outcome']}",
               flush=True)

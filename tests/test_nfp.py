@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+from catalogue import interlocking_combs
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from profiles import examples
@@ -446,17 +447,7 @@ def test_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
 
 
 def _regular_combs(teeth):
-    """A comb with ``teeth`` unit teeth up and one with its teeth down between them, each
-    tooth exactly as wide as the other's gaps (slides everywhere)."""
-    w = 2 * teeth + 1
-    up = [(0, 0), (w, 0), (w, 2), (w - 1, 2)]
-    for i in range(teeth - 1, -1, -1):
-        up += [(2 * i + 2, 1), (2 * i + 1, 1), (2 * i + 1, 2), (2 * i, 2)]
-    down = [(0, 0), (w, 0), (w, 1)]
-    for i in range(teeth - 1, -1, -1):
-        down += [(2 * i + 2, 1), (2 * i + 2, 2), (2 * i + 1, 2), (2 * i + 1, 1)]
-    down += [(0, 1)]
-    return pc.Shape(np.array(down, float) * [1, -1]), pc.Shape(up)
+    return tuple(pc.Shape(x) for x in interlocking_combs(teeth))
 
 
 def test_interlocking_combs_match_the_reference():

@@ -122,24 +122,8 @@ def piece_cones(xy, starts):
     cones = np.empty((n, 5))
     for i in range(n):
         x, y = xy[i, 0], xy[i, 1]
-        n_out = 0
-        out_row = -1
-        q = _first_at(sx, sy, by_start, x, y)
-        while q < n and sx[by_start[q]] == x and sy[by_start[q]] == y:
-            r = by_start[q]
-            if boundary[r] and not (n_out == 1 and _same_edge(xy, nxt, r, out_row)):
-                n_out += 1
-                out_row = r
-            q += 1
-        n_in = 0
-        in_row = -1
-        q = _first_at(ex, ey, by_end, x, y)
-        while q < n and ex[by_end[q]] == x and ey[by_end[q]] == y:
-            r = by_end[q]
-            if boundary[r] and not (n_in == 1 and _same_edge(xy, nxt, r, in_row)):
-                n_in += 1
-                in_row = r
-            q += 1
+        n_out, out_row = _boundary_at(sx, sy, by_start, x, y, boundary, xy, nxt)
+        n_in, in_row = _boundary_at(ex, ey, by_end, x, y, boundary, xy, nxt)
         cones[i, 1:] = 0.0
         if n_out != 1 or n_in != 1:
             cones[i, 0] = ANY
@@ -158,6 +142,22 @@ def piece_cones(xy, starts):
         cones[i, 3] = uox
         cones[i, 4] = uoy
     return boundary, cones
+
+
+@njit(cache=True, nogil=True)
+def _boundary_at(px, py, order, x, y, boundary, xy, nxt):
+    """``(count, row)``: how many distinct boundary edges have their point ``(px, py)``
+    (their start or their end, sorted by ``order``) at (x, y), and the last one's row."""
+    count = 0
+    row = -1
+    q = _first_at(px, py, order, x, y)
+    while q < order.shape[0] and px[order[q]] == x and py[order[q]] == y:
+        r = order[q]
+        if boundary[r] and not (count == 1 and _same_edge(xy, nxt, r, row)):
+            count += 1
+            row = r
+        q += 1
+    return count, row
 
 
 @njit(cache=True, nogil=True)
