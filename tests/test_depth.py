@@ -18,6 +18,9 @@ import numpy as np
 import pyclipper
 import pytest
 import shapely
+from hypothesis import given
+from hypothesis import strategies as st
+from profiles import examples
 
 import polycontact as pc
 
@@ -200,13 +203,62 @@ def test_depth_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
     # Two 50 000-vertex stars overlapping at the rim needed more memory than the machine
     # had (the process was killed). Past its budget the depth now raises a clear error;
     # the budget is lowered here to reach it with small stars.
-    from polycontact import _depth
+    from polycontact import limits
 
     rng = np.random.default_rng(3)
     a, b = _star(rng, 300), _star(rng, 300, (0.3, 0.1))
-    monkeypatch.setattr(_depth, "MAX_SUM_VERTICES", 1000)
+    monkeypatch.setattr(limits, "MAX_SUM_VERTICES", 1000)
     rel = pc.classify(a, b)
     assert rel.state is pc.State.PENETRATING
     with pytest.raises(pc.DepthTooLargeError, match="too large and interlocked"):
         rel.distance
     assert isinstance(pc.DepthTooLargeError("x"), (pc.PolycontactError, MemoryError))
+
+
+def test_depth_refused_before_decomposing_when_the_near_contacts_prove_it_too_large(
+        monkeypatch):
+    # The vertex-edge contacts within the first escape bound the sums from below: past
+    # the limit the depth is refused without decomposing either body (GEOS's
+    # triangulation of 10^5-vertex bodies alone took seconds).
+    from polycontact import _depth, limits
+
+    rng = np.random.default_rng(3)
+    a, b = _star(rng, 300), _star(rng, 300, (0.3, 0.1))
+    monkeypatch.setattr(limits, "MAX_SUM_VERTICES", 1000)
+
+    def no_pieces(*args):
+        raise AssertionError("decomposed")
+
+    monkeypatch.setattr(_depth, "pieces_packed", no_pieces)
+    rel = pc.classify(a, b)
+    with pytest.raises(pc.DepthTooLargeError,
+                       match=r"at least 100[0-9] \(counted from the vertex-edge contacts"):
+        rel.distance
+
+
+@examples(40)
+@given(st.integers(0, 10**6), st.integers(5, 60), st.integers(5, 60), st.floats(0.0, 1.5))
+def test_near_contacts_never_exceed_the_sums_the_depth_builds(seed, m, n, dx):
+    # the estimate is a lower bound: never more than the vertices of the sums of the
+    # pieces whose sums reach the first escape's disk
+    from polycontact._kernels import depth as kd
+    from polycontact._pieces import pieces_packed
+
+    rng = np.random.default_rng(seed)
+
+    def ring(k, cx):  # star-shaped: angles one per k-th of a turn, jittered
+        t = 2.0 * np.pi * (np.arange(k) + rng.uniform(0.1, 0.9, k)) / k
+        r = rng.uniform(0.5, 1.0, k)
+        return np.column_stack((cx + r * np.cos(t), 0.1 * cx + r * np.sin(t)))
+
+    a, b = pc.Shape(ring(m, 0.0)), pc.Shape(ring(n, dx))
+    if pc.classify(a, b).state is not pc.State.PENETRATING:
+        return  # (no depth)
+    (xa, sa), (xb, sb) = a.packed, b.packed
+    bound = kd.first_escape(xa, xb)[0]
+    lower = kd.contacts_near(xa, sa, xb, sb, bound, 1e12)
+    bxy, bst = pieces_packed(xb, sb)
+    axy, ast = pieces_packed(xa, sa)
+    pairs = kd._select_pairs(kd.boxes(bxy, bst), kd.boxes(-axy, ast), bound, bst, ast, 10**12)
+    built = sum(int(bst[i + 1] - bst[i] + ast[j + 1] - ast[j]) for i, j in pairs)
+    assert lower <= built

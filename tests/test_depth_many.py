@@ -17,7 +17,7 @@ from profiles import examples
 from test_depth import _clipper_depth
 
 import polycontact as pc
-from polycontact import _depth
+from polycontact import limits
 from polycontact._kernels import depth as kd
 from polycontact._pieces import pieces_packed
 from polycontact.limits import MAX_SUM_VERTICES
@@ -131,7 +131,7 @@ def test_distinct_bodies_tells_apart_bodies_of_equal_key():
 
 
 def test_batch_depth_beyond_its_memory_budget_is_refused(monkeypatch):
-    monkeypatch.setattr(_depth, "MAX_SUM_VERTICES", 3)
+    monkeypatch.setattr(limits, "MAX_SUM_VERTICES", 3)
     # (40-gons: two small bodies take the contact segments, which build no sums)
     t = 2.0 * np.pi * np.arange(40) / 40
     disk = np.column_stack((np.cos(t), np.sin(t)))

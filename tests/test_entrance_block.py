@@ -56,9 +56,15 @@ def note_bodies(*shapes: pc.Shape) -> None:
         note(repr([loop.tolist() for loop in s.loops]))
 
 
-def _same_region(g1, g2, rel=1e-9):
-    scale = max(g1.area, g2.area, 1e-300)
-    assert g1.symmetric_difference(g2).area <= rel * scale
+def _same_region(g1, g2, rel=1e-9, grid=0.0):
+    """g1 and g2 are one region up to slivers along their boundaries: their symmetric
+    difference is within ``rel`` of their area, or within a band along their outlines
+    as wide as the rounding of their coordinates (16 float spacings of the largest
+    |coordinate|) plus the ``grid`` a union was snapped to."""
+    bounds = [v for g in (g1, g2) if not g.is_empty for v in g.bounds]
+    width = grid + 16.0 * float(np.spacing(max([abs(v) for v in bounds] + [1e-300])))
+    allowed = max(rel * max(g1.area, g2.area), width * (g1.length + g2.length), 1e-300)
+    assert g1.symmetric_difference(g2).area <= allowed
 
 
 # -- hand cases ------------------------------------------------------------------------
@@ -236,7 +242,7 @@ def test_each_swept_region_is_the_union_of_its_edge_pairs(a, b):
         # on a fine grid: GEOS's floating union of pieces whose edges lie ulps apart can
         # drop area (test_nfp::test_reference_union_of_near_coincident_hulls)
         union = shapely.union_all([c.geometry for c in mine], grid_size=1e-13 * scale)
-        _same_region(union.buffer(0), comp.geometry.buffer(0))
+        _same_region(union.buffer(0), comp.geometry.buffer(0), grid=1e-13 * scale)
         # equal as closed sets, segments included: each within 1e-9 of the other
         assert union.buffer(1e-9 * scale).covers(comp.geometry)
         assert comp.geometry.buffer(1e-9 * scale).covers(union)
@@ -327,3 +333,16 @@ def test_union_of_components_a_hole_snaps_onto_its_shell():
         eb = pc.entrance_block(a, b, method=method)
         want = reference_region(a.to_shapely(), b.to_shapely(), eb.reference)
         assert same_region(eb.to_shapely(), want, rel=1e-6) is None
+
+
+def test_edge_pairs_beyond_their_limit_are_refused_before_any_is_built(monkeypatch):
+    a = pc.Shape(SQUARE)
+    b = a.moved((3.0, 0.0))
+    monkeypatch.setattr(pc.limits, "MAX_EDGE_PAIRS", 15)
+    with pytest.raises(pc.EntranceBlockTooLargeError,
+                       match=r"16 edge-pair components .*MAX_EDGE_PAIRS = 15"):
+        pc.entrance_block(a, b, method="pairs")
+    assert len(pc.entrance_block(a, b).components) == 12  # (swept: one per edge of B)
+    monkeypatch.setattr(pc.limits, "MAX_EDGE_PAIRS", 16)
+    assert len(pc.entrance_block(a, b, method="pairs").of_family("A1-B1")) == 16
+    assert issubclass(pc.EntranceBlockTooLargeError, (pc.WorkLimitError, MemoryError))

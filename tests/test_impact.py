@@ -171,17 +171,66 @@ def test_accelerating_slide_ends_with_a_verdict():
     assert oracle_first_penetration(a, ma, floor, mb, 0, 2, 2001) is None
 
 
-def test_contact_without_relative_motion_runs_out_of_iterations_with_a_status():
-    # a square spinning in a square hole it fits exactly, the holed body spinning with
-    # it about the same centre: touching throughout with no relative motion, but the
-    # bounds see each body's own spin, so the touch is probed; a small budget ends the
-    # search with a status, not a hang and not a guess
+def test_contact_that_lasts_while_the_bodies_turn_runs_out_of_iterations_with_a_status():
+    # a square spinning in a square hole it fits exactly, the holed body spinning a hair
+    # faster about the same centre: touching throughout, turning apart by far less than
+    # the tolerance, but the bounds see each body's own spin, so the touch is probed; a
+    # small budget ends the search with a status, not a hang and not a guess
     sq = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
     b = Shape([(-3, -3), (3, -3), (3, 3), (-3, 3)], [[(-1, -1), (-1, 1), (1, 1), (1, -1)]])
-    spin = Motion(angular_velocity=1.0)
-    hit = time_of_impact(sq, spin, b, spin, t_max=5, max_iterations=1000)
+    hit = time_of_impact(sq, Motion(angular_velocity=1.0), b,
+                         Motion(angular_velocity=1.0 + 1e-13), t_max=5, max_iterations=1000)
     assert hit.status is ImpactStatus.OUT_OF_ITERATIONS
     assert not hit.collides and hit.first_contact == 0.0 and hit.searched_to < 5
+
+
+def _disc_in_its_frame(n):
+    t = 2.0 * np.pi * np.arange(n) / n
+    disc = np.column_stack((np.cos(t), np.sin(t)))
+    return Shape(disc), Shape([(-2, -2), (2, -2), (2, 2), (-2, 2)], [disc[::-1]])
+
+
+@pytest.mark.parametrize("n", [64, 512])
+def test_bodies_without_relative_motion_are_answered_from_the_start(n):
+    # a disc spinning with its exact-fit frame at the same rate (about one centre) keeps
+    # its pose in the frame's: the contact at t = 0 holds, however long the window
+    disc, frame = _disc_in_its_frame(n)
+    spin = Motion(velocity=(3.0, -1.0), acceleration=(0.5, 0.0), angular_velocity=20.0,
+                  angular_acceleration=1.0)
+    hit = time_of_impact(disc, spin, frame, spin, t_max=1000.0)
+    assert hit.status is ImpactStatus.NO_HIT and not hit.collides
+    assert hit.first_contact == 0.0 and hit.state is State.CONTACT and hit.iterations <= 2
+    # a common translation keeps apart bodies apart, and overlapping ones overlapping
+    drift = Motion(velocity=(1.0, 2.0), acceleration=(0.0, -3.0))
+    apart = time_of_impact(disc, drift, disc.moved((5.0, 0.0)), drift, t_max=1000.0)
+    assert apart.status is ImpactStatus.NO_HIT and apart.first_contact is None
+    assert apart.iterations <= 2
+    inside = time_of_impact(disc, spin, disc.moved((0.5, 0.0)), spin, t_max=1000.0)
+    assert inside.status is ImpactStatus.PENETRATING_AT_START
+
+
+def test_a_common_spin_about_two_centres_is_relative_motion():
+    # equal motions but different centroids: in A's frame B circles A's centroid without
+    # turning, so its corner meets A's near an eighth of a turn
+    a = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
+    spin = Motion(angular_velocity=1.0)
+    hit = time_of_impact(a, spin, a.moved((2.5, 0.0)), spin, t_max=10.0)
+    assert hit.collides and 0.0 < hit.time < np.pi / 4
+
+
+def test_sampled_search_refuses_more_samples_per_round_than_its_budget():
+    b = SQ.moved((3, 0))
+    with pytest.raises(ValueError, match=r"samples: .*1000000000.* max_iterations = 1000000"):
+        time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=5, method="sampled",
+                       samples=10**9)
+    # within the budget it answers; a search that spends it ends with a status
+    hit = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=5, method="sampled",
+                         samples=1000)
+    assert hit.status is ImpactStatus.HIT and abs(hit.time - 2.0) <= 0.01
+    out = time_of_impact(SQ, Motion(velocity=(1, 0)), b, Motion(), t_max=5, method="sampled",
+                         samples=100, max_iterations=100)
+    assert out.status is ImpactStatus.OUT_OF_ITERATIONS and not out.collides
+    assert out.iterations <= 101 and 0.0 < out.searched_to < 5.0
 
 
 def _no_overlap(a, ma, b, mb, ts, area=0.0):

@@ -191,14 +191,36 @@ def test_exact_search_on_flush_squares():
 
 def test_exact_search_reports_the_budget():
     # a square spinning in a square hole it fits exactly, the holed body spinning with
-    # it: in contact throughout with no relative motion, but each body's own spin is
-    # all the bounds see, so the touch is stepped through by probes
+    # it a hair faster: in contact throughout, turning apart by far less than the
+    # tolerance, while each body's own spin is all the bounds see, so the touch is
+    # stepped through by probes
     sq = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
     b = Shape([(-3, -3), (3, -3), (3, 3), (-3, 3)], [[(-1, -1), (-1, 1), (1, 1), (1, -1)]])
-    spin = Motion(angular_velocity=1.0)
-    out = ki.exact_search(*_kernel_args(sq, spin, b, spin), np.array([[0.0, 1.0]]),
-                          (1e-4, 1e-12, ULPS, 1e-3, 50))
+    out = ki.exact_search(*_kernel_args(sq, Motion(angular_velocity=1.0), b,
+                                        Motion(angular_velocity=1.0 + 1e-13)),
+                          np.array([[0.0, 1.0]]), (1e-4, 1e-12, ULPS, 1e-3, 50))
     assert out[0] == ki.OUT_OF_ITERATIONS and out[3] == 0.0 and out[5] < 1.0
+
+
+def test_exact_search_answers_at_once_without_relative_motion():
+    # the same square and hole spinning together: B keeps its pose in A's frame, so the
+    # contact at t = 0 holds throughout, however fast they turn
+    sq = Shape([(-1, -1), (1, -1), (1, 1), (-1, 1)])
+    b = Shape([(-3, -3), (3, -3), (3, 3), (-3, 3)], [[(-1, -1), (-1, 1), (1, 1), (1, -1)]])
+    for spin in (Motion(angular_velocity=50.0), Motion((3.0, -1.0), (0.5, 2.0), 7.0, 1.0)):
+        code, hi, lo, contact, its, reached = ki.exact_search(
+            *_kernel_args(sq, spin, b, spin), np.array([[0.0, 100.0]]),
+            (1e-4, 1e-12, ULPS, 1e-6, 1_000_000))
+        assert (code, contact) == (ki.NO_HIT, 0.0) and its == 1
+    # apart, a common translation keeps them apart; a common spin about two centres
+    # moves B in A's frame: not answered at once
+    far = sq.moved((5.0, 0.0))
+    drift = Motion((1.0, 2.0), (0.0, -1.0))
+    assert ki.exact_search(*_kernel_args(sq, drift, far, drift), np.array([[0.0, 100.0]]),
+                           (1e-4, 1e-12, ULPS, 1e-6, 1_000_000))[0] == ki.NO_HIT
+    args = _kernel_args(sq, Motion(angular_velocity=1.0), far, Motion(angular_velocity=1.0))
+    assert not ki.fixed_relative_pose(args[0][2], args[1], args[0][3], args[2][2], args[3],
+                                      args[2][3], ULPS)
 
 
 def test_exact_search_follows_a_slide_under_an_overhang():
@@ -270,7 +292,8 @@ def test_sampled_search_follows_the_paper_steps():
     for n in (2, 3, 10):
         m_a = Motion(velocity=(1, 0.1), angular_velocity=0.3)
         code, hi, lo, contact, evals = ki.sampled_search(
-            *_kernel_args(sq, m_a, b, Motion()), np.array([[0.5, 4.0]]), 1e-3, n, 1e-12, ULPS)
+            *_kernel_args(sq, m_a, b, Motion()), np.array([[0.5, 4.0]]), 1e-3, n, 1e-12, ULPS,
+            1_000_000)
         expected = _paper_sampled(sq, m_a, b, Motion(), 0.5, 4.0, n, 1e-3)
         assert code == ki.HIT and math.isclose(hi, expected, abs_tol=1e-12)
 

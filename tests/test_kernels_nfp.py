@@ -44,7 +44,7 @@ def convex_polys(draw, grid=4):
 @examples(100)
 @given(convex_polys(), convex_polys())
 def test_convex_sums_match_the_hull_of_vertex_sums(p, q):
-    xy, starts = kmink.convex_sums(*_packed([p]), *_packed([q]))
+    xy, starts, _ = kmink.convex_sums(*_packed([p]), *_packed([q]))
     got = shapely.Polygon(xy)
     want = shapely.convex_hull(shapely.MultiPoint((p[:, None, :] + q[None, :, :]).reshape(-1, 2)))
     assert got.is_valid

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+from catalogue import interlocking_combs
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from profiles import examples
@@ -438,11 +439,41 @@ def test_nfp_beyond_its_memory_budget_is_refused_not_killed(monkeypatch):
     # Two large concave bodies make a sum per pair of pieces (1000 x 100 000 vertices:
     # hundreds of millions of vertices); past its budget the NFP raises a clear error.
     # The budget is lowered here to reach it with small shapes.
-    monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
+    monkeypatch.setattr(pc.limits, "MAX_SUM_VERTICES", 20)
     comb = [(0, 0), (4, 0), (4, 3), (3, 1), (2, 3), (1, 1), (0, 3)]
     with pytest.raises(nfp_module.NfpTooLargeError, match="memory"):
         pc.no_fit_polygon(comb, comb)
     assert issubclass(nfp_module.NfpTooLargeError, (pc.PolycontactError, MemoryError))
+
+
+def _regular_combs(teeth):
+    return tuple(pc.Shape(x) for x in interlocking_combs(teeth))
+
+
+def test_interlocking_combs_match_the_reference():
+    # their sums overlap by the dozen wherever teeth meet gaps: every exact fit found is
+    # a point where A touches B, every slide a segment, and the region is the reference
+    a, b = _regular_combs(20)
+    nfp = pc.no_fit_polygon(a, b, reference="origin")
+    ref = reference_region(a.to_shapely(), b.to_shapely(), (0.0, 0.0))
+    assert same_region(nfp.region, ref) is None
+    # a slide for each way the teeth can enter: 2 x 20 - 1 shifts
+    assert len(nfp.slides) == 39 and len(nfp.exact_fits) == 0
+    for s in nfp.slides:
+        for p in (s[0], s[1], 0.5 * (s[0] + s[1])):
+            assert nfp.contains(p) is State.CONTACT
+
+
+def test_nfp_beyond_its_clipping_limit_is_refused_naming_the_estimate(monkeypatch):
+    # the edge-sum tests are counted once the sums are built, before any clipping (420
+    # sums: enough for the grid that lists them)
+    a, b = _regular_combs(20)
+    monkeypatch.setattr(pc.limits, "MAX_CLIP_TESTS", 1000)
+    with pytest.raises(pc.NfpTooLargeError, match=r"about [0-9.e+]+ edge–sum tests "
+                                                  r".*MAX_CLIP_TESTS = 1e\+03 \(time\)"):
+        pc.no_fit_polygon(a, b, reference="origin")
+    monkeypatch.undo()
+    assert pc.no_fit_polygon(a, b, reference="origin").region.area > 0
 
 
 @pytest.mark.parametrize("far", [1e150, 1e100, 1e17])
@@ -470,7 +501,7 @@ def test_nfp_kernel_reports_non_finite_sums_instead_of_crashing():
         "sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])\n"
         "st = np.array([0, 4])\n"
         "r = np.full((4, 2), np.inf)\n"
-        "print(kn.entrance_region(sq, st, r, st, -1.0, 1e-12, 64.0, 1e-9)[4][1])\n"
+        "print(kn.entrance_region(sq, st, r, st, -1.0, 1e-12, 64.0, 1e-9, 1e8)[4][1])\n"
         "print(len(kmink.convex_sums(sq, st, r, st)[0]) <= 8)\n"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -63,9 +63,10 @@ def test_ring_kernel_is_the_pieces_path_bit_for_bit(a, b, reference):
     a0 = nfp_module._reference(a, reference, b)
     bxy, bst = nfp_module._convex_pieces(b)
     axy, ast = nfp_module._convex_pieces(a)
-    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT)
+    want_head, want = kn.entrance_packed(bxy, bst, a0 - axy, ast, *ARGS, *EXACT,
+                                         MAX_CLIP_TESTS)
     head, got = kn.ring_entrance(b.packed[0], a.packed[0], a0[0], a0[1], *ARGS, *EXACT,
-                                 EAR_CLIPPING_MAX, MAX_SUM_VERTICES)
+                                 EAR_CLIPPING_MAX, MAX_SUM_VERTICES, MAX_CLIP_TESTS)
     assert head[0] == 1.0
     assert head == want_head
     np.testing.assert_array_equal(got, want)
@@ -104,12 +105,13 @@ def test_packed_candidates_are_the_snapped_merged_sorted_ones(b):
 def _check_packed(bxy, bst, r, ast):
     """entrance_packed = entrance_region, its candidates snapped, merged and sorted as
     the Python code did before the kernel took it over; returns the candidates' count."""
-    ring_xy, ring_starts, stats, cand, meta = kn.entrance_region(bxy, bst, r, ast, *ARGS)
-    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS, *EXACT)
-    ok, eps, status, n_pts, n_rings, n_vertices, n_cand = head
-    assert (ok, eps, status, n_pts) == (1.0, *meta.tolist())
+    ring_xy, ring_starts, stats, cand, meta = kn.entrance_region(bxy, bst, r, ast, *ARGS,
+                                                                 MAX_CLIP_TESTS)
+    head, buf = kn.entrance_packed(bxy, bst, r, ast, *ARGS, *EXACT, MAX_CLIP_TESTS)
+    ok, eps, status, n_pts, n_rings, n_vertices, n_cand, tests = head
+    assert (ok, eps, status, n_pts, tests) == (1.0, *meta.tolist())
     if len(cand):
-        cand = _exact_candidates(cand, int(n_pts), *kmink.convex_sums(bxy, bst, r, ast), eps)
+        cand = _exact_candidates(cand, int(n_pts), *kmink.convex_sums(bxy, bst, r, ast)[:2], eps)
     assert (n_rings, n_vertices, n_cand) == (len(ring_starts) - 1, len(ring_xy), len(cand))
     for g, w in zip(nfp_module._unpack(buf, n_rings, n_vertices),
                     (ring_xy, ring_starts, stats, cand)):
@@ -158,7 +160,7 @@ def test_each_path_is_taken_and_right(monkeypatch, case):
         b = pc.Shape(star(EAR_CLIPPING_MAX + 11, 4, (1.0, 0.5)))
         want_path = {"ring": 1, "pieces": 1}
     elif case == "budget":  # the ring kernel declines, the pieces path refuses
-        monkeypatch.setattr(nfp_module, "MAX_SUM_VERTICES", 20)
+        monkeypatch.setattr(pc.limits, "MAX_SUM_VERTICES", 20)
     calls = _count_paths(monkeypatch)
     if case == "budget":
         with pytest.raises(nfp_module.NfpTooLargeError):

@@ -24,6 +24,7 @@ from test_nfp import CATALOGUE, ESICUP, _rotated, shape, star_shapes
 import polycontact as pc
 from polycontact import nfp as nfp_module
 from polycontact._kernels import nfp as kn
+from polycontact.limits import MAX_CLIP_TESTS
 from polycontact.tolerances import RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 
@@ -34,7 +35,7 @@ def eager_region(a: pc.Shape, b: pc.Shape, a0: np.ndarray) -> shapely.Geometry:
     axy, ast = nfp_module._convex_pieces(a)
     ring_xy, ring_starts, stats, _, meta = kn.entrance_region(
         bxy, bst, a0 - axy, ast, -1.0, RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        nfp_module.ANGLE_TOLERANCE)
+        nfp_module.ANGLE_TOLERANCE, MAX_CLIP_TESTS)
     assert meta[1] == 1.0
     width = nfp_module.HOLE_WIDTH_FACTOR * meta[0]
     return nfp_module._polygon_from_rings(ring_xy, ring_starts, stats, width)

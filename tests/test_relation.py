@@ -402,3 +402,27 @@ def test_a_relation_cannot_be_changed():
         assert back.features == r.features and np.array_equal(back.point, point)
     with pytest.raises(TypeError, match="classify"):
         Relation(State.CONTACT, 1e-12, sq, sq)
+
+
+def test_first_classification_of_large_shapes_binds_with_their_own_tolerance(monkeypatch):
+    # The first call on Shapes too large for the stack scratch binds the allocating
+    # kernel by one call with the caller's arguments: with a made-up tolerance of 1.0,
+    # every vertex of a 2e6-vertex unit ring touched every edge near it and that call
+    # alone took minutes.
+    from polycontact import relation as relation_module
+    from polycontact._kernels import packs as kpack
+
+    seen = []
+
+    def spy(dispatcher, args):
+        seen.append(args[-1])
+        return dispatcher
+
+    monkeypatch.setattr(relation_module, "entry_point", spy)
+    monkeypatch.setattr(relation_module, "_state_full", relation_module._bind_state_full)
+    t = np.linspace(0.0, 2.0 * np.pi, 400, endpoint=False)
+    ring = Shape(np.c_[np.cos(t), np.sin(t)])
+    square = Shape([(0.9, -0.1), (1.2, -0.1), (1.2, 0.1), (0.9, 0.1)])
+    assert ring.n_vertices > kpack.STACK_VERTICES
+    assert classify(ring, square, tolerance=1e-10).state is State.PENETRATING
+    assert seen == [1e-10]

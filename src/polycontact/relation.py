@@ -518,7 +518,9 @@ def _bind_state_into(pa: bytes, pb: bytes, eps: float) -> int:
     binding at once bind the same entry point).
     """
     global _state_into
-    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, 1.0))
+    # (bound by a call with the caller's own tolerance: a made-up one could make the
+    # binding call far costlier than the classification asked for)
+    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, eps))
     return int(_state_into(pa, pb, eps))
 
 
@@ -526,7 +528,9 @@ def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndar
                      eps: float) -> int:
     """:func:`_bind_state_into` for ``relate_state`` on the shapes' arrays (``_state_full``)."""
     global _state_full
-    _state_full = entry_point(_kr().relate_state, (xa, sa, xb, sb, 1.0))
+    # (a tolerance of 1.0 on a large unit ring made every vertex touch every edge near
+    # it: the binding call took minutes)
+    _state_full = entry_point(_kr().relate_state, (xa, sa, xb, sb, eps))
     return int(_state_full(xa, sa, xb, sb, eps))
 
 
