@@ -76,8 +76,7 @@ def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
 _ALL_PAIRS = 256
 
 
-@njit(cache=True, nogil=True)
-def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
+def _edge_pair_test(xa, xb, na, ga, a1, gb, b1, eps, touch):
     """Edge ga->a1 of A against edge gb->b1 of B (B's rows offset by na).
 
     Marks in ``touch`` every end vertex within eps of the other edge; returns 1 if some
@@ -120,6 +119,11 @@ def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
     if ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
         return 2
     return 0
+
+
+_edge_pair = njit(cache=True, nogil=True)(_edge_pair_test)
+# Inlined into :func:`moved_state`, which calls it for each pair of edges in its window.
+_edge_pair_inlined = njit(nogil=True, _nrt=False, inline="always")(_edge_pair_test)
 
 
 @njit(cache=True, nogil=True)
@@ -309,6 +313,143 @@ _overlap_state = njit(cache=True, nogil=True, _nrt=False)(_overlap_test)
 # three classes of 200 pairs). The kernels that loop over many pairs call it: inlined
 # into each of them it would multiply their compile time.
 _overlap_state_inlined = njit(nogil=True, _nrt=False, inline="always")(_overlap_test)
+
+
+#: The verdicts of :func:`moved_state`: not penetrating, penetrating, and penetrating
+#: in a way that holds within the margin asked for.
+MOVED_CLEAR = 0
+MOVED_PENETRATING = 1
+MOVED_HELD = 2
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def moved_state(a, b, dx, dy, eps, margin, moved, scratch):
+    """Whether A moved by (dx, dy) penetrates B, as :func:`state_in` decides it:
+    :data:`MOVED_CLEAR`, :data:`MOVED_PENETRATING`, or :data:`MOVED_HELD` when it holds
+    by more than ``margin``: two edges cross with each end farther than ``margin`` from
+    the other edge's line, or a vertex lies inside the other body farther than
+    ``margin`` from its boundary (then A penetrates B after any further translation
+    shorter than ``margin`` less ``eps`` and the rounding).
+
+    ``a`` = ``(xa, sa, ea, nxa, box)``: A's packed loops (interior on the left), its
+    :func:`polycontact._kernels.primitives.edge_rows` table and successors, its bounding
+    box; ``b`` likewise. ``moved`` (shaped like ``xa``) receives A moved; ``scratch`` is
+    the state kernel's (:func:`polycontact._kernels.packs.scratch_floats` of both
+    bodies' vertices). For the translations of one pair the edge boxes come from the
+    tables (a translation shifts them exactly: rounding is monotonic), not from the
+    coordinates; the edges whose boxes meet the common window are tested all against
+    all, as :func:`_overlap_test` does. A touch (an end within ``eps`` of the other
+    edge), or more pairs of edges in the window than :data:`_ALL_PAIRS`, is left to
+    :func:`_overlap_test`, so the verdict is the state kernel's in every case.
+    """
+    xa, sa, ea, nxa, ba = a
+    xb, sb, eb, nxb, bb = b
+    m = xa.shape[0]
+    nb = xb.shape[0]
+    for i in range(m):
+        moved[i, 0] = xa[i, 0] + dx
+        moved[i, 1] = xa[i, 1] + dy
+    bm = (ba[0] + dx, ba[1] + dx, ba[2] + dy, ba[3] + dy)
+    if _boxes_apart(bm, bb, eps):
+        return MOVED_CLEAR
+    wx0, wx1, wy0, wy1 = _window(bm, bb, eps)
+    views = state_scratch_views(scratch, m + nb)
+    box, ids, touch = views[0], views[1], views[2]
+    ca = 0
+    for i in range(m):
+        x0 = ea[i, 3] + dx
+        x1 = ea[i, 4] + dx
+        y0 = ea[i, 5] + dy
+        y1 = ea[i, 6] + dy
+        box[ca, 0] = x0 - eps
+        box[ca, 1] = x1 + eps
+        box[ca, 2] = y0 - eps
+        box[ca, 3] = y1 + eps
+        ids[ca, 0] = i
+        ca += not (x1 < wx0 or x0 > wx1 or y1 < wy0 or y0 > wy1)
+    c = ca
+    for j in range(nb):
+        box[c, 0] = eb[j, 3]
+        box[c, 1] = eb[j, 4]
+        box[c, 2] = eb[j, 5]
+        box[c, 3] = eb[j, 6]
+        ids[c, 0] = j
+        c += not (eb[j, 4] < wx0 or eb[j, 3] > wx1 or eb[j, 6] < wy0 or eb[j, 5] > wy1)
+    if ca * (c - ca) > _ALL_PAIRS:
+        return MOVED_PENETRATING if _overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb,
+                                                   views) == PENETRATING else MOVED_CLEAR
+    touch[:m + nb] = False
+    for p in range(ca):
+        i = ids[p, 0]
+        for q in range(ca, c):
+            if (box[q, 0] > box[p, 1] or box[q, 1] < box[p, 0] or box[q, 2] > box[p, 3]
+                    or box[q, 3] < box[p, 2]):
+                continue
+            j = ids[q, 0]
+            met = _edge_pair_inlined(moved, xb, m, i, nxa[i], m + j, m + nxb[j], eps, touch)
+            if met == 1:  # a touch: the cones decide
+                return MOVED_PENETRATING if _overlap_state(
+                    moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views) == PENETRATING \
+                    else MOVED_CLEAR
+            if met == 2:
+                return MOVED_HELD if _held(moved, i, nxa[i], xb, j, nxb[j], margin) \
+                    else MOVED_PENETRATING
+    # (2) of the state test: the first vertex of each loop (none touches), inside
+    got = MOVED_CLEAR
+    for side in range(2):  # A's loops in B, then B's in A (one inlined copy)
+        if side == 0:
+            xv, sv, xo, so, eo, bo, ox, oy, nxo = moved, sa, xb, sb, eb, bb, 0.0, 0.0, nxb
+        else:
+            xv, sv, xo, so, eo, bo, ox, oy, nxo = xb, sb, moved, sa, ea, bm, dx, dy, nxa
+        if got == MOVED_CLEAR:
+            got = _first_inside(xv, sv, xo, so, eo, bo, ox, oy, nxo, margin)
+    return got
+
+
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _first_inside(xv, sv, xo, so, eo, bo, ox, oy, nxo, margin):
+    """As :func:`_untouched_inside` with no vertex touching (the first vertex of each
+    loop of V, inside O's box ``bo`` and O): :data:`MOVED_HELD` when such a vertex lies
+    farther than ``margin`` from O's boundary, :data:`MOVED_PENETRATING` when one lies
+    nearer, else :data:`MOVED_CLEAR`. ``eo``, ``nxo``: O's edge table, its boxes moved
+    by (ox, oy) from O's rows ``xo``, and successors."""
+    got = MOVED_CLEAR
+    for k in range(sv.shape[0] - 1):
+        x = xv[sv[k], 0]
+        y = xv[sv[k], 1]
+        if not (bo[0] <= x <= bo[1] and bo[2] <= y <= bo[3] and point_inside(x, y, xo, so)):
+            continue
+        got = MOVED_PENETRATING
+        if not margin < np.inf:
+            return got
+        near = margin * margin
+        for f in range(xo.shape[0]):
+            gx = max(0.0, x - ox - eo[f, 4], eo[f, 3] + ox - x)
+            gy = max(0.0, y - oy - eo[f, 6], eo[f, 5] + oy - y)
+            if gx * gx + gy * gy > near:
+                continue
+            g = nxo[f]
+            near = min(near, closest_on_segment(x, y, xo[f, 0], xo[f, 1], xo[g, 0],
+                                                xo[g, 1])[2])
+        if not near < margin * margin:
+            return MOVED_HELD
+    return got
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _held(xa, i, i1, xb, j, j1, margin):
+    """Whether each end of edge i → i1 of A and of edge j → j1 of B lies farther than
+    ``margin`` from the other edge's line (squared orientations against the margin
+    times the lengths)."""
+    px, py, qx, qy = xa[i, 0], xa[i, 1], xa[i1, 0], xa[i1, 1]
+    rx, ry, sx, sy = xb[j, 0], xb[j, 1], xb[j1, 0], xb[j1, 1]
+    la = margin * margin * ((qx - px) ** 2 + (qy - py) ** 2)
+    lb = margin * margin * ((sx - rx) ** 2 + (sy - ry) ** 2)
+    o1 = orient(px, py, qx, qy, rx, ry)
+    o2 = orient(px, py, qx, qy, sx, sy)
+    o3 = orient(rx, ry, sx, sy, px, py)
+    o4 = orient(rx, ry, sx, sy, qx, qy)
+    return o1 * o1 > la and o2 * o2 > la and o3 * o3 > lb and o4 * o4 > lb
 
 
 @njit(cache=True, nogil=True)

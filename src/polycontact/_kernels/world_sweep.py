@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit, prange
 
 from .advance import edge_table
-from .contact_geometry import geometry_buffers, pair_geometry_into
+from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
 from .impact import exact_query, state_at, tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, view
 
@@ -215,28 +215,46 @@ def sweep_search(pi, pj, movers, base, tables, settings, vmax, lmax, chunks):
 
 @njit(cache=True, nogil=True)
 def _event_range(events, base, tables, vmax, lmax, ulps, k0, k1, point, normal):
-    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``."""
+    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``.
+    The two bodies of an event are placed side by side as the rows of a World of two
+    (``rows``, one pair), for :func:`polycontact._kernels.contact_geometry.geometry_into`."""
     pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb = events
     fa, fb = _frame_scratch(vmax, lmax)
-    xa = np.empty((vmax, 2))
-    xb = np.empty((vmax, 2))
+    xy = np.empty((2 * vmax, 2))
+    ls = np.empty(2 * lmax + 1, np.int64)
+    lo = np.zeros(2, np.int64)
+    nl = np.empty(2, np.int64)
+    rows = (xy, ls, lo, nl)
+    pair = (np.zeros(1, np.int64), np.ones(1, np.int64), np.empty(1, np.int8), np.empty(1))
     scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
     buffers = geometry_buffers(vmax)
-    m = k1 - k0
-    dist = np.empty(m)
-    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
-            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    dist = np.empty(1)
+    rest = (np.empty(1), np.empty((1, 2)), np.empty(1, np.int8), np.empty(1, np.int64),
+            np.empty(1, np.int64))
     for k in range(k0, k1):
         r1, s1, _ = _frame(pa[k], ta[k], base, tables, fa)
         r2, s2, _ = _frame(pb[k], tb[k], base, tables, fb)
+        n1 = r1.shape[0]
+        n2 = r2.shape[0]
+        nl[0] = s1.shape[0] - 1
+        nl[1] = s2.shape[0] - 1
+        lo[1] = nl[0]
+        ls[:nl[0] + 1] = s1
+        ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
         t = times[k]
-        ya = xa[:r1.shape[0]]
-        yb = xb[:r2.shape[0]]
         eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
-        now = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t, eps,
-                       (ya, yb, scratch))
-        pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
-        if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
+        pair[2][0] = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t,
+                              eps, (xy[:n1], xy[n1:n1 + n2], scratch))
+        pair[3][0] = eps
+        out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
+        while True:
+            done, status = geometry_into(rows, pair, 0, 1, out, buffers, ba, bb)
+            if done == 1:
+                break
+            buffers = grown_buffers(buffers, status, vmax)
+        if not dist[0] == dist[0]:  # a depth left undecided: for the caller
             normal[k, 0] = np.nan
             normal[k, 1] = np.nan
 
