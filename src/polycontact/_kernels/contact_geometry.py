@@ -38,7 +38,7 @@ from .depth import box_escape
 from .overlap import overlap_moments, overlap_of_tables, overlap_scratch
 from .packs import scratch_floats
 from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next, loop_prev
-from .relation import MOVED_CLEAR, moved_state
+from .relation import moved_state
 from .world import body_view
 
 SEPARATE = 0
@@ -224,7 +224,7 @@ def _penetrating(ya, sa, yb, sb, e, buffers):
             dy = qy - xv[vv, 1] if s == 0 else xv[vv, 1] - qy
     if deep > 0.0:
         g = 1.0 + 2.0 * e / deep
-        if moved_state(a, b, dx * g, dy * g, e, np.inf, moved[:na], state_buf) == MOVED_CLEAR:
+        if not moved_state(a, b, dx * g, dy * g, e, moved[:na], state_buf)[0]:
             xv = ya if side == 0 else yb
             return GEOMETRY_DONE, deep, -dx / deep + 0.0, -dy / deep + 0.0, xv[v, 0], \
                 xv[v, 1], area, cx, cy, side, v, f

@@ -42,7 +42,7 @@ from numba import njit
 from .packs import scratch_floats, state_scratch_views
 from .primitives import (bbox, edge_rows, grow_rows, loop_prev, norm, origin_distance_sq,
                          origin_foot)
-from .relation import MOVED_CLEAR, MOVED_HELD, PENETRATING, moved_state, state_in
+from .relation import PENETRATING, moved_state, state_in, witness_holds
 
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
@@ -72,61 +72,62 @@ def _add_segments(v, o, sign, bound, slack, seg, n, near):
     without overlap: convex, and both of its edges on the outer (right) side of the
     edge, each up to :data:`_SIN_SLACK` and ``slack`` (an absolute allowance for the
     rounding of the coordinates) in the cross products. The segment of vertex p and
-    edge e is nearer than ``bound`` only if p is, so a vertex farther than ``bound``
-    from the other body's box, and an edge whose box is that far from the vertex (or
-    from the vertices' box), is passed over. ``near`` (one entry per vertex of the other
-    body) is scratch.
+    edge e is nearer than ``bound`` only if p is, so only the vertices within ``bound``
+    of the other body's box, and the edges within it of the vertices' box, are paired.
+    ``near`` (one entry per vertex of both bodies) is scratch. (The lists are made
+    without branches, a row written whether kept or not: the tests' outcomes follow no
+    pattern a branch predictor could learn.)
     """
     xv, sv, ev, _, (vx0, vx1, vy0, vy1) = v
     xe, _, ee, ne, (ex0, ex1, ey0, ey1) = o
     b2 = bound * bound
-    # only the edges whose boxes come within bound of V's box can hold one: listed in
-    # ``near`` (the rest are farther than bound from every vertex of V)
+    # only the edges whose boxes come within bound of V's box can hold one
     m = 0
     for j in range(xe.shape[0]):
-        if (ee[j, 3] < vx1 + bound and ee[j, 4] > vx0 - bound and ee[j, 5] < vy1 + bound
-                and ee[j, 6] > vy0 - bound):
-            near[m] = j
-            m += 1
+        near[m] = j
+        m += ((ee[j, 3] < vx1 + bound) & (ee[j, 4] > vx0 - bound) & (ee[j, 5] < vy1 + bound)
+              & (ee[j, 6] > vy0 - bound))
+    # the convex vertices within bound of the other body's box, after them
+    c = m
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
-            px = xv[i, 0]
-            py = xv[i, 1]
-            gapx = max(0.0, px - ex1, ex0 - px)
-            gapy = max(0.0, py - ey1, ey0 - py)
-            if gapx * gapx + gapy * gapy >= b2:
-                continue
             p = loop_prev(i, sv, k)
+            gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])
+            gapy = max(0.0, xv[i, 1] - ey1, ey0 - xv[i, 1])
             ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
-            vx, vy, lv = ev[i, 0], ev[i, 1], ev[i, 2]
-            if (ux * vy - uy * vx) < -(_SIN_SLACK * lu * lv + slack * (lu + lv)):
-                continue  # reflex: its wedge overlaps any edge it touches
-            for t in range(m):
-                j = near[t]
-                gapx = max(0.0, px - ee[j, 4], ee[j, 3] - px)
-                gapy = max(0.0, py - ee[j, 6], ee[j, 5] - py)
-                if gapx * gapx + gapy * gapy >= b2:
-                    continue
-                gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
-                if ((gx * vy - gy * vx) > _SIN_SLACK * lg * lv + slack * (lg + lv)
-                        or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
-                    continue
-                jj = ne[j]
-                x0 = sign * (px - xe[j, 0])
-                y0 = sign * (py - xe[j, 1])
-                x1 = sign * (px - xe[jj, 0])
-                y1 = sign * (py - xe[jj, 1])
-                d = origin_distance_sq(x0, y0, x1, y1)
-                if d < b2:
-                    seg[n, 0] = x0
-                    seg[n, 1] = y0
-                    seg[n, 2] = x1
-                    seg[n, 3] = y1
-                    seg[n, 4] = d
-                    seg[n, 5] = 0.5 + 0.5 * sign
-                    seg[n, 6] = i
-                    seg[n, 7] = j
-                    n += 1
+            wx, wy, lw = ev[i, 0], ev[i, 1], ev[i, 2]
+            near[c] = i
+            near[c + 1] = p
+            c += 2 * ((gapx * gapx + gapy * gapy < b2)
+                      & ((ux * wy - uy * wx) >= -(_SIN_SLACK * lu * lw + slack * (lu + lw))))
+    for r in range(m, c, 2):
+        i = near[r]
+        p = near[r + 1]
+        px = xv[i, 0]
+        py = xv[i, 1]
+        ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
+        wx, wy, lw = ev[i, 0], ev[i, 1], ev[i, 2]
+        for t in range(m):
+            j = near[t]
+            gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
+            jj = ne[j]
+            x0 = sign * (px - xe[j, 0])
+            y0 = sign * (py - xe[j, 1])
+            x1 = sign * (px - xe[jj, 0])
+            y1 = sign * (py - xe[jj, 1])
+            seg[n, 0] = x0
+            seg[n, 1] = y0
+            seg[n, 2] = x1
+            seg[n, 3] = y1
+            seg[n, 5] = 0.5 + 0.5 * sign
+            seg[n, 6] = i
+            seg[n, 7] = j
+            if ((gx * wy - gy * wx) > _SIN_SLACK * lg * lw + slack * (lg + lw)
+                    or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
+                continue
+            d = origin_distance_sq(x0, y0, x1, y1)
+            seg[n, 4] = d
+            n += d < b2
     return n
 
 
@@ -211,11 +212,6 @@ def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
     return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, views) == PENETRATING
 
 
-#: Units of 2**-52 of the largest |coordinate| added to the margin of the first test of
-#: :func:`_escapes` (the rounding of the orientations it compares, a few units).
-_HELD_ULPS = 64.0
-
-
 @njit(cache=True, nogil=True, _nrt=False)
 def _escapes(a, b, px, py, d, eps, moved, scratch):
     """Whether A moved by p = (px, py), a point at distance d of a contact segment, ends
@@ -225,22 +221,18 @@ def _escapes(a, b, px, py, d, eps, moved, scratch):
     having been found to penetrate, either makes p the depth within 2 ``eps``. ``a``,
     ``b``: the bodies as :func:`contact_depth_of` takes them.
 
-    When the first test finds two edges crossing with every end farther than 4 ``eps``
-    (and the rounding) from the other edge's line, they still cross at p, 2 ``eps``
-    nearer: p penetrates, untested."""
+    A penetration found 2 ``eps`` further whose witness (two edges crossing, a vertex
+    inside) holds at p too (:func:`polycontact._kernels.relation.witness_holds`) makes
+    p penetrate: the state kernel is not asked again there."""
     if d > 0.0:
         f = 1.0 + 2.0 * eps / d
-        ba = a[4]
-        bb = b[4]
-        mag = max(-ba[0], ba[1], -ba[2], ba[3], -bb[0], bb[1], -bb[2], bb[3]) + \
-            abs(px * f) + abs(py * f)
-        got = moved_state(a, b, px * f, py * f, eps, 4.0 * eps + _HELD_ULPS * 2.0**-52 * mag,
-                          moved, scratch)
-        if got == MOVED_CLEAR:
+        got, witness, i, j = moved_state(a, b, px * f, py * f, eps, moved, scratch)
+        if not got:
             return True
-        if got == MOVED_HELD:
+        touch = state_scratch_views(scratch, a[0].shape[0] + b[0].shape[0])[2]
+        if witness_holds(a, b, px, py, eps, witness, i, j, moved, touch):
             return False
-    return moved_state(a, b, px, py, eps, np.inf, moved, scratch) == MOVED_CLEAR
+    return not moved_state(a, b, px, py, eps, moved, scratch)[0]
 
 
 @njit(cache=True, nogil=True)
@@ -285,10 +277,10 @@ def depth_buffers(m, n):
     """Scratch of :func:`contact_depth_into` for bodies of up to ``m`` and ``n``
     vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near)``."""
     k = 2 * m * n
-    return (np.empty((k, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
+    return (np.empty((k + 1, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
             np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 7)),
             np.empty(m, np.int64), np.empty((n, 7)), np.empty(n, np.int64),
-            np.empty(max(m, n), np.int64))
+            np.empty(3 * (m + n), np.int64))
 
 
 #: What :func:`contact_depth_of` says of a depth: found, left undecided (the caller's
@@ -389,7 +381,7 @@ def contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers):
         if _escapes(a, b, px, py, d, eps, moved, scratch):
             q = int(pts[r, 4])
             return d, px, py, DEPTH_FOUND, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
-    if moved_state(a, b, bdx, bdy, eps, np.inf, moved, scratch) != MOVED_CLEAR:
+    if moved_state(a, b, bdx, bdy, eps, moved, scratch)[0]:
         return np.nan, np.nan, np.nan, DEPTH_UNDECIDED, -1, -1, -1
     return bound, bdx, bdy, DEPTH_FOUND, -1, -1, -1
 

@@ -242,8 +242,8 @@ def _crossings(a, b, eps, window, deg_a, deg_b, cross, boxes, ids):
 @njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _boundary_inside(v, o, eps, frame, deg, cross, col, sums, where_v):
     """Add the parts of body V's boundary inside body O (see the module docstring):
-    ``v``, ``o`` the bodies as :func:`overlap_of_tables` takes them, ``frame`` = ``(wx0, wx1, wy0, wy1, ox, oy)`` the window and the local
-    origin, ``deg`` V's edges to classify by midpoints, ``cross`` the crossings, with
+    ``v``, ``o`` the bodies as :func:`overlap_of_tables` takes them, ``frame`` =
+    ``(wx0, wx1, wy0, wy1, ox, oy)`` the window and the local origin, ``deg`` V's edges to classify by midpoints, ``cross`` the crossings, with
     V's edge in column ``col`` (0: V is A, whose pieces on O's boundary count) and its
     parameter in ``col + 2``; ``sums`` = ``(ts, acc)``: the cut parameters' scratch and
     the sums of :func:`_green`. Each vertex's place goes to ``where_v`` (as

@@ -315,21 +315,22 @@ _overlap_state = njit(cache=True, nogil=True, _nrt=False)(_overlap_test)
 _overlap_state_inlined = njit(nogil=True, _nrt=False, inline="always")(_overlap_test)
 
 
-#: The verdicts of :func:`moved_state`: not penetrating, penetrating, and penetrating
-#: in a way that holds within the margin asked for.
-MOVED_CLEAR = 0
-MOVED_PENETRATING = 1
-MOVED_HELD = 2
+#: The witnesses :func:`moved_state` gives of a penetration: none (the state kernel
+#: decided), two edges that cross, a vertex of A inside B, a vertex of B inside A.
+NO_WITNESS = 0
+CROSSING = 1
+A_INSIDE = 2
+B_INSIDE = 3
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def moved_state(a, b, dx, dy, eps, margin, moved, scratch):
-    """Whether A moved by (dx, dy) penetrates B, as :func:`state_in` decides it:
-    :data:`MOVED_CLEAR`, :data:`MOVED_PENETRATING`, or :data:`MOVED_HELD` when it holds
-    by more than ``margin``: two edges cross with each end farther than ``margin`` from
-    the other edge's line, or a vertex lies inside the other body farther than
-    ``margin`` from its boundary (then A penetrates B after any further translation
-    shorter than ``margin`` less ``eps`` and the rounding).
+def moved_state(a, b, dx, dy, eps, moved, scratch):
+    """Whether A moved by (dx, dy) penetrates B, as :func:`state_in` decides it, and
+    why: ``(penetrating, witness, i, j)``, the witness :data:`CROSSING` (A's edge i
+    and B's edge j cross properly), :data:`A_INSIDE` (A's vertex i lies inside B, no
+    edge within ``eps``), :data:`B_INSIDE` (B's vertex j inside A) or
+    :data:`NO_WITNESS`; :func:`witness_holds` tells whether it still holds at another
+    translation.
 
     ``a`` = ``(xa, sa, ea, nxa, box)``: A's packed loops (interior on the left), its
     :func:`polycontact._kernels.primitives.edge_rows` table and successors, its bounding
@@ -351,7 +352,7 @@ def moved_state(a, b, dx, dy, eps, margin, moved, scratch):
         moved[i, 1] = xa[i, 1] + dy
     bm = (ba[0] + dx, ba[1] + dx, ba[2] + dy, ba[3] + dy)
     if _boxes_apart(bm, bb, eps):
-        return MOVED_CLEAR
+        return False, NO_WITNESS, -1, -1
     wx0, wx1, wy0, wy1 = _window(bm, bb, eps)
     views = state_scratch_views(scratch, m + nb)
     box, ids, touch = views[0], views[1], views[2]
@@ -376,8 +377,8 @@ def moved_state(a, b, dx, dy, eps, margin, moved, scratch):
         ids[c, 0] = j
         c += not (eb[j, 4] < wx0 or eb[j, 3] > wx1 or eb[j, 6] < wy0 or eb[j, 5] > wy1)
     if ca * (c - ca) > _ALL_PAIRS:
-        return MOVED_PENETRATING if _overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb,
-                                                   views) == PENETRATING else MOVED_CLEAR
+        return (_overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views) == PENETRATING,
+                NO_WITNESS, -1, -1)
     touch[:m + nb] = False
     for p in range(ca):
         i = ids[p, 0]
@@ -388,68 +389,56 @@ def moved_state(a, b, dx, dy, eps, margin, moved, scratch):
             j = ids[q, 0]
             met = _edge_pair_inlined(moved, xb, m, i, nxa[i], m + j, m + nxb[j], eps, touch)
             if met == 1:  # a touch: the cones decide
-                return MOVED_PENETRATING if _overlap_state(
-                    moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views) == PENETRATING \
-                    else MOVED_CLEAR
+                return (_overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views)
+                        == PENETRATING, NO_WITNESS, -1, -1)
             if met == 2:
-                return MOVED_HELD if _held(moved, i, nxa[i], xb, j, nxb[j], margin) \
-                    else MOVED_PENETRATING
+                return True, CROSSING, i, j
     # (2) of the state test: the first vertex of each loop (none touches), inside
-    got = MOVED_CLEAR
-    for side in range(2):  # A's loops in B, then B's in A (one inlined copy)
-        if side == 0:
-            xv, sv, xo, so, eo, bo, ox, oy, nxo = moved, sa, xb, sb, eb, bb, 0.0, 0.0, nxb
-        else:
-            xv, sv, xo, so, eo, bo, ox, oy, nxo = xb, sb, moved, sa, ea, bm, dx, dy, nxa
-        if got == MOVED_CLEAR:
-            got = _first_inside(xv, sv, xo, so, eo, bo, ox, oy, nxo, margin)
-    return got
+    for k in range(sa.shape[0] - 1):
+        x = moved[sa[k], 0]
+        y = moved[sa[k], 1]
+        if bb[0] <= x <= bb[1] and bb[2] <= y <= bb[3] and point_inside(x, y, xb, sb):
+            return True, A_INSIDE, sa[k], -1
+    for k in range(sb.shape[0] - 1):
+        x = xb[sb[k], 0]
+        y = xb[sb[k], 1]
+        if bm[0] <= x <= bm[1] and bm[2] <= y <= bm[3] and point_inside(x, y, moved, sa):
+            return True, B_INSIDE, -1, sb[k]
+    return False, NO_WITNESS, -1, -1
 
 
-@njit(cache=True, nogil=True, _nrt=False, inline="always")
-def _first_inside(xv, sv, xo, so, eo, bo, ox, oy, nxo, margin):
-    """As :func:`_untouched_inside` with no vertex touching (the first vertex of each
-    loop of V, inside O's box ``bo`` and O): :data:`MOVED_HELD` when such a vertex lies
-    farther than ``margin`` from O's boundary, :data:`MOVED_PENETRATING` when one lies
-    nearer, else :data:`MOVED_CLEAR`. ``eo``, ``nxo``: O's edge table, its boxes moved
-    by (ox, oy) from O's rows ``xo``, and successors."""
-    got = MOVED_CLEAR
-    for k in range(sv.shape[0] - 1):
-        x = xv[sv[k], 0]
-        y = xv[sv[k], 1]
-        if not (bo[0] <= x <= bo[1] and bo[2] <= y <= bo[3] and point_inside(x, y, xo, so)):
-            continue
-        got = MOVED_PENETRATING
-        if not margin < np.inf:
-            return got
-        near = margin * margin
-        for f in range(xo.shape[0]):
-            gx = max(0.0, x - ox - eo[f, 4], eo[f, 3] + ox - x)
-            gy = max(0.0, y - oy - eo[f, 6], eo[f, 5] + oy - y)
-            if gx * gx + gy * gy > near:
-                continue
-            g = nxo[f]
-            near = min(near, closest_on_segment(x, y, xo[f, 0], xo[f, 1], xo[g, 0],
-                                                xo[g, 1])[2])
-        if not near < margin * margin:
-            return MOVED_HELD
-    return got
+@njit(cache=True, nogil=True, _nrt=False)
+def witness_holds(a, b, dx, dy, eps, witness, i, j, moved, touch):
+    """Whether a witness of :func:`moved_state` makes A moved by (dx, dy) penetrate B
+    as :func:`state_in` decides it: the two edges still cross properly, or the vertex
+    still lies inside the other body with no edge within ``eps`` (computed as the state
+    kernel would, from A's rows moved into ``moved``; ``touch``: room for a flag per
+    vertex of both bodies). A proper crossing, or a vertex so inside, is a penetration
+    whatever else the bodies do there."""
+    xa, sa, _, nxa, _ = a
+    xb, sb, _, nxb, _ = b
+    m = xa.shape[0]
+    for r in range(m):
+        moved[r, 0] = xa[r, 0] + dx
+        moved[r, 1] = xa[r, 1] + dy
+    if witness == CROSSING:
+        return _edge_pair_inlined(moved, xb, m, i, nxa[i], m + j, m + nxb[j], eps, touch) == 2
+    if witness == A_INSIDE:
+        return _deep_inside(moved[i, 0], moved[i, 1], xb, sb, nxb, eps)
+    if witness == B_INSIDE:
+        return _deep_inside(xb[j, 0], xb[j, 1], moved, sa, nxa, eps)
+    return False
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _held(xa, i, i1, xb, j, j1, margin):
-    """Whether each end of edge i → i1 of A and of edge j → j1 of B lies farther than
-    ``margin`` from the other edge's line (squared orientations against the margin
-    times the lengths)."""
-    px, py, qx, qy = xa[i, 0], xa[i, 1], xa[i1, 0], xa[i1, 1]
-    rx, ry, sx, sy = xb[j, 0], xb[j, 1], xb[j1, 0], xb[j1, 1]
-    la = margin * margin * ((qx - px) ** 2 + (qy - py) ** 2)
-    lb = margin * margin * ((sx - rx) ** 2 + (sy - ry) ** 2)
-    o1 = orient(px, py, qx, qy, rx, ry)
-    o2 = orient(px, py, qx, qy, sx, sy)
-    o3 = orient(rx, ry, sx, sy, px, py)
-    o4 = orient(rx, ry, sx, sy, qx, qy)
-    return o1 * o1 > la and o2 * o2 > la and o3 * o3 > lb and o4 * o4 > lb
+def _deep_inside(px, py, xo, so, nxo, eps):
+    """Whether (px, py) lies inside O with none of O's edges within ``eps``."""
+    e2 = eps * eps
+    for f in range(xo.shape[0]):
+        g = nxo[f]
+        if closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0], xo[g, 1])[2] <= e2:
+            return False
+    return point_inside(px, py, xo, so)
 
 
 @njit(cache=True, nogil=True)
