@@ -179,20 +179,18 @@ def _crossings(a, b, eps, window, deg_a, deg_b, cross, boxes, ids):
     xa, _, ea, nxa, _ = a
     xb, _, eb, nxb, _ = b
     wx0, wx1, wy0, wy1 = window
-    m = 0
+    m = 0  # (B's edges in the window listed without branches: a row written for each)
     for f in range(xb.shape[0]):
-        if not _edge_box_meets(eb, f, wx0, wx1, wy0, wy1):
-            continue
         boxes[m, 0] = eb[f, 3] - eps
         boxes[m, 1] = eb[f, 4] + eps
         boxes[m, 2] = eb[f, 5] - eps
         boxes[m, 3] = eb[f, 6] + eps
         ids[m] = f
-        m += 1
+        m += _edge_box_meets(eb, f, wx0, wx1, wy0, wy1)
     c = 0
     for e in range(xa.shape[0]):
         ex0, ex1, ey0, ey1 = ea[e, 3], ea[e, 4], ea[e, 5], ea[e, 6]
-        if ex1 < wx0 or ex0 > wx1 or ey1 < wy0 or ey0 > wy1:
+        if m == 0 or ex1 < wx0 or ex0 > wx1 or ey1 < wy0 or ey0 > wy1:
             continue
         e1 = nxa[e]
         px, py, qx, qy = xa[e, 0], xa[e, 1], xa[e1, 0], xa[e1, 1]
