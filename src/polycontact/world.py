@@ -1594,7 +1594,7 @@ class World:
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]
         """
-        from ._kernels.world_sweep import sweep_search
+        from ._kernels.world_sweep import sweep_search, turned_frames
         from ._kernels.swept import box_pairs, swept_boxes
 
         step = finite_number(dt, "dt", minimum=0.0)
@@ -1622,16 +1622,19 @@ class World:
             cand = box_pairs(boxes, owner, n)
         else:
             cand = np.empty((0, 2), np.int64)
-        self._sweep_frames(ids[np.unique(cand)])
+        bodies = ids[np.unique(cand)]
+        self._sweep_frames(bodies)
         tint, tflt, tio, tfo = self._frames[:4]
         box = self._box
         extent = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2])
         pi = np.ascontiguousarray(cand[:, 0])
         pj = np.ascontiguousarray(cand[:, 1])
         base = (self._bxy, self._ls, self._lo, self._nl, self._cen)
+        tables = (tint, tflt, tio, tfo)
+        frames = turned_frames(base, tables, bodies, self._ang, _chunks(len(bodies), _POSE_WORK))
         code, t_hit, t_contact, state = sweep_search(
-            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base,
-            (tint, tflt, tio, tfo),
+            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base, tables,
+            frames, (self._xy, self._ls, self._lo, self._nl),
             (step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, ROUNDING_FACTOR,
              CONTACT_RESOLUTION, int(max_iterations)),
             self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
@@ -1644,7 +1647,8 @@ class World:
                    self._rad[a], self._rad[b],
                    RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j]),
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
-                  (tint, tflt, tio.copy(), tfo.copy()), self._vmax, self._lmax, ROUNDING_FACTOR)
+                  (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
+                  ROUNDING_FACTOR)
         hit = np.where(code[order] == 2, 0.0, np.where(code[order] == 1, t_hit[order], np.nan))
         return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
                      events)
