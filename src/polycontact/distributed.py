@@ -4,30 +4,27 @@ Dask is an optional extra (``pip install "polycontact[dask]"``): this module imp
 ``distributed`` only inside its functions, and nothing else in polycontact imports this
 module unless a Dask client is given or is already the default.
 
+:func:`polycontact.classify_many`, :func:`polycontact.time_of_impact_many` and
+:func:`polycontact.nfp_table` take ``client=``: the same call, with the same checks in
+the calling process, runs its work here as tasks, and the result is identical to the
+local one. This module holds what they share:
+
 - :func:`current_client` is the client a batch runs on: the one given, else the
   default client of this process when ``distributed`` is already imported and one is
   set (``Client(...)`` or ``with Client(...)``), never one inside a Dask task.
 - ``WarmupPlugin`` (registered by :func:`ensure_warm`) compiles or loads the
   kernels once per worker, when the worker starts or joins, not once per task.
-- :func:`map_batches` splits aligned sequences into slices, calls a function on each
-  slice as one task, and returns the results in order; :func:`classify_many` is
-  :func:`polycontact.classify_many` split this way, with results identical to the
-  local run. :func:`polycontact.nfp_table` with ``client=`` runs its tasks through
-  :func:`run_tasks`.
-- :func:`time_of_impact_many` is :func:`polycontact.time_of_impact_many` on slices of
-  pairs: the arguments are checked here first, shapes used by several tasks are sent
-  to every worker once, and the result equals the local call's
-  :class:`~polycontact.ImpactBatch`.
+- :func:`run_spans` cuts ``range(count)`` into tasks: a first task measures the work per
+  item, the others get at least :data:`~polycontact.limits.TASK_SECONDS` of work each
+  and four per worker thread where there is enough; what every task needs is sent to
+  every worker once, and the results come back as they finish.
+- :func:`map_batches` calls any function on aligned slices of sequences that way.
 
 Examples
 --------
 Without a client everything runs locally:
 
->>> import numpy as np
 >>> from polycontact import distributed
->>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
->>> distributed.classify_many(np.stack([sq, sq]), np.stack([sq + 2, sq + 1])).states.tolist()
-[0, 1]
 >>> distributed.map_batches(len, list(range(10)), chunk_size=4)
 [4, 4, 2]
 """
@@ -41,23 +38,21 @@ from typing import Any
 
 import numpy as np
 
-from .limits import (DEFAULT_BATCH, DEFAULT_IMPACT_BATCH, MAX_ITERATIONS, SAMPLES,
-                     TIME_TOLERANCE)
-
 __all__ = [
     "WarmupPlugin",
-    "classify_many",
     "current_client",
     "ensure_warm",
     "map_batches",
-    "run_tasks",
-    "time_of_impact_many",
-    "DEFAULT_BATCH",
-    "DEFAULT_IMPACT_BATCH",
+    "run_spans",
+    "task_size",
+    "PROBE_ITEMS",
 ]
 
 #: Prefix of the names under which ``WarmupPlugin`` is registered (one per family).
 PLUGIN_NAME = "polycontact-warmup"
+
+#: Items of the first task of :func:`run_spans`, which measures the work per item.
+PROBE_ITEMS = 256
 
 
 def current_client(client: Any = None) -> Any:
@@ -123,32 +118,80 @@ def _plugins(dask_worker: Any) -> list[str]:
     return sorted(dask_worker.plugins)
 
 
-def run_tasks(
-    client: Any, fn: Callable[..., Any], shared: Any, tasks: Sequence[Any], *args: Any,
-    families: Iterable[str] | None = None,
-) -> Generator[tuple[int, Any], None, None]:
-    """Run ``fn(shared, task, *args)`` for each task on the cluster; yield
-    ``(task index, result)`` as tasks finish.
+Tasks = Callable[[list[tuple[int, int]]], tuple[Any, list[Any]]]
 
-    ``shared`` is sent once to every worker. Closing the generator early (an error, or
-    Ctrl-C in the caller) cancels the tasks not yet finished.
+
+def task_size(count: int, per_item: float, workers: int) -> int:
+    """Items per task for ``count`` items of ``per_item`` seconds each on ``workers``
+    worker threads: at least :data:`~polycontact.limits.TASK_SECONDS` of work, and as
+    many more as keeps four tasks per worker thread.
+
+    >>> task_size(1_000_000, 1e-6, 4), task_size(1000, 1e-6, 4)
+    (200000, 1000)
+    """
+    from .limits import TASK_SECONDS
+
+    by_time = math.ceil(TASK_SECONDS / max(per_item, 1e-12) * (1.0 - 1e-12))  # (no 1 ulp up)
+    return max(1, min(count, max(by_time, math.ceil(count / (4 * workers)))))
+
+
+def _timed(fn: Callable[..., Any], shared: Any, task: Any, *args: Any) -> tuple[Any, float]:
+    """``fn(shared, task, *args)`` and the seconds it took (on the worker)."""
+    import time
+
+    t0 = time.perf_counter()
+    out = fn(shared, task, *args)
+    return out, time.perf_counter() - t0
+
+
+def run_spans(
+    client: Any, fn: Callable[..., Any], count: int, tasks_of: Tasks, *args: Any,
+    chunk_size: int | None = None, families: Iterable[str] | None = None,
+) -> Generator[tuple[int, int, Any], None, None]:
+    """Run ``fn(shared, task, *args)`` over spans of ``range(count)`` as tasks on the
+    cluster; yield ``(p0, p1, result)`` for each span as its task finishes.
+
+    ``tasks_of(spans)`` gives ``(shared, tasks)``: what every task of those spans needs
+    (sent to every worker once) and each span's own task. With ``chunk_size`` the spans
+    have that many items; else a first task of :data:`PROBE_ITEMS` items measures the
+    work per item and :func:`task_size` sizes the others. Closing the generator early
+    (an error, or Ctrl-C in the caller) cancels the tasks not yet finished.
     """
     import distributed
 
+    if not count:
+        return
     as_completed: Any = distributed.as_completed
     ensure_warm(client, families)
-    [shared_future] = client.scatter([shared], broadcast=True, hash=False)
-    futures = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
-    index = {f.key: k for k, f in enumerate(futures)}
+    futures: list[Any] = []
     try:
-        for f in as_completed(futures):
+        start = 0
+        size = chunk_size or 0
+        if not size:
+            start = min(count, PROBE_ITEMS)
+            shared, [task] = tasks_of([(0, start)])
+            probe = client.submit(_timed, fn, shared, task, *args, pure=False)
+            futures.append(probe)
+            result, seconds = probe.result()
+            yield 0, start, result
+            workers = max(1, sum(client.nthreads().values()))
+            size = task_size(count - start, seconds / start, workers)
+        spans = [(p, min(count, p + size)) for p in range(start, count, size)]
+        if not spans:
+            return
+        shared, tasks = tasks_of(spans)
+        [shared_future] = client.scatter([shared], broadcast=True, hash=False)
+        futures.append(shared_future)
+        submitted = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
+        futures.extend(submitted)
+        index = {f.key: k for k, f in enumerate(submitted)}
+        for f in as_completed(submitted):
             result = f.result()
             k = index[f.key]
             f.release()
-            yield k, result
+            yield *spans[k], result
     finally:
         client.cancel(futures)
-        client.cancel([shared_future])
 
 
 def _call_on_slices(
@@ -168,7 +211,7 @@ def map_batches(
     """``[fn(*slices, **kwargs) for each slice]`` over aligned sequences, on Dask.
 
     The sequences (lists, arrays: anything sliceable, all of one length) are cut into
-    consecutive slices of ``chunk_size`` items; each call is one task. Without a client
+    consecutive slices; each call is one task (:func:`run_spans`). Without a client
     (see :func:`current_client`) the calls run here, one after the other.
 
     Parameters
@@ -179,8 +222,8 @@ def map_batches(
         Aligned inputs, e.g. shapes_a, shapes_b.
     client : dask.distributed.Client, optional
     chunk_size : int, optional
-        Items per task; default :data:`~polycontact.limits.DEFAULT_BATCH`, fewer if
-        that would give less than four tasks per worker thread.
+        Items per task; default sized by :func:`run_spans` from a first task (here,
+        without a client: every item in one call).
     families : iterable of str, optional
         Kernel families the workers warm up (default all).
     **kwargs
@@ -202,32 +245,29 @@ def map_batches(
     for k, s in enumerate(sequences[1:], 1):
         if len(s) != count:
             raise ValueError(f"sequences: argument {k} has {len(s)} items, the first {count}")
-    _check_chunk_size(chunk_size)
+    check_chunk_size(chunk_size)
     client = current_client(client)
-    if chunk_size is None:
-        chunk_size = _default_chunk(client, count, DEFAULT_BATCH)
-    spans = [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
     if client is None:
-        return [fn(*(s[p0:p1] for s in sequences), **kwargs) for p0, p1 in spans]
-    tasks = [tuple(s[p0:p1] for s in sequences) for p0, p1 in spans]
-    out: list[Any] = [None] * len(tasks)
-    with _closing(run_tasks(client, _call_on_slices, None, tasks, fn, kwargs,
-                            families=families)) as results:
-        for k, r in results:
-            out[k] = r
-    return out
+        size = chunk_size or max(count, 1)
+        return [fn(*(s[p:p + size] for s in sequences), **kwargs)
+                for p in range(0, count, size)]
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return None, [tuple(s[p0:p1] for s in sequences) for p0, p1 in spans]
+
+    parts: dict[int, Any] = {}
+    with _closing(run_spans(client, _call_on_slices, count, tasks_of, fn, kwargs,
+                            chunk_size=chunk_size, families=families)) as results:
+        for p0, _, r in results:
+            parts[p0] = r
+    return [parts[p] for p in sorted(parts)]
 
 
-def _check_chunk_size(chunk_size: Any) -> None:
+def check_chunk_size(chunk_size: Any) -> None:
+    """Refuse a ``chunk_size`` that is not None or a positive integer."""
     if chunk_size is not None and (isinstance(chunk_size, bool) or not isinstance(
             chunk_size, int) or chunk_size < 1):
         raise ValueError(f"chunk_size: expected a positive integer, got {chunk_size!r}")
-
-
-def _default_chunk(client: Any, count: int, largest: int) -> int:
-    """``largest`` items per task, fewer if that gives less than four tasks per thread."""
-    n_workers = 1 if client is None else max(1, sum(client.nthreads().values()))
-    return max(1, min(largest, math.ceil(count / (4 * n_workers))))
 
 
 def _closing(gen: Iterator[Any]) -> Any:
@@ -236,144 +276,66 @@ def _closing(gen: Iterator[Any]) -> Any:
     return closing(gen)
 
 
-def classify_many(
-    shapes_a: Any,
-    shapes_b: Any,
-    *,
-    tolerance: float | None = None,
-    client: Any = None,
-    chunk_size: int | None = None,
-) -> Any:
-    """:func:`polycontact.classify_many` split into tasks on a Dask cluster.
+# -- classify_many and time_of_impact_many on the cluster --------------------------------
+def classify_states(client: Any, packs: tuple[Any, ...], tol: float,
+                    chunk_size: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """The states and tolerances of the packed pairs ``packs`` (both sides'
+    ``pack_bodies``) as :func:`polycontact.classify_many` computes them, in tasks (each
+    with the slices of the packed arrays its pairs need)."""
+    count = len(packs[3])
+    states = np.empty(count, np.int8)
+    tols = np.empty(count)
 
-    Same arguments and result (a :class:`~polycontact.RelationBatch`, identical to the
-    local call: each pair's tolerance depends on that pair only), plus ``client`` and
-    ``chunk_size`` as in :func:`map_batches`. Without a client it is the local call.
-    ``distances``, on first access, are computed locally.
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return None, [(_pack_slice(packs[:4], p0, p1), _pack_slice(packs[4:], p0, p1))
+                      for p0, p1 in spans]
 
-    Examples
-    --------
-    See the module's example.
-    """
-    from .relation import RelationBatch, pack_bodies
-    from .relation import classify_many as local
-
-    client = current_client(client)
-    if client is None:
-        return local(shapes_a, shapes_b, tolerance=tolerance)
-    if len(shapes_a) != len(shapes_b):
-        raise ValueError(
-            f"shapes_a and shapes_b differ in length ({len(shapes_a)} and {len(shapes_b)})")
-    # packed now (a copy): the distances, computed locally on first access, are those of
-    # the bodies as they were at the call, whatever the caller does with its arrays since
-    packed = (*pack_bodies(shapes_a, "shapes_a"), *pack_bodies(shapes_b, "shapes_b"))
-    parts = map_batches(_states, shapes_a, shapes_b, client=client, chunk_size=chunk_size,
-                        families=["classification"], tolerance=tolerance)
-    states = np.concatenate([p[0] for p in parts]) if parts else np.empty(0, np.int8)
-    tols = np.concatenate([p[1] for p in parts]) if parts else np.empty(0)
-    return RelationBatch(states, tols, lambda: packed)
+    with _closing(run_spans(client, _states, count, tasks_of, tol, chunk_size=chunk_size,
+                            families=["classification"])) as results:
+        for p0, p1, (st, e) in results:
+            states[p0:p1] = st
+            tols[p0:p1] = e
+    return states, tols
 
 
-def _states(a: Any, b: Any, tolerance: float | None) -> tuple[np.ndarray, np.ndarray]:
-    from .relation import classify_many as local
+def _pack_slice(pack: tuple[Any, ...], p0: int, p1: int) -> tuple[Any, ...]:
+    """The bodies ``p0:p1`` of a ``pack_bodies`` result ``(xy, ls, bs, sign)``, packed
+    alone (their rows, loop starts and body starts renumbered from 0)."""
+    xy, ls, bs, sign = pack
+    b0, b1 = int(bs[p0]), int(bs[p1])
+    r0 = int(ls[b0]) if b1 > b0 else 0
+    r1 = int(ls[b1 - 1]) if b1 > b0 else 0
+    return (xy[r0:r1], ls[b0:b1] - r0, bs[p0:p1 + 1] - b0, sign[p0:p1])
 
-    batch = local(a, b, tolerance=tolerance)
-    return batch.states, batch.tolerances
+
+def _states(_: Any, task: tuple[Any, ...], tol: float) -> tuple[np.ndarray, np.ndarray]:
+    from .relation import pack_states
+
+    (xa, lsa, bsa, fa), (xb, lsb, bsb, fb) = task
+    return pack_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, 1)
 
 
-def time_of_impact_many(
-    shapes_a: Any,
-    motions_a: Any,
-    shapes_b: Any,
-    motions_b: Any,
-    t_max: float,
-    *,
-    method: str = "exact",
-    time_tolerance: float = TIME_TOLERANCE,
-    samples: int = SAMPLES,
-    max_iterations: int = MAX_ITERATIONS,
-    threads: int | None = None,
-    client: Any = None,
-    chunk_size: int | None = None,
-) -> Any:
-    """:func:`polycontact.time_of_impact_many` split into tasks on a Dask cluster.
+def impact_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, ...],
+                  chunk_size: int | None) -> tuple[Any, ...]:
+    """The raw result arrays of :func:`polycontact.impacts.search_pairs` for the
+    prepared pairs (``prepare_pairs``'s answer), in tasks; ``options`` = ``(t_max,
+    method, tol, samples, max_iterations)``."""
+    from .impacts import empty_result
 
-    Same arguments and result (an :class:`~polycontact.ImpactBatch` equal to the local
-    call's: ``status``, ``collides``, ``times``, ``first_contacts`` and every
-    ``impact(k)``; each pair's answer depends on that pair only), plus ``client`` and
-    ``chunk_size`` as in :func:`map_batches`. Without a client it is the local call.
+    uniq, _, sa, sb, rows_a, rows_b, eps_rel = prepared
+    count = len(sa)
+    raw = empty_result(count)
 
-    Every shape and motion is checked here, before any task is sent, so errors name
-    the argument and index in the caller's numbering, as the local call does. The
-    shapes that pairs of more than one task use are sent to every worker once; the
-    others go with their task. Each task runs the local search on its slice of pairs
-    and returns its result arrays; the :class:`~polycontact.Impact` objects are built
-    here, on demand, from the caller's own shapes and motions.
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return _impact_tasks(uniq, sa, sb, rows_a, rows_b, eps_rel, spans)
 
-    Parameters
-    ----------
-    shapes_a, motions_a, shapes_b, motions_b, t_max
-        As for :func:`polycontact.time_of_impact_many` (``t_max`` may be positional).
-    method, time_tolerance, samples, max_iterations
-        As there.
-    threads : int, optional
-        Threads of each task (default 1 on a cluster: the worker threads already run
-        tasks side by side); without a client, as for the local call.
-    client : dask.distributed.Client, optional
-    chunk_size : int, optional
-        Pairs per task; default :data:`~polycontact.limits.DEFAULT_IMPACT_BATCH`, fewer
-        if that would give less than four tasks per worker thread.
-
-    Returns
-    -------
-    ImpactBatch
-
-    Examples
-    --------
-    Without a client this is the local call:
-
-    >>> from polycontact import Motion, Shape
-    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
-    ...                             [sq.moved((3, 0)), sq.moved((0, 5))], [Motion()] * 2, 5)
-    >>> batch.status.tolist(), batch.times.round(3).tolist()
-    ([1, 0], [2.0, nan])
-    """
-    from . import impacts
-
-    options: dict[str, Any] = dict(t_max=t_max, method=method, time_tolerance=time_tolerance,
-                                   samples=samples, max_iterations=max_iterations)
-    _check_chunk_size(chunk_size)
-    client = current_client(client)
-    if client is None:
-        return impacts.time_of_impact_many(shapes_a, motions_a, shapes_b, motions_b,
-                                           threads=threads, **options)
-    # the local call's checks, in its order, before anything is sent
-    a = impacts.check_shapes(shapes_a, "shapes_a")
-    b = impacts.check_shapes(shapes_b, "shapes_b")
-    if len(a) != len(b):
-        raise ValueError(f"shapes_a and shapes_b differ in length ({len(a)} and {len(b)})")
-    ma = impacts.check_motions(motions_a, "motions_a", len(a), "shapes_a")
-    mb = impacts.check_motions(motions_b, "motions_b", len(b), "shapes_b")
-    t_max, tol, samples, max_iterations, threads = impacts.check_many_options(
-        t_max, method, time_tolerance, samples, max_iterations,
-        1 if threads is None else threads)
-    uniq, sa, sb, rows_a, rows_b, eps_rel = impacts.prepare_pairs(a, b, ma, mb, t_max)
-    count = len(a)
-    if count == 0:
-        return impacts.time_of_impact_many([], [], [], [], threads=threads, **options)
-    if chunk_size is None:
-        chunk_size = _default_chunk(client, count, DEFAULT_IMPACT_BATCH)
-    spans = [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
-    shared, tasks = _impact_tasks(uniq, sa, sb, rows_a, rows_b, eps_rel, spans)
-    parts: list[Any] = [None] * len(tasks)
-    with _closing(run_tasks(client, _impact_slice, shared, tasks, t_max, method, tol, samples,
-                            max_iterations, threads,
+    with _closing(run_spans(client, _impact_slice, count, tasks_of, *options,
+                            chunk_size=chunk_size,
                             families=["many moving bodies"])) as results:
-        for k, r in results:
-            parts[k] = r
-    raw = tuple(np.concatenate(field) for field in zip(*parts))
-    return impacts.impact_batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
+        for p0, p1, part in results:
+            for whole, got in zip(raw, part):
+                whole[p0:p1] = got
+    return raw
 
 
 def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
@@ -406,19 +368,18 @@ def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.nd
 
 
 def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, method: str,
-                  tol: float, samples: int, max_iterations: int,
-                  threads: int) -> tuple[Any, ...]:
+                  tol: float, samples: int, max_iterations: int) -> tuple[Any, ...]:
     """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
     (only the shapes it uses are packed for the kernel); the raw result arrays."""
-    from .impacts import search_pairs
+    from .impacts import pack_shapes, search_pairs
 
     sa, sb, own, rows_a, rows_b, eps_rel = task
     common, mine = shared.shapes(), own.shapes()
     used, inverse = np.unique(np.concatenate([sa, sb]), return_inverse=True)
     shapes = [common[u] if u < len(common) else mine[u - len(common)] for u in used]
     n = len(sa)
-    return search_pairs(shapes, inverse[:n], inverse[n:], rows_a, rows_b, eps_rel, t_max,
-                        method, tol, samples, max_iterations, threads)
+    return search_pairs(pack_shapes(shapes), inverse[:n], inverse[n:], rows_a, rows_b,
+                        eps_rel, t_max, method, tol, samples, max_iterations, 1)
 
 
 class _ShapePack:
@@ -429,8 +390,7 @@ class _ShapePack:
     send against 1 s of work); here every vertex of every shape is one array. The
     receiving process unpacks them once into :class:`_PackedShape` (what the search
     reads of a shape: its packed loops, centroid and bounding radius, as sent, not
-    recomputed) and keeps them, with the tables the search builds on them, for every
-    later task.
+    recomputed) and keeps them for every later task.
 
     Examples
     --------
@@ -438,9 +398,9 @@ class _ShapePack:
     >>> from polycontact import Shape
     >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
     >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))]))).shapes()
-    >>> back[1].centroid.tolist(), back[1].bounding_radius == frame.bounding_radius
+    >>> back[1]._centroid.tolist(), back[1]._radius == frame.bounding_radius
     ([4.0, 3.0], True)
-    >>> [b.tolist() for b in back[0].packed] == [b.tolist() for b in frame.packed]
+    >>> back[0]._xy.tolist() == frame.packed[0].tolist()
     True
     """
 
@@ -479,18 +439,15 @@ class _ShapePack:
 
 
 class _PackedShape:
-    """What the time-of-impact search reads of a :class:`~polycontact.Shape`
-    (``packed``, ``centroid``, ``bounding_radius``, and the body-frame tables it keeps
-    in ``_frame``), on a worker. Read-only arrays, as a Shape's: the kernels are
-    compiled (and cached) for those types."""
+    """What the time-of-impact search reads of a :class:`~polycontact.Shape` (its stored
+    coordinates, loop starts, centroid and bounding radius, under a Shape's names), on
+    a worker."""
 
-    __slots__ = ("packed", "centroid", "bounding_radius", "_frame")
+    __slots__ = ("_xy", "_starts", "_centroid", "_radius")
 
     def __init__(self, xy: np.ndarray, starts: np.ndarray, centroid: np.ndarray,
                  radius: float) -> None:
-        for array in (xy, starts, centroid):
-            array.flags.writeable = False
-        self.packed = (xy, starts)
-        self.centroid = centroid
-        self.bounding_radius = radius
-        self._frame: Any = None
+        self._xy = xy
+        self._starts = starts
+        self._centroid = centroid
+        self._radius = radius
