@@ -441,8 +441,8 @@ def main() -> None:
     repeat = args.repeat or (3 if args.quick else 5)
     q = int(args.quick)
     chosen = (args.paths.split(",") if args.paths else
-              ["contacts", "set_poses", "geometry", "classify_many", "distances",
-               "time_of_impact_many", "first_impacts", "nfp_table", "dask"])
+              ["contacts", "time_of_impact_many", "nfp_table", "classify_many", "set_poses",
+               "first_impacts", "distances", "geometry", "dask"])
     print(f"{os.cpu_count()} CPUs, Numba {numba.__version__} ({most} threads, layer "
           f"{numba.config.THREADING_LAYER}), Python {platform.python_version()}, "
           f"{'quick' if args.quick else 'full'} sizes, {repeat} calls per figure")
@@ -469,15 +469,22 @@ def main() -> None:
         row = measure(path, threads, repeat)
         show(row)
         rows.append(row)
+        save(args.json, rows, most, args.quick, repeat)
     if "dask" in chosen:
         for row in dask_rows(workers, args.quick, repeat):
             show(row)
             rows.append(row)
-    if args.json:
+        save(args.json, rows, most, args.quick, repeat)
+
+
+def save(out: str | None, rows: list[dict[str, Any]], most: int, quick: bool,
+         repeat: int) -> None:
+    """Write the rows so far to ``out`` (if given): a run cut short keeps its figures."""
+    if out:
         doc = {"cpus": os.cpu_count(), "numba_threads": most,
                "python": platform.python_version(), "numba": numba.__version__,
-               "quick": args.quick, "repeat": repeat, "rows": rows}
-        with open(args.json, "w") as f:
+               "quick": quick, "repeat": repeat, "rows": rows}
+        with open(out, "w") as f:
             json.dump(doc, f, indent=1)
 
 

@@ -10,6 +10,7 @@ import shapely
 
 import polycontact as pc
 from polycontact import distributed as pd
+from polycontact import impacts
 from polycontact.esicup import turned
 
 distributed = pytest.importorskip("distributed")
@@ -62,19 +63,19 @@ def test_the_default_client_is_used(client):
                          progress=lambda d, n: seen.append(d))
     assert pd.current_client() is client
     assert len(seen) == 4 and table.computed == 16  # four tasks of 4 entries, on the cluster
-    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd._plugins).values())
+    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd.worker_plugins).values())
 
 
 def test_kernels_are_warmed_once_per_worker(client):
     pc.nfp_table(PIECES[:1], progress=False, client=client)
     name = pd.plugin_name("no-fit polygon")
-    assert all(name in p for p in client.run(pd._plugins).values())
+    assert all(name in p for p in client.run(pd.worker_plugins).values())
     before = client.run(_setup_id, name)
     pd.ensure_warm(client, ["no-fit polygon"])
     pc.nfp_table(PIECES[:2], progress=False, client=client)
     assert client.run(_setup_id, name) == before  # no new registration, no warm-up per task
     # a batch warms only its own family
-    assert pd.plugin_name("time of impact") not in next(iter(client.run(pd._plugins).values()))
+    assert pd.plugin_name("time of impact") not in next(iter(client.run(pd.worker_plugins).values()))
 
 
 def _setup_id(name, dask_worker=None) -> int:
@@ -162,7 +163,7 @@ def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):
     remote = pc.time_of_impact_many(arrays, ma, b, mb, t_max=2)  # a default chunk size
     assert same_batch(local, remote)
     name = pd.plugin_name("many moving bodies")
-    assert all(name in p for p in client.run(pd._plugins).values())
+    assert all(name in p for p in client.run(pd.worker_plugins).values())
     empty = pc.time_of_impact_many([], [], [], [], t_max=1, client=client)
     assert len(empty) == 0 and empty.times.shape == (0,)
 
@@ -194,7 +195,7 @@ def test_impact_tasks_send_shapes_of_several_tasks_once():
     sb = np.array([1, 2, 1, 3, 4])
     uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
     rows, eps = np.zeros((5, 6)), np.ones(5)
-    shared, tasks = pd._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
+    shared, tasks = impacts._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
     assert shared.shapes() == [uniq[0], uniq[1]]
     assert [t[2].shapes() for t in tasks] == [[uniq[2]], [uniq[3]], [uniq[4]]]
     # a task numbers the shared shapes first, then its own
@@ -273,8 +274,7 @@ def test_tasks_are_sized_from_a_first_task(client):
         spans.extend(got)
         return None, [np.arange(p0, p1) for p0, p1 in got]
 
-    parts = dict(((p0, p1), r) for p0, p1, r in pd.run_spans(
-        client, _total, 1000, tasks_of, families=["classification"]))
+    parts = dict(((p0, p1), r) for p0, p1, r in pd.run_spans(client, _total, 1000, tasks_of))
     assert spans[0] == (0, pd.PROBE_ITEMS) and spans[1:] == [(pd.PROBE_ITEMS, 1000)]
     assert sum(parts.values()) == sum(range(1000))
     assert pd.task_size(10**6, 1e-6, 4) == 200_000  # 0.2 s of work

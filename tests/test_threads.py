@@ -268,6 +268,6 @@ def test_nfp_table_on_two_threads_equals_one_thread_and_single_nfps(share_everyt
     for key in one:
         assert entries_equal(one[key], two[key]), key
         i, ai, j, aj = key
-        single = pc.no_fit_polygon(one._shapes[one._slot(i, ai, "i")],
-                                   one._shapes[one._slot(j, aj, "j")], reference)
+        single = pc.no_fit_polygon(one._shape(one._slot(i, ai, "i")),
+                                   one._shape(one._slot(j, aj, "j")), reference)
         assert entries_equal(one[key], single), key

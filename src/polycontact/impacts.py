@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import closing
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -32,6 +33,7 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
 from .bodies import as_shape
+from .relation import shapes_packed
 from .shape import Shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._threads import as_done, numba_threads, requested, useful
@@ -147,25 +149,15 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
 
 # -- the batched search ----------------------------------------------------------------
 def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
-    """The shapes' coordinates packed for :mod:`polycontact._kernels.impact_batch`:
-    ``(xy, rows, starts, st_off, centroids, radii)``. Read from each shape's stored
-    arrays (``_xy``, ``_starts``, ``_centroid``, ``_radius``) and joined as bytes: the
-    few hundred nanoseconds per shape that no compiled code can take over."""
+    """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
+    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, and
+    each shape's stored centroid and bounding radius)."""
     n = len(shapes)
-    rows = np.zeros(n + 1, np.int64)
-    st_off = np.zeros(n + 1, np.int64)
-    xy = list(map(_XY, shapes))
-    starts = list(map(_STARTS, shapes))
-    np.cumsum(np.fromiter(map(len, xy), np.int64, n), out=rows[1:])
-    np.cumsum(np.fromiter(map(len, starts), np.int64, n), out=st_off[1:])
-    return (np.frombuffer(b"".join(xy), np.float64).reshape(-1, 2),
-            rows, np.frombuffer(b"".join(starts), np.int64), st_off,
+    return (*shapes_packed(shapes),
             np.frombuffer(b"".join(map(_CENTROID, shapes)), np.float64).reshape(n, 2),
             np.fromiter(map(_RADIUS, shapes), np.float64, n))
 
 
-_XY = operator.attrgetter("_xy")
-_STARTS = operator.attrgetter("_starts")
 _CENTROID = operator.attrgetter("_centroid")
 _RADIUS = operator.attrgetter("_radius")
 
@@ -211,12 +203,9 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     # empty broad phase against a long slide), so the threads take chunks as they go
     order = np.arange(p_count, dtype=np.int64)
     n = useful(threads, p_count * _PAIR_SECONDS)
-    if n == 1:
-        run(order)
-    else:
-        n_chunks = min(p_count // 16, 16 * n)
-        for _ in as_done(run, [order[c::n_chunks].copy() for c in range(n_chunks)], n):
-            pass
+    n_chunks = 1 if n == 1 else min(p_count // 16, 16 * n)
+    for _ in as_done(run, [order[c::n_chunks].copy() for c in range(n_chunks)], n):
+        pass
     return out
 
 
@@ -375,7 +364,7 @@ def time_of_impact_many(
     >>> batch.impact(0).status.value
     'hit'
     """
-    from .distributed import check_chunk_size, current_client, impact_search
+    from ._cluster import check_chunk_size, current_client
 
     check_chunk_size(chunk_size)
     a = check_shapes(shapes_a, "shapes_a")
@@ -393,7 +382,7 @@ def time_of_impact_many(
         raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol,
                            samples, max_iterations, threads)
     else:
-        raw = impact_search(remote, prepared, (t_max, method, tol, samples, max_iterations),
+        raw = _remote_search(remote, prepared, (t_max, method, tol, samples, max_iterations),
                             chunk_size)
     return impact_batch(a, b, ma, mb, raw, prepared[6], t_max, method, tol)
 
@@ -405,8 +394,7 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Mot
     the distinct shapes and the inputs of :func:`search_pairs`: the shapes packed, each
     pair's two indices among them, its two motion rows and its ``eps_rel``, the size term of its distance
     tolerance (``RELATIVE_TOLERANCE`` times the larger of the two shapes' extents).
-    (:func:`polycontact.distributed.impact_search` runs :func:`search_pairs` on slices
-    of them in tasks.)"""
+    (:func:`_remote_search` runs :func:`search_pairs` on slices of them in tasks.)"""
     p_count = len(a)
 
     def name_of(k: int) -> tuple[str, str]:
@@ -438,6 +426,142 @@ def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Moti
         first_contacts=np.where(code == 2, 0.0, np.where(contact >= 0.0, contact, np.nan)),
         _make=make,
     )
+
+
+# -- on a Dask cluster ------------------------------------------------------------------
+def _remote_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, ...],
+                   chunk_size: int | None) -> tuple[Any, ...]:
+    """The raw result arrays of :func:`search_pairs` for the prepared pairs
+    (:func:`prepare_pairs`'s answer), in tasks on the cluster of ``client``; ``options`` = ``(t_max,
+    method, tol, samples, max_iterations)``."""
+    from ._cluster import run_spans
+
+    uniq, _, sa, sb, rows_a, rows_b, eps_rel = prepared
+    count = len(sa)
+    raw = empty_result(count)
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return _impact_tasks(uniq, sa, sb, rows_a, rows_b, eps_rel, spans)
+
+    with closing(run_spans(client, _impact_slice, count, tasks_of, *options,
+                           chunk_size=chunk_size, family="many moving bodies")) as results:
+        for p0, p1, part in results:
+            for whole, got in zip(raw, part):
+                whole[p0:p1] = got
+    return raw
+
+
+def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
+                  rows_b: np.ndarray, eps_rel: np.ndarray,
+                  spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple[Any, ...]]]:
+    """The shapes several tasks use (sent once to every worker) and the tasks: each its
+    slice of pairs, with its own shapes, the pairs' shape indices numbering the shared
+    shapes first, then the task's own."""
+    task = np.empty(len(sa), np.int64)
+    for k, (p0, p1) in enumerate(spans):
+        task[p0:p1] = k
+    first = np.full(len(uniq), len(spans), np.int64)
+    last = np.full(len(uniq), -1, np.int64)
+    for s in (sa, sb):
+        np.minimum.at(first, s, task)
+        np.maximum.at(last, s, task)
+    shared_ids = np.flatnonzero(first < last)
+    number = np.full(len(uniq), -1, np.int64)
+    number[shared_ids] = np.arange(len(shared_ids))
+    tasks = []
+    for p0, p1 in spans:
+        ta, tb = sa[p0:p1], sb[p0:p1]
+        own = np.unique(np.concatenate([ta, tb]))
+        own = own[number[own] < 0]
+        number[own] = len(shared_ids) + np.arange(len(own))
+        tasks.append((number[ta], number[tb], _ShapePack([uniq[u] for u in own]),
+                      rows_a[p0:p1], rows_b[p0:p1], eps_rel[p0:p1]))
+        number[own] = -1
+    return _ShapePack([uniq[u] for u in shared_ids]), tasks
+
+
+def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, method: str,
+                  tol: float, samples: int, max_iterations: int) -> tuple[Any, ...]:
+    """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
+    (only the shapes it uses are packed for the kernel); the raw result arrays."""
+    sa, sb, own, rows_a, rows_b, eps_rel = task
+    common, mine = shared.shapes(), own.shapes()
+    used, inverse = np.unique(np.concatenate([sa, sb]), return_inverse=True)
+    shapes = [common[u] if u < len(common) else mine[u - len(common)] for u in used]
+    n = len(sa)
+    return search_pairs(pack_shapes(shapes), inverse[:n], inverse[n:], rows_a, rows_b,
+                        eps_rel, t_max, method, tol, samples, max_iterations, 1)
+
+
+class _ShapePack:
+    """Shapes sent to Dask workers as five flat arrays, unpacked there on first use.
+
+    A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
+    shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
+    send against 1 s of work); here every vertex of every shape is one array. The
+    receiving process unpacks them once into :class:`_PackedShape` (what the search
+    reads of a shape: its packed loops, centroid and bounding radius, as sent, not
+    recomputed) and keeps them for every later task.
+
+    Examples
+    --------
+    >>> import pickle
+    >>> from polycontact import Shape
+    >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
+    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))]))).shapes()
+    >>> back[1]._centroid.tolist(), back[1]._radius == frame.bounding_radius
+    ([4.0, 3.0], True)
+    >>> back[0]._xy.tolist() == frame.packed[0].tolist()
+    True
+    """
+
+    def __init__(self, shapes: Sequence[Any]) -> None:
+        n = len(shapes)
+        self.arrays: tuple[np.ndarray, ...] = (
+            np.concatenate([s.packed[0] for s in shapes]) if n else np.empty((0, 2)),
+            np.concatenate([np.diff(s.packed[1]) for s in shapes]) if n
+            else np.empty(0, np.int64),
+            np.array([len(s.packed[1]) - 1 for s in shapes], dtype=np.int64),
+            np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2),
+            np.array([s.bounding_radius for s in shapes], dtype=np.float64),
+        )
+        self._shapes: list[Any] | None = list(shapes)
+
+    def __getstate__(self) -> tuple[np.ndarray, ...]:
+        return self.arrays
+
+    def __setstate__(self, arrays: tuple[np.ndarray, ...]) -> None:
+        self.arrays = arrays
+        self._shapes = None
+
+    def shapes(self) -> list[Any]:
+        """The shapes: those given, or, in a process that received them, unpacked."""
+        if self._shapes is None:
+            xy, loop_len, n_loops, cent, rad = self.arrays
+            loop_end = np.concatenate([[0], np.cumsum(loop_len)])
+            first = np.concatenate([[0], np.cumsum(n_loops)])
+            shapes = []
+            for k in range(len(rad)):
+                ends = loop_end[first[k]:first[k + 1] + 1]
+                shapes.append(_PackedShape(xy[ends[0]:ends[-1]], ends - ends[0],
+                                           cent[k].copy(), float(rad[k])))
+            self._shapes = shapes
+        return self._shapes
+
+
+class _PackedShape:
+    """What the time-of-impact search reads of a :class:`~polycontact.Shape` (its stored
+    coordinates, loop starts, centroid and bounding radius, under a Shape's names), on
+    a worker."""
+
+    __slots__ = ("_xy", "_starts", "_centroid", "_radius")
+
+    def __init__(self, xy: np.ndarray, starts: np.ndarray, centroid: np.ndarray,
+                 radius: float) -> None:
+        self._xy = xy
+        self._starts = starts
+        self._centroid = centroid
+        self._radius = radius
 
 
 # -- many moving bodies ----------------------------------------------------------------

@@ -87,7 +87,7 @@ import shapely
 
 from . import __version__
 from ._json import load_json
-from .esicup import Instance, turned
+from .esicup import Instance, turned, turned_loops
 from .nfp import NoFitPolygon, no_fit_polygon
 from .bodies import as_shape
 from .shape import Shape
@@ -167,13 +167,15 @@ class NfpTable:
         pieces: tuple[Shape, ...],
         orientations: tuple[tuple[float, ...], ...],
         reference: str,
+        packed: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]],
         shapes: dict[tuple[int, int], Shape],
         digests: dict[tuple[int, int], bytes],
     ) -> None:
         self.pieces = pieces
         self.orientations = orientations
         self.reference = reference
-        self._shapes = shapes
+        self._packed = packed  # each slot's turned piece, as Shape.packed
+        self._shapes = shapes  # the turned pieces made Shapes so far
         self._digests = digests
         # An entry is a pair of distinct turned pieces (digests): its code is
         # ``ia * D + ib``, ia and ib the digests' numbers, D how many there are.
@@ -226,7 +228,15 @@ class NfpTable:
         if region is None:
             region = self._regions[code] = shapely.from_wkb(rec.wkb)
         return NoFitPolygon(region, rec.exact_fits, rec.slides, rec.reference,
-                            self._shapes[sa], self._shapes[sb], rec.tolerance)
+                            self._shape(sa), self._shape(sb), rec.tolerance)
+
+    def _shape(self, slot: tuple[int, int]) -> Shape:
+        """The turned piece of ``slot`` (piece, orientation number), made on first use."""
+        shape = self._shapes.get(slot)
+        if shape is None:
+            i, k = slot
+            shape = self._shapes[slot] = turned(self.pieces[i], self.orientations[i][k])
+        return shape
 
     def _key(self, code: int) -> str:
         """The cache key of entry ``code``."""
@@ -489,20 +499,50 @@ def _is_number(a: Any) -> bool:
 
 def _prepare(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],
              reference: str) -> NfpTable:
-    """A table without entries: the turned pieces and their digests."""
+    """A table without entries: the turned pieces, packed, and their digests.
+
+    The turned pieces of one loop are checked together in one compiled call
+    (:func:`polycontact._kernels.relation_many.check_rings`); one it takes as given
+    (counter-clockwise, no vertex dropped) is what :func:`~polycontact.esicup.turned`
+    would store, and its Shape is made only when asked for. Any other turned piece is
+    made a Shape here, checked (or refused) as ``turned`` does."""
+    from ._kernels.relation_many import check_rings
+    from .limits import COORDINATE_LIMIT, EXTENT_FLOOR, RELATIVE_TOLERANCE, ROUNDING_ULPS
+
+    packed: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
     shapes: dict[tuple[int, int], Shape] = {}
-    digests: dict[tuple[int, int], bytes] = {}
-    prefix = f"{FORMAT}/{FORMAT_VERSION}/{__version__}/{reference}/".encode()
+    rings: dict[tuple[int, int], np.ndarray] = {}
     for i, (piece, angles) in enumerate(zip(pieces, orientations)):
         for k, a in enumerate(angles):
-            s = turned(piece, a)
-            xy, starts = s.packed
+            loops = turned_loops(piece, a)
+            if loops is not None and len(loops) == 1:
+                rings[i, k] = loops[0]
+            else:
+                shapes[i, k] = piece if loops is None else Shape(loops[0], loops[1:])
+    if rings:
+        n = np.array([len(r) for r in rings.values()], np.int64)
+        used, sign = check_rings(np.concatenate(list(rings.values())),
+                                 np.cumsum(n) - n, n, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                                 COORDINATE_LIMIT, EXTENT_FLOOR)
+        for (slot, ring), u, m, sg in zip(rings.items(), used.tolist(), n.tolist(),
+                                          sign.tolist()):
+            if u == m and sg > 0.0:
+                starts = np.array([0, m], np.int64)
+                packed[slot] = (ring, starts)
+            else:
+                i, k = slot
+                shapes[slot] = turned(pieces[i], orientations[i][k])
+    packed.update({slot: shape.packed for slot, shape in shapes.items()})
+    digests: dict[tuple[int, int], bytes] = {}
+    prefix = f"{FORMAT}/{FORMAT_VERSION}/{__version__}/{reference}/".encode()
+    for i, angles in enumerate(orientations):
+        for k in range(len(angles)):
+            xy, starts = packed[i, k]
             h = hashlib.blake2b(prefix, digest_size=16)
             h.update(np.ascontiguousarray(xy, dtype="<f8").tobytes())
             h.update(np.ascontiguousarray(starts, dtype="<i8").tobytes())
-            shapes[i, k] = s
             digests[i, k] = h.digest()
-    return NfpTable(pieces, orientations, reference, shapes, digests)
+    return NfpTable(pieces, orientations, reference, packed, shapes, digests)
 
 
 def _pair_key(da: bytes, db: bytes) -> str:
@@ -510,24 +550,35 @@ def _pair_key(da: bytes, db: bytes) -> str:
 
 
 class _Pieces:
-    """The distinct turned pieces of a build: the Shapes, and the packing that
-    :func:`polycontact._kernels.nfp_batch.nfp_pairs` reads (made once per build, sent
-    once to every worker)."""
+    """The distinct turned pieces of a build, packed as
+    :func:`polycontact._kernels.nfp_batch.nfp_pairs` reads them (made once per build,
+    sent once to every worker), with what the kernel needs of each: its largest
+    |coordinate|, the larger side of its box and its area centroid (computed as
+    :class:`~polycontact.Shape` computes them, to the last bit)."""
 
-    def __init__(self, shapes: Sequence[Shape]) -> None:
-        self.shapes = list(shapes)
-        packs = [s.packed for s in self.shapes]
+    def __init__(self, packs: Sequence[tuple[np.ndarray, np.ndarray]]) -> None:
+        from ._kernels.poses import centroids
+
         rows = np.array([0, *np.cumsum([len(xy) for xy, _ in packs])], np.int64)
-        self.xy = (np.concatenate([xy for xy, _ in packs]) if packs
-                   else np.empty((0, 2)))
+        self.xy = (np.ascontiguousarray(np.concatenate([xy for xy, _ in packs]))
+                   if packs else np.empty((0, 2)))
         self.ls = np.concatenate([st + rows[k] for k, (_, st) in enumerate(packs)]
                                  + [np.empty(0, np.int64)])
         self.nl = np.array([len(st) - 1 for _, st in packs], np.int64)
-        self.lo = np.array([0, *np.cumsum(self.nl + 1)[:-1]], np.int64)[: len(packs)]
-        self.magnitude = np.array([s._magnitude for s in self.shapes], np.float64)
-        self.extent = np.array([s._extent for s in self.shapes], np.float64)
-        self.centroid = np.array([s.centroid for s in self.shapes],
-                                 np.float64).reshape(-1, 2)
+        self.lo = np.concatenate([[0], np.cumsum(self.nl + 1)]).astype(np.int64)
+        first = rows[:-1]
+        lo = np.minimum.reduceat(self.xy, first) if packs else np.empty((0, 2))
+        hi = np.maximum.reduceat(self.xy, first) if packs else np.empty((0, 2))
+        self.extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
+        self.magnitude = np.maximum(-lo.min(axis=1, initial=np.inf),
+                                    hi.max(axis=1, initial=-np.inf))
+        self.centroid = np.empty((len(packs), 2))
+        centroids(self.xy, self.ls, self.lo, self.centroid, np.empty(len(packs)))
+
+    def shape(self, k: int) -> Shape:
+        """Piece ``k`` as a Shape (its loops as packed: checked already)."""
+        st = self.ls[self.lo[k]:self.lo[k + 1]]
+        return Shape._trusted([self.xy[st[q]:st[q + 1]] for q in range(len(st) - 1)])
 
 
 def _compute_chunk(pieces: _Pieces, pairs: np.ndarray, reference: str) -> Packed:
@@ -563,7 +614,7 @@ def _compute(pieces: _Pieces, pairs: np.ndarray, reference: str) -> tuple[Packed
     ends = [wkb_ends, fit_ends, slide_ends]
     t0 = time.perf_counter()
     if len(flagged):
-        made = [no_fit_polygon(pieces.shapes[ia], pieces.shapes[ib], reference)
+        made = [no_fit_polygon(pieces.shape(ia), pieces.shape(ib), reference)
                 for ia, ib in pairs[flagged].tolist()]
         parts = ([np.frombuffer(shapely.to_wkb(n.region, byte_order=1, include_srid=False),
                                 np.uint8) for n in made],
@@ -628,7 +679,7 @@ def _compute_missing(
 ) -> None:
     """Compute the entries ``todo`` (codes) of ``table``, writing the cache's shards as
     they come."""
-    from .distributed import current_client
+    from ._cluster import current_client
 
     client = current_client(client)
     # the distinct turned pieces the missing entries need, and the pairs of them
@@ -637,7 +688,7 @@ def _compute_missing(
     used = np.unique(np.concatenate([ia, ib]))
     local = np.full(n, -1, np.int64)
     local[used] = np.arange(len(used))
-    pieces = _Pieces([table._shapes[table._first[d]] for d in used.tolist()])
+    pieces = _Pieces([table._packed[table._first[d]] for d in used.tolist()])
     pairs = np.stack([local[ia], local[ib]], axis=1)
     count = len(todo)
     bar = _progress_bar(progress, count)
@@ -659,13 +710,13 @@ def _compute_missing(
     results: Generator[tuple[int, int, Packed], None, None]
     try:
         if client is not None:
-            from .distributed import run_spans
+            from ._cluster import run_spans
 
             def tasks_of(spans: list[tuple[int, int]]) -> tuple[_Pieces, list[np.ndarray]]:
                 return pieces, [pairs[p0:p1] for p0, p1 in spans]
 
             results = run_spans(client, _compute_chunk, count, tasks_of, table.reference,
-                                chunk_size=chunk_size, families=["no-fit polygon"])
+                                chunk_size=chunk_size, family="no-fit polygon")
         else:
             results = _local(pieces, pairs, table.reference, workers, threads, chunk_size)
         with closing(results):

@@ -466,6 +466,14 @@ def _id_array(ids: Any, what: str) -> np.ndarray:
     return np.ascontiguousarray(raw, dtype=np.int64)
 
 
+def _floats(value: Any, what: str) -> np.ndarray:
+    """``value`` itself if it is a C-contiguous float64 array (read during the call
+    only), else :func:`polycontact._checks.real_array` of it (a new array)."""
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.flags.c_contiguous:
+        return value
+    return real_array(value, what)
+
+
 def _values(value: Any, what: str, count: int) -> np.ndarray:
     """``value`` as a new float64 array of ``count`` finite real numbers, else an error
     naming ``what`` (and the index of a number that is not finite)."""
@@ -907,7 +915,7 @@ class World:
         from ._kernels.poses import pose_checks
 
         idx = _id_array(ids, "ids")
-        pos = real_array(positions, "positions")
+        pos = _floats(positions, "positions")
         if pos.shape != (len(idx), 2):
             pos = points(positions, "positions", (len(idx), 2))  # (says what is wrong)
         if angles is None:
@@ -915,7 +923,7 @@ class World:
         elif np.ndim(angles) == 0:
             ang = np.full(len(idx), finite_number(angles, "angles"))
         else:
-            ang = real_array(angles, "angles")
+            ang = _floats(angles, "angles")
             if ang.shape != (len(idx),):
                 ang = _values(angles, "angles", len(idx))
         # every check in one parallel pass; only when it finds something, one by one
