@@ -241,7 +241,7 @@ class Impacts(Path):
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
         b = pc.time_of_impact_many(*self.pairs, t_max=3, threads=threads)
-        return b.status, b.times, b.first_contacts
+        return b.statuses, b.times, b.first_contacts
 
 
 class FirstImpacts(Path):
@@ -255,7 +255,7 @@ class FirstImpacts(Path):
         self.size = f"{count} bodies"
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
-        ev = pc.first_impacts(self.shapes, self.motions, 0.5, threads=threads)
+        ev = pc.first_impacts(self.shapes, self.motions, t_max=0.5, threads=threads)
         return (np.array([(e.i, e.j) for e in ev]).reshape(-1, 2),
                 np.array([e.impact.status.value == "hit" for e in ev]),
                 np.array([np.nan if e.impact.time is None else e.impact.time for e in ev]))
@@ -373,7 +373,7 @@ def dask_rows(workers: list[int], quick: bool, repeat: int) -> list[dict[str, An
             getattr(pc.classify_many(a, b, client=c), f) for f in ("states", "tolerances")),
         "dask time_of_impact_many": lambda c: tuple(
             getattr(pc.time_of_impact_many(*pairs, t_max=3, client=c), f)
-            for f in ("status", "times", "first_contacts")),
+            for f in ("statuses", "times", "first_contacts")),
     }
     rows = {name: {"path": name, "size": "", "threads": {}, "serial_fraction": None,
                    "amdahl16": None, "unit": "workers"} for name in calls}

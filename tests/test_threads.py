@@ -206,7 +206,7 @@ def test_time_of_impact_many_on_two_threads_equals_one_thread(share_everything):
     mb = [pc.Motion()] * 400
     one = on(1, lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, threads=1))
     two = on(2, lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, threads=2))
-    for name in ("status", "times", "first_contacts"):
+    for name in ("statuses", "times", "first_contacts"):
         assert same(getattr(one, name), getattr(two, name)), name
     assert np.count_nonzero(one.collides) > 50
     single = pc.time_of_impact(a[7], ma[7], b[7], mb[7], t_max=3)
@@ -221,7 +221,7 @@ def test_first_impacts_on_two_threads_equal_one_thread(share_everything):
 
     def events(threads):
         return [(e.i, e.j, e.impact.status, e.impact.time)
-                for e in on(threads, lambda: pc.first_impacts(shapes, motions, 0.5,
+                for e in on(threads, lambda: pc.first_impacts(shapes, motions, t_max=0.5,
                                                                 threads=threads))]
 
     one = events(1)

@@ -89,8 +89,7 @@ from . import __version__
 from ._json import load_json
 from .esicup import Instance, turned, turned_loops
 from .nfp import NoFitPolygon, no_fit_polygon
-from .bodies import as_shape
-from .shape import Shape
+from .shape import Shape, as_shape
 from ._threads import requested
 
 __all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_START"]
@@ -553,12 +552,12 @@ class _Pieces:
     """The distinct turned pieces of a build, packed as
     :func:`polycontact._kernels.nfp_batch.nfp_pairs` reads them (made once per build,
     sent once to every worker), with what the kernel needs of each: its largest
-    |coordinate|, the larger side of its box and its area centroid (computed as
-    :class:`~polycontact.Shape` computes them, to the last bit)."""
+    |coordinate| and the larger side of its box (computed as :class:`~polycontact.Shape`
+    computes them), and the reference points (``centroids``: the pieces' area
+    centroids, or None for the origin)."""
 
-    def __init__(self, packs: Sequence[tuple[np.ndarray, np.ndarray]]) -> None:
-        from ._kernels.poses import centroids
-
+    def __init__(self, packs: Sequence[tuple[np.ndarray, np.ndarray]],
+                 centroids: np.ndarray | None) -> None:
         rows = np.array([0, *np.cumsum([len(xy) for xy, _ in packs])], np.int64)
         self.xy = (np.ascontiguousarray(np.concatenate([xy for xy, _ in packs]))
                    if packs else np.empty((0, 2)))
@@ -572,8 +571,7 @@ class _Pieces:
         self.extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
         self.magnitude = np.maximum(-lo.min(axis=1, initial=np.inf),
                                     hi.max(axis=1, initial=-np.inf))
-        self.centroid = np.empty((len(packs), 2))
-        centroids(self.xy, self.ls, self.lo, self.centroid, np.empty(len(packs)))
+        self.centroids = centroids
 
     def shape(self, k: int) -> Shape:
         """Piece ``k`` as a Shape (its loops as packed: checked already)."""
@@ -601,10 +599,10 @@ def _compute(pieces: _Pieces, pairs: np.ndarray, reference: str) -> tuple[Packed
                          MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
 
     pairs = np.ascontiguousarray(pairs, dtype=np.int64)
-    if reference == "origin":
+    if pieces.centroids is None:
         refs = np.zeros((len(pairs), 2))
     else:
-        refs = np.ascontiguousarray(pieces.centroid[pairs[:, 0]])
+        refs = np.ascontiguousarray(pieces.centroids[pairs[:, 0]])
     settings = (RELATIVE_TOLERANCE, ROUNDING_ULPS, ANGLE_TOLERANCE, SNAP_FACTOR,
                 HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX, MAX_SUM_VERTICES, reference == "origin")
     blob, wkb_ends, fits, fit_ends, slides, slide_ends, tols, flagged = nfp_pairs(
@@ -688,7 +686,9 @@ def _compute_missing(
     used = np.unique(np.concatenate([ia, ib]))
     local = np.full(n, -1, np.int64)
     local[used] = np.arange(len(used))
-    pieces = _Pieces([table._packed[table._first[d]] for d in used.tolist()])
+    slots = [table._first[d] for d in used.tolist()]
+    pieces = _Pieces([table._packed[slot] for slot in slots], None if table.reference ==
+                     "origin" else np.array([table._shape(slot).centroid for slot in slots]))
     pairs = np.stack([local[ia], local[ib]], axis=1)
     count = len(todo)
     bar = _progress_bar(progress, count)
