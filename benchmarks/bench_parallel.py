@@ -13,7 +13,8 @@ Paths (size, then the ``--quick`` size):
   against a copy moved by up to 0.8 (most pairs overlap);
 - ``distances``: the signed distances of 10⁵ of those pairs (10⁴), given as Shapes;
 - ``time_of_impact_many``: 4·10⁴ pairs (4·10³), bench_distributed's pairs (a square, an
-  L and a U against each other and a square frame, random motions over [0, 3]);
+  L and a U against each other and a square frame, random motions over [0, 3]); and
+  ``time_of_impact_many_rows``, the same with the motions given as the rows of arrays;
 - ``first_impacts``: 2·10⁴ moving 12-gons (2·10³) on a jittered grid, random velocities
   and spins, over [0, 0.5];
 - ``nfp_table``: the shipped jakobs1 (25 pieces) at 12 orientations, 90 000 entries
@@ -126,6 +127,8 @@ class Regions:
 
     @contextlib.contextmanager
     def measuring(self) -> Iterator[None]:
+        """Every parallel region wrapped, in its module and wherever a module of
+        polycontact imported it by name."""
         saved = []
         for module, name in PARALLEL:
             try:
@@ -135,8 +138,12 @@ class Regions:
             fn = getattr(mod, name, None)
             if fn is None:
                 continue
-            saved.append((mod, name, fn))
-            setattr(mod, name, self._timed_call(fn))
+            timed = self._timed_call(fn)
+            for other in list(sys.modules.values()):
+                if (getattr(other, "__name__", "").startswith("polycontact")
+                        and getattr(other, name, None) is fn):
+                    saved.append((other, name, fn))
+                    setattr(other, name, timed)
         try:
             yield
         finally:
@@ -194,12 +201,16 @@ class Contacts(WorldPath):
 class SetPoses(WorldPath):
     name = "set_poses"
 
-    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+    def prepare(self) -> None:
         w = self.w
         w.step = (w.step + 1) % 4  # back and forth: the same poses at every thread count
         d = 0.01 * (w.step % 2)
-        w.world.set_poses(w.ids, w.pos + d, w.ang + d)
-        return w.world.poses()
+        self.poses = (w.pos + d, w.ang + d)
+
+    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+        w = self.w
+        w.world.set_poses(w.ids, *self.poses)
+        return w.world._xy, w.world._box  # (the World's own arrays: copied to compare)
 
 
 class Geometry(WorldPath):
@@ -233,10 +244,15 @@ class ClassifyMany(Path):
 
 
 class Impacts(Path):
-    name = "time_of_impact_many"
+    """``time_of_impact_many`` of bench_distributed's pairs, the motions as Motions or
+    (``rows``) as the rows of arrays."""
 
-    def __init__(self, count: int) -> None:
-        self.pairs = impact_pairs(count)
+    def __init__(self, count: int, rows: bool) -> None:
+        a, ma, b, mb = impact_pairs(count)
+        if rows:
+            ma, mb = (np.array([m.array for m in ms]) for ms in (ma, mb))
+        self.pairs = (a, ma, b, mb)
+        self.name = "time_of_impact_many" + (" (motions as rows)" if rows else "")
         self.size = f"{count} pairs"
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
@@ -307,11 +323,15 @@ def same(x: tuple[np.ndarray, ...], y: tuple[np.ndarray, ...]) -> bool:
         for a, b in zip(x, y))
 
 
+def copies(arrays: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+    return tuple(np.array(a, copy=True) for a in arrays)
+
+
 def measure(path: Path, threads: list[int], repeat: int) -> dict[str, Any]:
     """The path's row: seconds per thread count, speed-ups, the serial fraction."""
     numba.set_num_threads(1)
     path.prepare()
-    want = path.run(1)  # (warm: the kernels loaded, the pools and buffers made)
+    want = copies(path.run(1))  # (warm: the kernels loaded, the pools and buffers made)
     if isinstance(path, NfpTable):
         want = table_arrays(path.last)
     regions = Regions()
@@ -329,7 +349,7 @@ def measure(path: Path, threads: list[int], repeat: int) -> dict[str, Any]:
     for t in threads:
         numba.set_num_threads(t)
         path.prepare()
-        got = path.run(t)
+        got = copies(path.run(t))
         if isinstance(path, NfpTable):
             got = table_arrays(path.last)
         times = []
@@ -423,8 +443,8 @@ def main() -> None:
                          "--quick)")
     ap.add_argument("--repeat", type=int, default=None, help="calls per figure (5; 3 quick)")
     ap.add_argument("--paths", default=None, help="comma-separated paths (default all): "
-                    "contacts,set_poses,geometry,classify_many,distances,"
-                    "time_of_impact_many,first_impacts,nfp_table,dask")
+                    "contacts,time_of_impact_many,time_of_impact_many_rows,nfp_table,"
+                    "classify_many,set_poses,first_impacts,distances,geometry,dask")
     ap.add_argument("--json", metavar="OUT", help="write the figures to this file")
     args = ap.parse_args()
     most = int(numba.config.NUMBA_NUM_THREADS)
@@ -441,8 +461,8 @@ def main() -> None:
     repeat = args.repeat or (3 if args.quick else 5)
     q = int(args.quick)
     chosen = (args.paths.split(",") if args.paths else
-              ["contacts", "time_of_impact_many", "nfp_table", "classify_many", "set_poses",
-               "first_impacts", "distances", "geometry", "dask"])
+              ["contacts", "time_of_impact_many", "time_of_impact_many_rows", "nfp_table",
+               "classify_many", "set_poses", "first_impacts", "distances", "geometry", "dask"])
     print(f"{os.cpu_count()} CPUs, Numba {numba.__version__} ({most} threads, layer "
           f"{numba.config.THREADING_LAYER}), Python {platform.python_version()}, "
           f"{'quick' if args.quick else 'full'} sizes, {repeat} calls per figure")
@@ -458,8 +478,8 @@ def main() -> None:
                           "geometry": Geometry}[name](world)
         elif name in ("classify_many", "distances"):
             path = ClassifyMany(SIZES[name][q], name == "distances")
-        elif name == "time_of_impact_many":
-            path = Impacts(SIZES[name][q])
+        elif name in ("time_of_impact_many", "time_of_impact_many_rows"):
+            path = Impacts(SIZES["time_of_impact_many"][q], name.endswith("rows"))
         elif name == "first_impacts":
             path = FirstImpacts(SIZES[name][q])
         elif name == "nfp_table":

@@ -196,11 +196,12 @@ def test_impact_tasks_send_shapes_of_several_tasks_once():
     uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
     rows, eps = np.zeros((5, 6)), np.ones(5)
     shared, tasks = impacts._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
-    assert shared.shapes() == [uniq[0], uniq[1]]
-    assert [t[2].shapes() for t in tasks] == [[uniq[2]], [uniq[3]], [uniq[4]]]
+    kernel = {s._kernel: k for k, s in enumerate(uniq)}  # each shape's kernel pack
+    assert [kernel[p] for p in shared.kernels] == [0, 1]
+    assert [[kernel[p] for p in t[2].kernels] for t in tasks] == [[2], [3], [4]]
     # a task numbers the shared shapes first, then its own
-    assert [[(shared.shapes() + t[2].shapes())[i] for i in t[1]] for t in tasks] == [
-        [uniq[1], uniq[2]], [uniq[1], uniq[3]], [uniq[4]]]
+    assert [[kernel[(shared.kernels + t[2].kernels)[i]] for i in t[1]] for t in tasks] == [
+        [1, 2], [1, 3], [4]]
     assert [t[0].tolist() for t in tasks] == [[0, 0], [0, 0], [0]]
 
 

@@ -213,6 +213,33 @@ def test_time_of_impact_many_on_two_threads_equals_one_thread(share_everything):
     assert one.impact(7).status is single.status
 
 
+def test_motions_as_rows_give_the_answers_of_motions(share_everything):
+    rng = np.random.default_rng(8)
+    ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+    a = [ell.moved(rng.uniform(-3, 3, 2), rng.uniform(0, 6)) for _ in range(300)]
+    b = [ell] * 300
+    ma = [pc.Motion(velocity=rng.uniform(-2, 2, 2), angular_velocity=rng.uniform(-1, 1),
+                    acceleration=rng.uniform(-1, 1, 2)) for _ in a]
+    mb = [pc.Motion()] * 300
+    rows_a = np.array([m.array for m in ma])
+    rows_b = np.zeros((300, 6))
+    objects = pc.time_of_impact_many(a, ma, b, mb, t_max=3)
+    for threads in (1, 2):
+        rows = on(threads, lambda: pc.time_of_impact_many(a, rows_a, b, rows_b, t_max=3,
+                                                           threads=threads))
+        for name in ("statuses", "times", "first_contacts"):
+            assert same(getattr(objects, name), getattr(rows, name)), name
+    assert rows.impact(5) == objects.impact(5)
+    events = [(e.i, e.j, e.impact.time) for e in pc.first_impacts(a, ma, t_max=1)]
+    assert events == [(e.i, e.j, e.impact.time) for e in pc.first_impacts(a, rows_a, t_max=1)]
+    bad = rows_a.copy()
+    bad[17, 4] = np.inf
+    with pytest.raises(ValueError, match=r"motions_a\[17\]: expected finite numbers"):
+        pc.time_of_impact_many(a, bad, b, rows_b, t_max=3)
+    with pytest.raises(ValueError, match=r"motions_b: expected 300 motions .* shape \(300, 6\)"):
+        pc.time_of_impact_many(a, rows_a, b, rows_b[:, :4], t_max=3)
+
+
 def test_first_impacts_on_two_threads_equal_one_thread(share_everything):
     rng = np.random.default_rng(6)
     shapes = [pc.Shape(x) for x in stars(rng, 300)]

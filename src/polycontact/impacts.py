@@ -39,6 +39,7 @@ from .motion import Motion
 from .relation import shapes_packed
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
+from ._checks import real_array
 from ._threads import as_done, numba_threads, requested, useful
 
 __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
@@ -181,9 +182,47 @@ def check_shapes(items: Any, what: str) -> list[Shape]:
     return out
 
 
-def check_motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion]:
-    """The ``count`` Motions of the sequence ``items``, one per shape of ``shapes_what``
-    (an error naming ``what``)."""
+class MotionRows:
+    """Motions given as the rows of an (N, 6) float64 array of kernel vectors ``[vx, vy,
+    ax, ay, ω, α]`` (:attr:`polycontact.Motion.array`): the batch reads the rows as
+    they are, and makes the :class:`~polycontact.Motion` of a row only when asked for
+    (``motions[k]``).
+
+    >>> MotionRows(np.array([[1.0, 0, 0, 0, 0.5, 0]]))[0].angular_velocity
+    0.5
+    """
+
+    def __init__(self, rows: np.ndarray) -> None:
+        self.rows = rows
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __getitem__(self, k: int) -> Motion:
+        vx, vy, ax, ay, w, alpha = self.rows[k].tolist()
+        return Motion(velocity=(vx, vy), acceleration=(ax, ay), angular_velocity=w,
+                      angular_acceleration=alpha)
+
+
+#: Motions as a batch takes them: Motion objects, or the rows of an array.
+Motions = list[Motion] | MotionRows
+
+
+def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motions:
+    """The ``count`` motions of ``items``, one per shape of ``shapes_what`` (an error
+    naming ``what``): a sequence of Motions, or an array of shape (count, 6) of their
+    kernel vectors (:class:`MotionRows`, finite numbers)."""
+    if isinstance(items, np.ndarray) and items.ndim == 2:
+        rows = real_array(items, what)
+        if rows.shape != (count, 6):
+            raise ValueError(f"{what}: expected {count} motions (one per shape of "
+                             f"{shapes_what}) as an array of shape ({count}, 6), got shape "
+                             f"{rows.shape}")
+        bad = ~np.isfinite(rows).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(f"{what}[{k}]: expected finite numbers, got {rows[k].tolist()}")
+        return MotionRows(rows)
     motions = _sequence(items, what)
     if len(motions) != count:
         raise ValueError(f"{what}: expected {count} motions (one per shape of {shapes_what}), "
@@ -192,6 +231,13 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> list[M
         return motions
     return [m if type(m) is Motion else check_motion(m, f"{what}[{k}]")
             for k, m in enumerate(motions)]
+
+
+def _rows(motions: Motions) -> np.ndarray:
+    """The kernel vectors of ``motions``, (N, 6)."""
+    if isinstance(motions, MotionRows):
+        return motions.rows
+    return np.frombuffer(b"".join(map(_ARRAY, motions)), np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -214,6 +260,7 @@ def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
             np.fromiter(map(_RADIUS, shapes), np.float64, n))
 
 
+_KERNEL = operator.attrgetter("_kernel")
 _CENTROID = operator.attrgetter("_centroid")
 _RADIUS = operator.attrgetter("_radius")
 
@@ -306,10 +353,11 @@ class _Bodies(NamedTuple):
     extents: np.ndarray     # the larger sides of their boxes
 
 
-def _bodies(shapes: list[Shape], motions: list[Motion],
+def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Motion],
             name_of: Callable[[int], tuple[str, str]], t_max: float,
             threads: int) -> _Bodies:
-    """The bodies ``(shapes[k], motions[k])`` after the checks ``time_of_impact`` makes:
+    """The bodies ``(shapes[k], motion_of(k))`` (``rows``: the motions' kernel vectors)
+    after the checks ``time_of_impact`` makes:
     coordinates within the range the kernels take, and motions that do not carry them,
     the points' speeds or accelerations beyond it within [0, t_max]. A shape object in
     many bodies is kept once. The checks run in compiled code on at most ``threads``
@@ -322,7 +370,6 @@ def _bodies(shapes: list[Shape], motions: list[Motion],
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
     uniq = [shapes[k] for k in first.tolist()]
     owner = owner.reshape(-1).astype(np.int64)
-    rows = np.frombuffer(b"".join(map(_ARRAY, motions)), np.float64).reshape(count, 6)
     packed = pack_shapes(uniq)
     xy, vrows, _, _, centroids, radii = packed
     with numba_threads(useful(threads, count * _TABLE_SECONDS)) as n:
@@ -333,7 +380,7 @@ def _bodies(shapes: list[Shape], motions: list[Motion],
         for k in marked:
             check_range(shapes[k].packed[0], name_of(k)[0])
         for k in marked:
-            sh, m = shapes[k], motions[k]
+            sh, m = shapes[k], motion_of(k)
             if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
                 check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
     extents = np.fromiter(map(_EXTENT, uniq), np.float64, len(uniq))
@@ -378,8 +425,11 @@ def time_of_impact_many(
     ----------
     shapes_a, shapes_b : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
         The bodies at t = 0, P of each.
-    motions_a, motions_b : sequence of Motion
-        Their motions, one per shape.
+    motions_a, motions_b : sequence of Motion, or ndarray of shape (P, 6)
+        Their motions, one per shape: Motions, or their kernel vectors ``[vx, vy, ax,
+        ay, ω, α]`` (:attr:`polycontact.Motion.array`) as the rows of an array, read as
+        they are (no Motion is made unless ``impact(k)`` asks for it: the quick form
+        for many pairs).
     t_max, method, time_tolerance, samples, max_iterations
         As for :func:`polycontact.time_of_impact`, for every pair.
     threads : int, optional
@@ -443,7 +493,7 @@ def time_of_impact_many(
     return impact_batch(a, b, ma, mb, raw, prepared[6], t_max, method, tol)
 
 
-def prepare_pairs(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
                   t_max: float, threads: int = 1) -> tuple[Any, ...]:
     """Check every body of the pairs as ``time_of_impact`` does (errors naming where it
     first appears: ``shapes_a[k]``, ``motions_b[k]``, ...; see :func:`_bodies`), then
@@ -457,14 +507,16 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Mot
         side, q = ("a", k) if k < p_count else ("b", k - p_count)
         return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
-    bodies = _bodies(a + b, ma + mb, name_of, t_max, threads)
+    bodies = _bodies(a + b, np.concatenate([_rows(ma), _rows(mb)]),
+                     lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
+                     threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
     eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[ia], bodies.extents[ib])
     return (bodies.shapes, bodies.packed, ia, ib, bodies.motions[:p_count],
             bodies.motions[p_count:], eps_rel)
 
 
-def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+def impact_batch(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
                  raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
                  tol: float) -> ImpactBatch:
     """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
@@ -541,87 +593,62 @@ def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, metho
     """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
     (only the shapes it uses are packed for the kernel); the raw result arrays."""
     sa, sb, own, rows_a, rows_b, eps_rel = task
-    common, mine = shared.shapes(), own.shapes()
     used, inverse = np.unique(np.concatenate([sa, sb]), return_inverse=True)
-    shapes = [common[u] if u < len(common) else mine[u - len(common)] for u in used]
     n = len(sa)
-    return search_pairs(pack_shapes(shapes), inverse[:n], inverse[n:], rows_a, rows_b,
-                        eps_rel, t_max, method, tol, samples, max_iterations, 1)
+    inverse = inverse.reshape(-1)
+    return search_pairs(_ShapePack.packed([shared, own], used.tolist()), inverse[:n],
+                        inverse[n:], rows_a, rows_b, eps_rel, t_max, method, tol, samples,
+                        max_iterations, 1)
 
 
 class _ShapePack:
-    """Shapes sent to Dask workers as five flat arrays, unpacked there on first use.
+    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates
+    and loop starts, see :func:`polycontact.relation.shapes_packed`), centroids and
+    bounding radii.
 
     A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
     shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
-    send against 1 s of work); here every vertex of every shape is one array. The
-    receiving process unpacks them once into :class:`_PackedShape` (what the search
-    reads of a shape: its packed loops, centroid and bounding radius, as sent, not
-    recomputed) and keeps them for every later task.
+    send against 1 s of work); bytes objects and two arrays travel as one message. The
+    receiving task packs the shapes it needs for the search with :meth:`packed`.
 
     Examples
     --------
     >>> import pickle
     >>> from polycontact import Shape
     >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
-    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))]))).shapes()
-    >>> back[1]._centroid.tolist(), back[1]._radius == frame.bounding_radius
-    ([4.0, 3.0], True)
-    >>> back[0]._xy.tolist() == frame.packed[0].tolist()
-    True
+    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))])))
+    >>> xy, rows, starts, st_off, centroids, radii = _ShapePack.packed([back], [1])
+    >>> centroids.tolist(), float(radii[0]) == frame.bounding_radius, starts.tolist()
+    ([[4.0, 3.0]], True, [0, 4, 8])
     """
 
     def __init__(self, shapes: Sequence[Any]) -> None:
         n = len(shapes)
-        self.arrays: tuple[np.ndarray, ...] = (
-            np.concatenate([s.packed[0] for s in shapes]) if n else np.empty((0, 2)),
-            np.concatenate([np.diff(s.packed[1]) for s in shapes]) if n
-            else np.empty(0, np.int64),
-            np.array([len(s.packed[1]) - 1 for s in shapes], dtype=np.int64),
-            np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2),
-            np.array([s.bounding_radius for s in shapes], dtype=np.float64),
-        )
-        self._shapes: list[Any] | None = list(shapes)
+        self.kernels = list(map(_KERNEL, shapes))
+        self.centroids = np.frombuffer(b"".join(map(_CENTROID, shapes)),
+                                       np.float64).reshape(n, 2)
+        self.radii = np.fromiter(map(_RADIUS, shapes), np.float64, n)
 
-    def __getstate__(self) -> tuple[np.ndarray, ...]:
-        return self.arrays
+    def __len__(self) -> int:
+        return len(self.kernels)
 
-    def __setstate__(self, arrays: tuple[np.ndarray, ...]) -> None:
-        self.arrays = arrays
-        self._shapes = None
+    @staticmethod
+    def packed(packs: Sequence[_ShapePack], chosen: Sequence[int]) -> tuple[np.ndarray, ...]:
+        """The shapes ``chosen`` (numbered through ``packs`` one after another) packed as
+        :func:`pack_shapes` packs them."""
+        from ._kernels.packs import unpack_shapes
 
-    def shapes(self) -> list[Any]:
-        """The shapes: those given, or, in a process that received them, unpacked."""
-        if self._shapes is None:
-            xy, loop_len, n_loops, cent, rad = self.arrays
-            loop_end = np.concatenate([[0], np.cumsum(loop_len)])
-            first = np.concatenate([[0], np.cumsum(n_loops)])
-            shapes = []
-            for k in range(len(rad)):
-                ends = loop_end[first[k]:first[k + 1] + 1]
-                shapes.append(_PackedShape(xy[ends[0]:ends[-1]], ends - ends[0],
-                                           cent[k].copy(), float(rad[k])))
-            self._shapes = shapes
-        return self._shapes
-
-
-class _PackedShape:
-    """What the time-of-impact search reads of a :class:`~polycontact.Shape` (its stored
-    coordinates, loop starts, centroid and bounding radius, under a Shape's names), on
-    a worker."""
-
-    __slots__ = ("_xy", "_starts", "_centroid", "_radius")
-
-    def __init__(self, xy: np.ndarray, starts: np.ndarray, centroid: np.ndarray,
-                 radius: float) -> None:
-        self._xy = xy
-        self._starts = starts
-        self._centroid = centroid
-        self._radius = radius
+        kernels = [k for p in packs for k in p.kernels]
+        centroids = np.concatenate([p.centroids for p in packs])
+        radii = np.concatenate([p.radii for p in packs])
+        picked = np.asarray(chosen, np.int64)
+        return (*unpack_shapes(np.frombuffer(b"".join(kernels[k] for k in picked.tolist()),
+                                             np.float64), len(picked)),
+                centroids[picked], radii[picked])
 
 
 # -- many moving bodies ----------------------------------------------------------------
-def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
+def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.ndarray, *,
                     t_max: float) -> np.ndarray:
     """Pairs of moving bodies whose swept bounds over ``[0, t_max]`` meet: the pairs
     :func:`first_impacts` searches.
@@ -657,10 +684,11 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
     >>> candidate_pairs(shapes, motions, t_max=5).tolist()
     [[0, 1]]
     """
-    shapes = check_shapes(shapes, "shapes")
-    motions = check_motions(motions, "motions", len(shapes), "shapes")
+    bodies = check_shapes(shapes, "shapes")
+    moves = check_motions(motions, "motions", len(bodies), "shapes")
     t_max = check_t_max(t_max)
-    return _candidates(_bodies(shapes, motions, _names, t_max, requested(None)), t_max)
+    return _candidates(_bodies(bodies, _rows(moves), moves.__getitem__, _names, t_max,
+                               requested(None)), t_max)
 
 
 def _candidates(bodies: _Bodies, t_max: float) -> np.ndarray:
@@ -712,7 +740,7 @@ def event_time(impact: Impact) -> float:
 
 def first_impacts(
     shapes: Sequence[ShapeLike],
-    motions: Sequence[Motion],
+    motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",
@@ -742,8 +770,9 @@ def first_impacts(
     ----------
     shapes : sequence of ShapeLike
         The bodies at t = 0.
-    motions : sequence of Motion
-        One per body.
+    motions : sequence of Motion, or ndarray of shape (N, 6)
+        One per body: Motions, or their kernel vectors as rows (as for
+        :func:`time_of_impact_many`).
     t_max : float
         End of the time window (>= 0).
     method : {"exact", "sampled"}, default "exact"
@@ -781,11 +810,11 @@ def first_impacts(
     0 1 hit penetrating 2.0
     """
     shapes = check_shapes(shapes, "shapes")
-    motions = check_motions(motions, "motions", len(shapes), "shapes")
+    moves = check_motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
-    bodies = _bodies(shapes, motions, _names, t_max, threads)
+    bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
     pairs = _candidates(bodies, t_max)
     if len(pairs) == 0:
         return []
@@ -795,11 +824,12 @@ def first_impacts(
     used, inverse = np.unique(np.concatenate([oi, oj]), return_inverse=True)
     inverse = inverse.reshape(-1).astype(np.int64)
     eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[oi], bodies.extents[oj])
-    raw = search_pairs(pack_shapes([bodies.shapes[u] for u in used.tolist()]), inverse[: len(i)],
-                       inverse[len(i):], bodies.motions[i], bodies.motions[j], eps_rel,
-                       t_max, method, tol, samples, max_iterations, threads)
+    raw = search_pairs(pack_shapes([bodies.shapes[u] for u in used.tolist()]),
+                       inverse[: len(i)], inverse[len(i):], bodies.motions[i],
+                       bodies.motions[j], eps_rel, t_max, method, tol, samples,
+                       max_iterations, threads)
     code, _, _, contact, *_ = raw
-    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
+    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
     events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
               for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
@@ -818,7 +848,7 @@ def _first_order(event: PairImpact) -> tuple[Any, ...]:
 
 def first_impact(
     shapes: Sequence[ShapeLike],
-    motions: Sequence[Motion],
+    motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",

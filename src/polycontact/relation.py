@@ -872,27 +872,22 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
 def shapes_packed(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     """The stored coordinates of many shapes one after another, ``(xy, rows, starts,
     st_off)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]`` and its loop starts
-    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]``. Read from each
-    shape's stored arrays (``_xy``, ``_starts``) and joined as bytes: the few hundred
-    nanoseconds per shape that no compiled code can take over.
+    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]``. Each shape's kernel
+    pack (the bytes ``classify`` hands the kernels) is joined with the others and read
+    in compiled code: per shape, only the few tens of nanoseconds of the join.
 
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> [a.tolist() for a in shapes_packed([sq, sq])[1:]]
     [[0, 4, 8], [0, 4, 0, 4], [0, 2, 4]]
     """
-    n = len(shapes)
-    xy = list(map(_XY, shapes))
-    starts = list(map(_STARTS, shapes))
-    rows = np.zeros(n + 1, np.int64)
-    st_off = np.zeros(n + 1, np.int64)
-    np.cumsum(np.fromiter(map(len, xy), np.int64, n), out=rows[1:])
-    np.cumsum(np.fromiter(map(len, starts), np.int64, n), out=st_off[1:])
-    return (np.frombuffer(b"".join(xy), np.float64).reshape(-1, 2), rows,
-            np.frombuffer(b"".join(starts), np.int64), st_off)
+    from ._kernels.packs import unpack_shapes
+
+    out: tuple[np.ndarray, ...] = unpack_shapes(
+        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), len(shapes))
+    return out
 
 
-_XY = operator.attrgetter("_xy")
-_STARTS = operator.attrgetter("_starts")
+_KERNEL = operator.attrgetter("_kernel")
 
 
 def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[Any, ...]:
