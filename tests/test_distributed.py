@@ -1,6 +1,6 @@
 """Dask: a LocalCluster of 2 worker processes gives the same NFP tables, classifications
 and times of impact as the local run; kernels are warmed once per worker; a killed worker
-loses nothing."""
+loses nothing; tasks are sized from a first one."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import shapely
 
 import polycontact as pc
 from polycontact import distributed as pd
+from polycontact import impacts
 from polycontact.esicup import turned
 
 distributed = pytest.importorskip("distributed")
@@ -31,6 +32,14 @@ def client():
             yield c
 
 
+def here(fn):
+    """``fn()`` with the calls that give no ``client=`` run in this process, though the
+    cluster's client is the default one."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(pd, "current_client", lambda client=None: client)
+        return fn()
+
+
 def same_entry(x: pc.NoFitPolygon, y: pc.NoFitPolygon) -> bool:
     return (shapely.to_wkb(x.region) == shapely.to_wkb(y.region)
             and np.array_equal(x.exact_fits, y.exact_fits)
@@ -38,7 +47,7 @@ def same_entry(x: pc.NoFitPolygon, y: pc.NoFitPolygon) -> bool:
 
 
 def test_table_on_the_cluster_is_identical_to_the_local_one(client, tmp_path):
-    local = pc.nfp_table(PIECES, ANGLES, progress=False)
+    local = here(lambda: pc.nfp_table(PIECES, ANGLES, progress=False))
     remote = pc.nfp_table(PIECES, ANGLES, client=client, progress=False, chunk_size=15,
                           cache=tmp_path)
     assert remote.computed == local.computed and len(remote) == 100
@@ -54,19 +63,19 @@ def test_the_default_client_is_used(client):
                          progress=lambda d, n: seen.append(d))
     assert pd.current_client() is client
     assert len(seen) == 4 and table.computed == 16  # four tasks of 4 entries, on the cluster
-    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd._plugins).values())
+    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd.worker_plugins).values())
 
 
 def test_kernels_are_warmed_once_per_worker(client):
     pc.nfp_table(PIECES[:1], progress=False, client=client)
     name = pd.plugin_name("no-fit polygon")
-    assert all(name in p for p in client.run(pd._plugins).values())
+    assert all(name in p for p in client.run(pd.worker_plugins).values())
     before = client.run(_setup_id, name)
     pd.ensure_warm(client, ["no-fit polygon"])
     pc.nfp_table(PIECES[:2], progress=False, client=client)
     assert client.run(_setup_id, name) == before  # no new registration, no warm-up per task
     # a batch warms only its own family
-    assert pd.plugin_name("time of impact") not in next(iter(client.run(pd._plugins).values()))
+    assert pd.plugin_name("time of impact") not in next(iter(client.run(pd.worker_plugins).values()))
 
 
 def _setup_id(name, dask_worker=None) -> int:
@@ -82,14 +91,14 @@ def test_classify_many_on_the_cluster_is_identical(client):
     b[::7] = a[::7] + [1e-3, 0]  # some overlapping, some touching
     width = a[1::7, 1, 0] - a[1::7, 0, 0]
     b[1::7] = a[1::7] + np.stack([width, 0 * width], axis=-1)[:, None, :]
-    local = pc.classify_many(a, b)
-    remote = pd.classify_many(a, b, client=client, chunk_size=700)
+    local = here(lambda: pc.classify_many(a, b))
+    remote = pc.classify_many(a, b, client=client, chunk_size=700)
     assert np.array_equal(local.states, remote.states)
     assert np.array_equal(local.tolerances, remote.tolerances)
     assert np.array_equal(local.distances, remote.distances)
     assert set(local.states.tolist()) == {0, 1, 2}
     shapes_a = [pc.Shape(r) for r in a[:50]]
-    listed = pd.classify_many(shapes_a, list(b[:50]), client=client, chunk_size=9)
+    listed = pc.classify_many(shapes_a, list(b[:50]), client=client, chunk_size=9)
     assert np.array_equal(listed.states, local.states[:50])
 
 
@@ -132,8 +141,9 @@ def same_batch(x: pc.ImpactBatch, y: pc.ImpactBatch) -> bool:
 @pytest.mark.parametrize("method", ["exact", "sampled"])
 def test_time_of_impact_many_on_the_cluster_is_identical(client, method):
     a, ma, b, mb = impact_pairs(400, seed=11)
-    local = pc.time_of_impact_many(a, ma, b, mb, t_max=3, method=method, threads=1)
-    remote = pd.time_of_impact_many(a, ma, b, mb, 3, method=method, client=client,
+    local = here(lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, method=method,
+                                                 threads=1))
+    remote = pc.time_of_impact_many(a, ma, b, mb, t_max=3, method=method, client=client,
                                     chunk_size=37)
     assert len(remote) == len(a) and same_batch(local, remote)
     # the chosen cases: hit, slide, miss, overlap at the start, through a hole
@@ -148,13 +158,13 @@ def test_time_of_impact_many_on_the_cluster_is_identical(client, method):
 def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):
     a, ma, b, mb = impact_pairs(40, seed=5)
     arrays = [np.asarray(s.exterior) for s in a]  # every pair its own shape objects
-    local = pc.time_of_impact_many(arrays, ma, b, mb, t_max=2)
+    local = here(lambda: pc.time_of_impact_many(arrays, ma, b, mb, t_max=2))
     assert pd.current_client() is client
-    remote = pd.time_of_impact_many(arrays, ma, b, mb, t_max=2)  # a default chunk size
+    remote = pc.time_of_impact_many(arrays, ma, b, mb, t_max=2)  # a default chunk size
     assert same_batch(local, remote)
     name = pd.plugin_name("many moving bodies")
-    assert all(name in p for p in client.run(pd._plugins).values())
-    empty = pd.time_of_impact_many([], [], [], [], 1, client=client)
+    assert all(name in p for p in client.run(pd.worker_plugins).values())
+    empty = pc.time_of_impact_many([], [], [], [], t_max=1, client=client)
     assert len(empty) == 0 and empty.times.shape == (0,)
 
 
@@ -171,12 +181,12 @@ def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):
 def test_time_of_impact_many_errors_name_the_caller_s_index(client, change, error, message):
     a, ma, b, mb = change(*impact_pairs(40, seed=5))
     with pytest.raises(error, match=message) as local:
-        pc.time_of_impact_many(a, ma, b, mb, t_max=1)
+        here(lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=1))
     with pytest.raises(error, match=message) as remote:
-        pd.time_of_impact_many(a, ma, b, mb, 1, client=client, chunk_size=7)
+        pc.time_of_impact_many(a, ma, b, mb, t_max=1, client=client, chunk_size=7)
     assert str(remote.value) == str(local.value)
     with pytest.raises(ValueError, match="chunk_size: expected a positive integer"):
-        pd.time_of_impact_many(a, ma, b, mb, 1, client=client, chunk_size=0)
+        pc.time_of_impact_many(a, ma, b, mb, t_max=1, client=client, chunk_size=0)
 
 
 def test_impact_tasks_send_shapes_of_several_tasks_once():
@@ -185,12 +195,13 @@ def test_impact_tasks_send_shapes_of_several_tasks_once():
     sb = np.array([1, 2, 1, 3, 4])
     uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
     rows, eps = np.zeros((5, 6)), np.ones(5)
-    shared, tasks = pd._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
-    assert shared.shapes() == [uniq[0], uniq[1]]
-    assert [t[2].shapes() for t in tasks] == [[uniq[2]], [uniq[3]], [uniq[4]]]
+    shared, tasks = impacts._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
+    kernel = {s._kernel: k for k, s in enumerate(uniq)}  # each shape's kernel pack
+    assert [kernel[p] for p in shared.kernels] == [0, 1]
+    assert [[kernel[p] for p in t[2].kernels] for t in tasks] == [[2], [3], [4]]
     # a task numbers the shared shapes first, then its own
-    assert [[(shared.shapes() + t[2].shapes())[i] for i in t[1]] for t in tasks] == [
-        [uniq[1], uniq[2]], [uniq[1], uniq[3]], [uniq[4]]]
+    assert [[kernel[(shared.kernels + t[2].kernels)[i]] for i in t[1]] for t in tasks] == [
+        [1, 2], [1, 3], [4]]
     assert [t[0].tolist() for t in tasks] == [[0, 0], [0, 0], [0]]
 
 
@@ -209,7 +220,7 @@ def _sum_pairs(x, y, scale):
 
 def test_a_killed_worker_loses_no_entry(client, tmp_path):
     pieces = [turned(p, 0) for p in PIECES]
-    local = pc.nfp_table(pieces, ANGLES, progress=False)
+    local = here(lambda: pc.nfp_table(pieces, ANGLES, progress=False))
     killed = []
 
     def kill_one(done, total):
@@ -249,7 +260,27 @@ def test_cli_on_a_scheduler_builds_the_same_table(client, tmp_path, capsys):
     captured = capsys.readouterr()
     assert "2 workers" in captured.err
     assert captured.out.startswith("three: 100 entries (")
-    local = pc.nfp_table(PIECES, ANGLES, progress=False)
+    local = here(lambda: pc.nfp_table(PIECES, ANGLES, progress=False))
     loaded = pc.NfpTable.load(out)
     for key in local:
         assert same_entry(local[key], loaded[key])
+
+
+def test_tasks_are_sized_from_a_first_task(client):
+    # a first task of PROBE_ITEMS items, then tasks of at least TASK_SECONDS of work each
+    # (here: every item left in one task), four per worker thread where there is enough
+    spans = []
+
+    def tasks_of(got):
+        spans.extend(got)
+        return None, [np.arange(p0, p1) for p0, p1 in got]
+
+    parts = dict(((p0, p1), r) for p0, p1, r in pd.run_spans(client, _total, 1000, tasks_of))
+    assert spans[0] == (0, pd.PROBE_ITEMS) and spans[1:] == [(pd.PROBE_ITEMS, 1000)]
+    assert sum(parts.values()) == sum(range(1000))
+    assert pd.task_size(10**6, 1e-6, 4) == 200_000  # 0.2 s of work
+    assert pd.task_size(10**8, 1e-6, 4) == 10**8 // 16  # four per worker thread
+
+
+def _total(_, task):
+    return int(np.sum(task))

@@ -59,16 +59,16 @@ def _alive(pids) -> list[int]:
 
 
 def _instance(path: Path) -> Path:
-    """Enough pieces and orientations for a build of minutes: it is still running when
-    the parent is killed."""
+    """Enough pieces and orientations (518 400 entries) for a build of many seconds on
+    two processes: it is still running when the parent is killed."""
     rng = np.random.default_rng(3)
     items = []
-    for k in range(12):
+    for k in range(20):
         n = 10
         t = 2 * np.pi * np.arange(n) / n
         r = rng.uniform(0.5, 1.5, n)
         ring = np.c_[r * np.cos(t), r * np.sin(t)] * 10
-        items.append({"id": k, "demand": 1, "allowed_orientations": list(range(0, 360, 15)),
+        items.append({"id": k, "demand": 1, "allowed_orientations": list(range(0, 360, 10)),
                       "shape": {"type": "simple_polygon", "data": ring.tolist()}})
     path.write_text(json.dumps({"name": "long", "strip_height": 100, "items": items}))
     return path

@@ -42,9 +42,10 @@ FAMILIES: dict[str, tuple[str, ...]] = {
                        "rings.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
     "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
-                       "fits.select_contacts"),
+                       "fits.select_contacts", "nfp_batch.nfp_pairs"),
     "entrance block": ("validate.first_defect",),
-    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
+    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk",
+                           "impact_batch.body_tables", "impact_batch.suspect_bodies"),
 }
 
 
@@ -113,6 +114,9 @@ def _run(family: str) -> None:
         no_fit_polygon(Shape(sq), slot).region  # noqa: B018
         inner_fit_polygon(Shape(sq), Shape(sq * 4.0))
         inner_fit_polygon(Shape(sq), Shape(sq))  # an exact fit
+        from .nfp_tables import nfp_table
+
+        nfp_table([ell, slot], progress=False, threads=1)  # the table's batch kernel
     elif family == "entrance block":
         from .entrance import entrance_block
 

@@ -45,8 +45,8 @@ __all__ = [
     "MAX_EDGE_PAIRS",
     "EAR_CLIPPING_MAX",
     "PIECES_CACHE_SIZE",
-    "DEFAULT_BATCH",
-    "DEFAULT_IMPACT_BATCH",
+    "THREAD_WORK",
+    "TASK_SECONDS",
     "JSON_MAX_DEPTH",
     "NOTICE_AFTER",
 ]
@@ -169,18 +169,17 @@ EAR_CLIPPING_MAX = 64
 #: asks about many pairs of the same pieces decomposes each piece once.
 PIECES_CACHE_SIZE = 4096
 
-# -- distributed batches -------------------------------------------------------------
+# -- threads and distributed batches -----------------------------------------------
 
-#: Default pairs per task of ``polycontact.distributed.map_batches`` (pairs):
-#: classification of this many is about 10 ms of work, well above a Dask task's
-#: overhead of about 1 ms (fewer if that would leave fewer than four tasks per worker
-#: thread).
-DEFAULT_BATCH = 20_000
+#: Work per thread (seconds) below which a parallel call starts no further thread:
+#: starting a thread and handing it its share costs tens of microseconds, under 2 % of
+#: this (see :mod:`polycontact._threads`).
+THREAD_WORK = 2e-3
 
-#: Default pairs per task of ``polycontact.distributed.time_of_impact_many`` (pairs): a
-#: pair's search costs ten to a thousand times a classification, so a task of this
-#: many is still well above Dask's overhead.
-DEFAULT_IMPACT_BATCH = 2_000
+#: Least work of one Dask task (seconds): a task costs the scheduler and the transfers
+#: about a millisecond, and the results a round trip, so a task of this much work loses
+#: under 1 % to them; tasks are made larger only to keep several per worker thread.
+TASK_SECONDS = 0.2
 
 # -- files and the command line ------------------------------------------------------
 
