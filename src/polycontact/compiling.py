@@ -1,18 +1,26 @@
 """Compiling the kernels: whether the cache is warm, and warm-up.
 
-polycontact's kernels are compiled by Numba on first use and cached on disk. The first
-run on a new machine (or after an upgrade) therefore takes about a minute; every run
-after it loads the compiled code in well under a second.
+polycontact's kernels are compiled by Numba on first use and cached on disk. A call
+compiles only the kernels it runs, the first time they run on a machine (or after an
+upgrade): a first call takes seconds to tens of seconds (about 40 s for the first time
+of impact on a 2-core machine), and every run after it loads the compiled code in well
+under a second.
+
+**The notice.** The first compile of a process says so once, as a warning on the
+``polycontact`` logger (:data:`polycontact._kernels.jit.LOGGER`), shown on stderr when
+logging is not configured: ``polycontact is compiling the kernels this call needs (...)``.
+``logging.getLogger("polycontact").setLevel(logging.ERROR)`` silences it. Kernels
+loaded from the cache say nothing.
 
 **Where the cache goes.** In the per-user cache directory (:func:`cache_directory`,
 e.g. ``~/.cache/polycontact/numba`` on Linux; ``NUMBA_CACHE_DIR`` overrides it for
 every Numba library), in a subdirectory named after a hash of all the kernels' sources
-(:func:`kernel_sources_fingerprint`); see :mod:`polycontact._kernels.cache`.
+(:func:`kernel_sources_fingerprint`), shared by every install of the same sources
+(editable or not); see :mod:`polycontact._kernels.cache`.
 
-**First run.** :func:`warmup` compiles (or loads) every kernel family and reports each
-stage to a callback; the command line says "compiling kernels, first run only, about a
-minute" on stderr before a command whose kernels are not cached yet, with one line per
-stage (``polycontact warmup`` does it on purpose), so stdout stays parseable.
+**Ahead of time.** :func:`warmup` compiles (or loads) every kernel family and reports
+each stage to a callback; ``polycontact warmup`` does it from the command line, one
+line per family on stderr.
 
 This module is the top of the package: :func:`warmup` calls every public function.
 

@@ -28,8 +28,9 @@ once.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .convolution import FEW_VERTICES, contact_depth_into, depth_buffers
 from .depth import box_escape
 from .overlap import overlap_moments, overlap_scratch, where

@@ -12,8 +12,8 @@ overlapping.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .minkowski import in_some_sum
 from .primitives import append_part
 from .relation import relate_state

@@ -10,7 +10,8 @@ sorted by x, and a grid whose cells remember the sums that contain them whole).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 
 @njit(cache=True, nogil=True)

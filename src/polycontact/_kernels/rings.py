@@ -11,8 +11,8 @@ in O(n) (:func:`_star_ring_is_simple`), short ones pair by pair, long ones by a 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import norm, orient, point_segment_distance, segment_meet
 from .relation import oriented_state
 from .sweep import sorted_edge_boxes

@@ -23,8 +23,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .advance import edge_table
 from .contact_geometry import geometry_buffers, pair_geometry_into
 from .impact import exact_query, state_at, tolerance_at, work_floats
