@@ -115,14 +115,33 @@ def test_installs_of_the_same_sources_in_two_places_share_the_compiled_kernels(t
         assert out.stderr.count(NOTICE) == (1 if k == 0 else 0), out.stderr
 
 
-def test_warmup_command_reports_every_family(tmp_path):
+@pytest.mark.parametrize("processes", ["1", "2"])
+def test_warmup_command_reports_every_family(tmp_path, processes):
     # Without the JIT the "compilation" is instant; the reporting is the same.
-    out = _run([sys.executable, "-m", "polycontact", "warmup"],
+    out = _run([sys.executable, "-m", "polycontact", "warmup", "--processes", processes],
                {"NUMBA_CACHE_DIR": str(tmp_path), "NUMBA_DISABLE_JIT": "1"})
     assert out.returncode == 0, out.stderr
     for k, family in enumerate(compiling.FAMILIES, 1):
-        assert f"[{k}/{len(compiling.FAMILIES)}] {family}" in out.stderr
+        assert f"[{k}/{len(compiling.FAMILIES)}] {family} ... " in out.stderr
     assert out.stdout.startswith("kernels ready in")
+
+
+def test_warmup_workers_number_their_functions_apart_from_other_processes():
+    # two processes that compile into one cache must not give one name to different
+    # functions (numba/numba#10486): a worker's numbers start at its process id * 2**20
+    code = ("import os\n"
+            "from numba.core.bytecode import FunctionIdentity\n"
+            "from polycontact import compiling\n"
+            "compiling._worker_start()\n"
+            "print(next(FunctionIdentity._unique_ids) - (os.getpid() << 20))\n")
+    out = _run([sys.executable, "-c", code], {})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "0"
+
+
+def test_warmup_refuses_a_number_of_processes_below_one():
+    with pytest.raises(ValueError, match="processes: expected an int >= 1"):
+        compiling.warmup(["classification"], processes=0)
 
 
 @pytest.mark.slow
