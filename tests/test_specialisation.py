@@ -108,7 +108,8 @@ def test_the_pairwise_kernels_compile_once_for_shapes_and_batches():
     far = sq.moved((3.0, 0.0))
     hit = pc.time_of_impact(sq, pc.Motion(velocity=(1.0, 0.0)), far, pc.Motion(), t_max=5.0)
     hit.features  # noqa: B018 - computed on access
-    pc.first_impacts([sq, far], [pc.Motion(velocity=(1.0, 0.0)), pc.Motion()], 5.0, threads=1)
+    pc.first_impacts([sq, far], [pc.Motion(velocity=(1.0, 0.0)), pc.Motion()], t_max=5.0,
+                     threads=1)
     for kernel in (impact.exact_query, impact.state_at, convolution.contact_depth):
         cache = kernel._cache
         probe = cache._index_key((), kernel.targetctx.codegen())

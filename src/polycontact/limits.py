@@ -23,7 +23,6 @@ from __future__ import annotations
 __all__ = [
     "RELATIVE_TOLERANCE",
     "ROUNDING_ULPS",
-    "VALIDATION_ULPS",
     "COORDINATE_LIMIT",
     "EXTENT_FLOOR",
     "TIME_TOLERANCE",
@@ -58,14 +57,6 @@ RELATIVE_TOLERANCE = 1e-12
 #: moves its vertices by rounding errors of a few ulps of its coordinates; 64 is well
 #: above that and still resolves 1e-4 at 1e9.
 ROUNDING_ULPS = 64.0
-
-#: Ulps of a polygon's largest absolute coordinate: two features of one polygon closer than
-#: this cannot be told apart in float64 (about the rounding of a distance computed from
-#: such coordinates), so the polygon is refused as invalid only then. Far below the
-#: classification tolerance on purpose: a valid polygon (GEOS's "very skinny polygon",
-#: 10 wide and 1e15 long) is accepted, and its features closer than the tolerance are
-#: then decided as touching.
-VALIDATION_ULPS = 4.0
 
 #: Largest absolute coordinate accepted (length). The kernels form products of up to three
 #: coordinate differences (areas, centroids, Minkowski sums): (2e100)**3 = 8e300 stays

@@ -15,11 +15,13 @@ and with repeated or closing points counted; :meth:`Shape.input_vertex`,
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import finite_number, is_real, point, real_array, shown
 from ._json import load_json
@@ -28,23 +30,19 @@ from .motion import Motion
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,
-    VALIDATION_ULPS,
     check_range,
     default_tolerance,
     tolerance_for,
-    validation_tolerance,
 )
 
-__all__ = ["Shape"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely import Polygon
+    from shapely.geometry.base import BaseGeometry
+
+__all__ = ["Shape", "ShapeLike", "GeoInterface", "as_shape", "SHAPE_FORMS"]
 
 ArrayLike = Any
-
-
-def _signed_area(ring: np.ndarray) -> float:
-    # Relative to the first vertex: small rings far from the origin keep their digits.
-    x = ring[:, 0] - ring[0, 0]
-    y = ring[:, 1] - ring[0, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
@@ -86,38 +84,55 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
-def _whole_body(obj: Any) -> bool:
-    """Whether ``obj`` is a body in a form other than an array of vertices: a Shape, a
+def _whole_shape(obj: Any) -> bool:
+    """Whether ``obj`` is a shape in a form other than an array of vertices: a Shape, a
     Shapely geometry, anything with ``__geo_interface__``, a mapping, text or WKB."""
     return (isinstance(obj, (Shape, str, bytes, bytearray, memoryview, Mapping))
             or hasattr(obj, "__geo_interface__") or hasattr(obj, "geom_type"))
 
 
 def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
-    """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
-    through :func:`as_shape`; such a body carries its own holes."""
+    """The Shape of a shape given in a form other than an array (see
+    :func:`_whole_shape`), through :func:`as_shape`; such a form carries its own holes."""
     if len(list(holes)):
-        raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
+        raise TypeError(f"holes: a {type(obj).__name__} carries its own holes; pass "
                         "holes only with an array of vertices")
     return as_shape(obj, "vertices", repair=repair)
 
 
-#: The forms a body may take, as error messages list them.
-BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+#: The forms a shape may take, as error messages list them.
+SHAPE_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB"
 
-_BODY_KEYS = {"vertices", "holes", "name"}
+_MAPPING_KEYS = {"vertices", "holes", "name"}
 _HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
 
 
-def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
-    """``obj`` as a :class:`Shape`, whatever accepted form it takes (the forms
-    :mod:`polycontact.bodies` lists; offered to the package from there).
+def as_shape(obj: ShapeLike, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever form it is given in.
+
+    Everywhere polycontact takes a shape (the functions, :class:`Shape` itself,
+    ``classify_many``, worlds, scenes, the command line) it accepts the same forms:
+
+    - a :class:`Shape` (returned as it is);
+    - an array-like of shape (N, 2): the outer loop, closed or not, either orientation;
+    - a Shapely ``Polygon`` (or a ``MultiPolygon`` of exactly one part);
+    - anything with ``__geo_interface__`` (GeoPandas, other geometry libraries);
+    - a GeoJSON mapping: ``Polygon``, a ``MultiPolygon`` of one part, or a ``Feature``
+      holding one;
+    - a vertices mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
+      ``"name"`` is ignored), the form of the scene files' bodies;
+    - WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
+      above or of a list of vertices (``"[[0, 0], [1, 0], [0, 1]]"``), WKB bytes or hex
+      WKB text.
+
+    ``Shape(obj)`` takes every one of these forms too; ``as_shape`` names the argument
+    in its errors, which is what a function of your own wants.
 
     Parameters
     ----------
-    obj : body
-        One of the forms listed in :mod:`polycontact.bodies`.
-    what : str
+    obj : ShapeLike
+        One of the forms above.
+    what : str, default "shape"
         The argument's name, put at the start of every error message.
     repair : bool, default False
         Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
@@ -130,9 +145,27 @@ def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
     Raises
     ------
     TypeError
-        ``obj`` is of no accepted type.
+        ``obj`` is of no accepted type (the message names ``what``).
     InvalidShapeError
-        ``obj`` is of an accepted type but not a valid polygon.
+        ``obj`` is of an accepted type but not a valid polygon (a ``ValueError``).
+
+    Examples
+    --------
+    >>> import shapely
+    >>> forms = [
+    ...     [(0, 0), (1, 0), (1, 1), (0, 1)],
+    ...     shapely.box(0, 0, 1, 1),
+    ...     {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]},
+    ...     {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+    ...     "POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))",
+    ...     shapely.box(0, 0, 1, 1).wkb,
+    ... ]
+    >>> [as_shape(f).area for f in forms]
+    [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+    >>> as_shape(3, "a")
+    Traceback (most recent call last):
+    ...
+    TypeError: a: expected a shape (Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB), got int
     """
     if isinstance(obj, Shape):
         return obj
@@ -158,24 +191,24 @@ def _coerce(obj: Any, repair: bool) -> Shape:
         return _from_mapping(geo, repair)
     if isinstance(obj, (np.ndarray, list, tuple)):
         return Shape(obj, repair=repair)
-    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+    raise TypeError(f"expected a shape ({SHAPE_FORMS}), got {type(obj).__name__}")
 
 
 def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
     if "vertices" in data:
-        unknown = sorted(set(data) - _BODY_KEYS)
+        unknown = sorted(set(data) - _MAPPING_KEYS)
         if unknown:
             raise InvalidShapeError(
-                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
+                f"unknown key {unknown[0]!r} (a vertices mapping has 'vertices', 'holes', 'name')"
             )
         holes = data.get("holes", ())
         if holes is None or isinstance(holes, (str, bytes, Mapping)):
-            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+            raise InvalidShapeError("vertices mapping: 'holes' must be a list of rings")
         return Shape(data["vertices"], holes, repair=repair)
     if "type" in data:
         return Shape.from_geojson(dict(data), repair=repair)
     raise InvalidShapeError(
-        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        "expected a GeoJSON mapping (with 'type') or a vertices mapping (with 'vertices'), "
         f"got keys {sorted(map(str, data))}"
     )
 
@@ -183,7 +216,7 @@ def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
 def _from_text(text: str, repair: bool) -> Shape:
     stripped = text.strip()
     if not stripped:
-        raise InvalidShapeError("empty text: no body in it")
+        raise InvalidShapeError("empty text: no shape in it")
     if stripped.startswith(("{", "[")):
         try:
             data = load_json(text)
@@ -203,7 +236,7 @@ def _from_wkb(data: bytes) -> Any:
     import shapely
 
     if not data:
-        raise InvalidShapeError("empty WKB: no body in it")
+        raise InvalidShapeError("empty WKB: no shape in it")
     try:
         return shapely.from_wkb(data)
     except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
@@ -236,33 +269,39 @@ class Shape:
 
     Parameters
     ----------
-    vertices : array_like of shape (N, 2), or a whole body
-        The outer loop, closed or not, in either orientation. Or a body in any other
-        form polycontact takes (:mod:`polycontact.bodies`), holes included: a Shape, a
-        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or body
+    vertices : array_like of shape (N, 2), or a whole shape (ShapeLike)
+        The outer loop, closed or not, in either orientation. Or a shape in any other
+        form polycontact takes (:func:`as_shape`), holes included: a Shape, a
+        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or vertices
         mapping ``{"vertices": ..., "holes": ...}``, WKT or JSON text, WKB.
     holes : sequence of array_like of shape (M, 2), optional
         Hole loops, closed or not, in either orientation (None or empty: no holes).
         Only with an array of vertices: the other forms carry their own holes.
     repair : bool, default False
-        If the loops are invalid, try ``shapely.make_valid`` and keep the result when it
-        is a single polygon; :attr:`repairs` then says what changed. Indices still
-        refer to the caller's vertices where the repaired loops keep them; a vertex or
-        edge the repair created has none (see :meth:`input_vertex`).
+        If the loops are invalid, try ``shapely.make_valid(method="structure")`` and keep
+        the result when it is a single polygon; where GEOS's result still meets itself
+        exactly, it is snap-rounded first (``shapely.set_precision``) onto a grid of
+        :func:`polycontact.tolerances.snap_grid` of the tolerance (each vertex moves by
+        far less than the tolerance). :attr:`repairs` then says what changed. Indices
+        still refer to the caller's vertices where the repaired loops keep them (or,
+        snapped, keep them within one grid step); a vertex or edge the repair created
+        has none (see :meth:`input_vertex`).
 
     Raises
     ------
     InvalidShapeError
         Fewer than 3 distinct vertices, a non-finite coordinate, a coordinate beyond
         ±1e100 or an extent below 1e-100 (see :func:`polycontact.tolerances.check_range`),
-        zero area, a self-intersection (with its point and the two edges), a hole
-        outside or crossing its outer loop, overlapping holes. Two features of a loop
-        count as meeting only when they are closer than float64 can tell apart at the
-        shape's coordinates (:func:`polycontact.tolerances.validation_tolerance`); the
-        message then says which, how far apart, and the float spacing.
+        zero area, a self-intersection (with its point and the two edges), a zero-width
+        spike, a hole outside or crossing its outer loop, overlapping holes, holes that
+        cut the solid in pieces. Every test is exact for the float64 coordinates given
+        (exact orientations): features are defects only where they truly meet, however
+        close they come otherwise, so a polygon GEOS calls valid is accepted at every
+        scale and position. Features closer than the tolerance are then decided as
+        touching by the functions that take the shape.
     TypeError
         Coordinates that are not real numbers (strings, booleans, complex numbers: the
-        message names the loop and the vertex), or ``holes`` with a body that carries
+        message names the loop and the vertex), or ``holes`` with a form that carries
         its own.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
@@ -300,7 +339,7 @@ class Shape:
     ) -> None:
         if holes is None:
             holes = ()
-        if _whole_body(vertices):
+        if _whole_shape(vertices):
             self._adopt(_other_form(vertices, holes, repair))
             return
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
@@ -378,18 +417,19 @@ class Shape:
             nxt[s:e] = np.roll(np.arange(s, e), -1)
         cross = x * y[nxt] - x[nxt] * y
         a2 = float(cross.sum())
-        if not (a2 > 0.0 and extent > validation_tolerance(magnitude)):
+        if _area_clear(a2, x, y, nxt, hi - lo):
+            centroid = [origin[0] + float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
+                        origin[1] + float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
+        else:  # a sliver, or a body rounded away: only the exact sums can tell
+            a2, centroid = _exact_area_centroid(xy, nxt)
+        if not a2 > 0.0:
             # (a rigid motion far from the origin rounded the body away)
             raise InvalidShapeError(
-                f"shape: coordinates up to {magnitude:g} cannot carry a body of size "
-                f"{extent:g}: float64's spacing there ({validation_tolerance(magnitude):.3g}) "
-                "is not below it"
+                f"shape: coordinates up to {magnitude:g} cannot carry a shape of size "
+                f"{extent:g}: rounded to float64 there, it has no area"
             )
         self._area = 0.5 * a2
-        self._centroid = np.array(
-            [origin[0] + float(((x + x[nxt]) * cross).sum()) / (3.0 * a2),
-             origin[1] + float(((y + y[nxt]) * cross).sum()) / (3.0 * a2)]
-        )
+        self._centroid = np.array(centroid)
         self._centroid.flags.writeable = False
         self._radius = float(
             np.max(np.hypot(xy[:, 0] - self._centroid[0], xy[:, 1] - self._centroid[1]))
@@ -405,60 +445,40 @@ class Shape:
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],
                          rings: Sequence[ArrayLike] | None = None) -> None:
         # ``rings``: the loops as the caller passed them (messages use their numbering);
-        # None when ``loops`` are already in the numbering to report
-        # Features meet only when float64 cannot tell them apart: a length compared with
-        # a few float spacings of the coordinates, an area with that length times the
-        # loop's extent. Nothing depends on where the origin is or on the unit.
-        magnitude = max(float(np.abs(r).max()) for r in loops)
-        eps = validation_tolerance(magnitude)
-        spacing = (f"{eps:.3g} = {VALIDATION_ULPS:g} × 2**-52 × {magnitude:g}, the float "
-                   f"spacing of coordinates up to {magnitude:g}")
+        # None when ``loops`` are already in the numbering to report.
+        # Every test is exact for the coordinates given: features are defects only where
+        # they truly meet, however close they come otherwise (closer than the tolerance,
+        # the classification decides them as touching). Nothing depends on where the
+        # origin is or on the unit.
+        signs = _check_loops(loops)
         for k, ring in enumerate(loops):
-            if _collinear(ring, eps):
-                raise InvalidShapeError(
-                    f"{_loop_name(k)}: zero area (all vertices on one line, within {spacing})"
-                )
-        _check_loops(loops, eps, spacing)
-        for k, ring in enumerate(loops):
-            area = _signed_area(ring)
-            if abs(area) <= eps * float(np.max(np.ptp(ring, axis=0))):
-                raise InvalidShapeError(
-                    f"{_loop_name(k)}: zero area ({area:.3g}: thinner than {spacing})"
-                )
-            if (k == 0) != (area > 0):
+            if (k == 0) != (signs[k] > 0):
                 loops[k] = ring[::-1].copy()
         if len(loops) > 1:
             _check_hole_placement(loops, loops if rings is None else rings)
         self._set(loops, repairs)
 
     def _init_repaired(self, vertices: ArrayLike, holes: Sequence[ArrayLike], why: str) -> None:
-        import shapely
+        from ._repair import repaired
+
+        def check(poly: Any) -> None:
+            _check_loops(_polygon_loops(poly))
 
         try:
-            raw = shapely.Polygon(
-                np.asarray(vertices, dtype=float), [np.asarray(h, dtype=float) for h in holes]
-            )
-        except Exception as exc:  # shapely refuses rings it cannot even build
+            rings = [np.asarray(r, dtype=float).reshape(-1, 2) for r in (vertices, *holes)]
+        except (TypeError, ValueError) as exc:
             raise InvalidShapeError(f"cannot repair: {why} ({exc})") from None
-        fixed = shapely.make_valid(raw, method="structure", keep_collapsed=False)
-        polys = [g for g in shapely.get_parts(fixed) if g.geom_type == "Polygon" and g.area > 0]
-        if len(polys) != 1:
-            raise InvalidShapeError(
-                f"cannot repair: {why}; shapely.make_valid gives {len(polys)} polygons, "
-                "not one"
-            )
-        poly = polys[0]
-        loops = [_clean_ring(np.asarray(poly.exterior.coords), "outer loop")]
-        loops += [
-            _clean_ring(np.asarray(r.coords), f"hole {i}") for i, r in enumerate(poly.interiors)
-        ]
-        lost = float(raw.area) - float(poly.area) if raw.is_valid else None
-        note = f"made valid with shapely.make_valid(method='structure') because {why}"
-        note += f"; now {sum(len(r) for r in loops)} vertices in {len(loops)} loop(s)"
-        if lost is not None:
-            note += f", area changed by {lost:g}"
-        self._init_from_loops(loops, repairs=(note,))
-        self._input = _repaired_maps(self, [vertices, *holes])
+        poly, grid, note = repaired(rings, why, check)
+        try:
+            loops = _polygon_loops(poly)
+            note += f"; now {sum(len(r) for r in loops)} vertices in {len(loops)} loop(s)"
+            raw_area = _valid_area(rings)
+            if raw_area is not None:
+                note += f", area changed by {raw_area - float(poly.area):g}"
+            self._init_from_loops(loops, repairs=(note,))
+        except InvalidShapeError as exc:
+            raise InvalidShapeError(f"cannot repair: {why}; the repaired polygon: {exc}") from None
+        self._input = _repaired_maps(self, rings, grid)
 
     # -- properties ---------------------------------------------------------------
     @property
@@ -479,9 +499,18 @@ class Shape:
         return self._loops
 
     def input_loop(self, loop: int) -> int | None:
-        """The caller's index of stored loop ``loop``: the same index (0 the outer loop,
-        1.. the holes in the order given), or None for a loop that ``repair=True`` made
-        and that holds none of the caller's vertices.
+        """The caller's index of a stored loop.
+
+        Parameters
+        ----------
+        loop : int
+            A stored loop (0 the outer loop, 1.. the holes).
+
+        Returns
+        -------
+        int or None
+            The same index (the holes are kept in the order given), or None for a loop
+            that ``repair=True`` made and that holds none of the caller's vertices.
 
         Examples
         --------
@@ -493,11 +522,21 @@ class Shape:
         return None if k < 0 else k
 
     def input_vertex(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored vertex ``i`` of loop ``loop``.
+        """The caller's index of a stored vertex.
 
-        That is its position in the vertices as passed (0-based, repeated and closing
-        points counted), whatever the stored orientation; None for a vertex that
-        ``repair=True`` created (where the repair cut an edge).
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            A vertex of that loop as stored (:attr:`loops`).
+
+        Returns
+        -------
+        int or None
+            Its position in the vertices as passed (0-based, repeated and closing points
+            counted), whatever the stored orientation; None for a vertex that
+            ``repair=True`` created (where the repair cut an edge).
 
         Examples
         --------
@@ -508,13 +547,22 @@ class Shape:
         return self._lookup(loop, i, 0)
 
     def input_edge(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored edge ``i`` of loop ``loop``.
+        """The caller's index of a stored edge.
 
-        Stored edge ``i`` joins stored vertices ``i`` and ``i + 1``; the answer ``k`` is
-        the caller's edge joining their vertices ``k`` and ``k + 1`` (mod the number of
-        vertices passed) that holds it: where repeated points were dropped, the one edge
-        of non-zero length between them. None for an edge that ``repair=True`` made and
-        that lies on no single edge of the caller's.
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            An edge of that loop as stored: it joins stored vertices ``i`` and ``i + 1``.
+
+        Returns
+        -------
+        int or None
+            The caller's edge ``k``, joining their vertices ``k`` and ``k + 1`` (mod the
+            number of vertices passed), that holds it: where repeated points were
+            dropped, the one edge of non-zero length between them. None for an edge
+            that ``repair=True`` made and that lies on no single edge of the caller's.
 
         Examples
         --------
@@ -572,11 +620,26 @@ class Shape:
 
     # -- rigid motions ------------------------------------------------------------
     def moved(self, translation: ArrayLike = (0.0, 0.0), angle: float = 0.0) -> Shape:
-        """This shape rotated by ``angle`` (radians, CCW) about its centroid, then translated.
+        """This shape rotated by ``angle`` about its centroid, then translated.
 
-        ``translation`` is two real numbers and ``angle`` one, finite (strings, booleans
-        and complex numbers raise ``TypeError``, other bad values ``ValueError``, naming
-        the argument), and the moved coordinates must stay within ±1e100.
+        Parameters
+        ----------
+        translation : (dx, dy), default (0, 0)
+            Two finite real numbers.
+        angle : float, default 0
+            Radians, counter-clockwise.
+
+        Returns
+        -------
+        Shape
+            The moved shape (numbered as this one).
+
+        Raises
+        ------
+        TypeError
+            Strings, booleans or complex numbers, naming the argument.
+        ValueError
+            Other bad values, or moved coordinates beyond ±1e100.
 
         Examples
         --------
@@ -599,7 +662,27 @@ class Shape:
             raise InvalidShapeError(f"translation: the moved {exc}") from None
 
     def at(self, motion: Motion, t: float) -> Shape:
-        """The shape placed by ``motion`` at time ``t`` (see :class:`polycontact.Motion`)."""
+        """The shape placed by a motion at a time.
+
+        Parameters
+        ----------
+        motion : Motion
+            How the shape moves about its area centroid from where it is.
+        t : float
+            The time.
+
+        Returns
+        -------
+        Shape
+            ``self.moved(*motion.pose(t))``.
+
+        Examples
+        --------
+        >>> from polycontact import Motion
+        >>> sq = Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+        >>> sq.at(Motion(velocity=(1, 0), acceleration=(0, 2)), 3.0).centroid.tolist()
+        [4.0, 10.0]
+        """
         if not isinstance(motion, Motion):
             raise TypeError(f"motion: expected a polycontact.Motion, got "
                             f"{type(motion).__name__}")
@@ -608,7 +691,7 @@ class Shape:
 
     # -- interchange ----------------------------------------------------------------
     @classmethod
-    def from_shapely(cls, geom: Any, *, repair: bool = False) -> Shape:
+    def from_shapely(cls, geom: BaseGeometry, *, repair: bool = False) -> Shape:
         """Shape from a shapely Polygon (or a MultiPolygon of exactly one part).
 
         Examples
@@ -627,13 +710,21 @@ class Shape:
             raise InvalidShapeError(f"expected one Polygon, got a {geom.geom_type}")
         if geom.is_empty:
             raise InvalidShapeError("the polygon is empty")
-        return cls(
-            np.asarray(geom.exterior.coords)[:, :2],
-            [np.asarray(r.coords)[:, :2] for r in geom.interiors],
-            repair=repair,
-        )
+        holes = [np.asarray(r.coords)[:, :2] for r in geom.interiors]
+        kept = [k for k, h in enumerate(holes) if len(h)]
+        shape = cls(np.asarray(geom.exterior.coords)[:, :2], [holes[k] for k in kept],
+                    repair=repair)
+        if len(kept) < len(holes):
+            # An empty interior ring (``POLYGON ((...), EMPTY)``) holds nothing (GEOS calls
+            # the polygon valid): it is left out, and the holes after it keep their numbers.
+            number = np.array([0] + [k + 1 for k in kept])
+            loops = shape._input[0]
+            object.__setattr__(shape, "_input", (
+                frozen_ints(np.where(loops < 0, -1, number[np.maximum(loops, 0)])),
+                shape._input[1]))
+        return shape
 
-    def to_shapely(self) -> Any:
+    def to_shapely(self) -> Polygon:
         """The shape as a ``shapely.Polygon``."""
         import shapely
 
@@ -688,7 +779,7 @@ class Shape:
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
 
-    def plot(self, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+    def plot(self, ax: Axes | None = None, *, numbers: bool = False, **style: Any) -> Axes:
         """Draw the shape (solid filled, holes open); returns the matplotlib Axes.
 
         Parameters
@@ -719,6 +810,21 @@ class Shape:
     def __repr__(self) -> str:
         holes = f", {len(self.holes)} hole(s)" if self.holes else ""
         return f"<Shape {len(self.exterior)} vertices{holes}, area {self._area:g}>"
+
+
+def _valid_area(rings: Sequence[np.ndarray]) -> float | None:
+    """The area of the loops as GEOS reads them, where GEOS calls them valid."""
+    import shapely
+
+    raw = shapely.Polygon(rings[0], rings[1:])
+    return float(raw.area) if raw.is_valid else None
+
+
+def _polygon_loops(poly: Any) -> list[np.ndarray]:
+    """The loops of a shapely Polygon, cleaned as :class:`Shape` cleans a caller's."""
+    loops = [_clean_ring(np.asarray(poly.exterior.coords), "outer loop")]
+    loops += [_clean_ring(np.asarray(r.coords), f"hole {i}") for i, r in enumerate(poly.interiors)]
+    return loops
 
 
 def _identity_map(starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -777,27 +883,36 @@ def _input_maps(
     return frozen_ints(np.arange(len(maps))), frozen_ints(np.concatenate(maps))
 
 
-def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
+class GeoInterface(Protocol):
+    """Anything with ``__geo_interface__`` (the Python geo interface)."""
+
+    @property
+    def __geo_interface__(self) -> Mapping[str, Any]: ...
+
+
+#: The type of a shape argument: every form :func:`as_shape` takes (WKT and JSON text
+#: are ``str``, WKB ``bytes``; Shapely geometries have ``__geo_interface__``).
+ShapeLike = Union[Shape, GeoInterface, Mapping[str, Any], npt.ArrayLike]
+
+
+def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike], grid: float) -> tuple[Any, ...]:
     """The map of a repaired shape to the caller's ``rings``.
 
     A stored loop belongs to the caller's loop that shares most of its vertices; a stored
-    vertex is the first caller's vertex of that loop at the same coordinates; a stored
-    edge is the caller's edge, next to a vertex at one of its ends, that holds both ends
-    within the tolerance. What the repair created maps to -1.
+    vertex is the first caller's vertex of that loop at the same coordinates (where the
+    repair snapped onto a grid of step ``grid`` > 0: the first within one step in x and
+    y, when none is at the same coordinates); a stored edge is the caller's edge, next to
+    a vertex at one of its ends, that holds both ends within the tolerance. What the
+    repair created maps to -1.
     """
     raws = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
-    where: list[dict[tuple[float, ...], list[int]]] = []
-    for raw in raws:
-        found: dict[tuple[float, ...], list[int]] = {}
-        for c, p in enumerate(map(tuple, raw.tolist())):
-            found.setdefault(p, []).append(c)
-        where.append(found)
+    where = [_VertexFinder(raw, grid) for raw in raws]
     eps = default_tolerance(*raws, shape.packed[0])
     loop_map = []
     rows = []
     for ring in shape.loops:
         pts = list(map(tuple, ring.tolist()))
-        hits = [sum(p in found for p in pts) for found in where]
+        hits = [sum(bool(found(p)) for p in pts) for found in where]
         k = int(np.argmax(hits)) if hits and max(hits) > 0 else -1
         loop_map.append(k)
         rows.append(np.full((len(ring), 2), -1, dtype=np.int64))
@@ -805,9 +920,9 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
             continue
         raw, found, n = raws[k], where[k], len(raws[k])
         for i, p in enumerate(pts):
-            rows[-1][i, 0] = found.get(p, [-1])[0]
+            rows[-1][i, 0] = (found(p) or [-1])[0]
             q = pts[(i + 1) % len(pts)]
-            near = {(c + d) % n for c in found.get(p, []) + found.get(q, []) for d in (-1, 0)}
+            near = {(c + d) % n for c in found(p) + found(q) for d in (-1, 0)}
             for c in sorted(near):
                 s, e = raw[c], raw[(c + 1) % n]
                 if np.any(s != e) and max(_to_segment(ring[i], s, e),
@@ -815,6 +930,34 @@ def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike]) -> tuple[Any, ...]:
                     rows[-1][i, 1] = c
                     break
     return frozen_ints(np.array(loop_map)), frozen_ints(np.concatenate(rows))
+
+
+class _VertexFinder:
+    """The caller's vertices of one ring at a point: those at its very coordinates, or
+    (with a ``grid`` step > 0, when there are none) those within one step of it in x
+    and y, in the caller's order."""
+
+    def __init__(self, raw: np.ndarray, grid: float) -> None:
+        self._raw = raw
+        self._grid = grid
+        self._exact: dict[tuple[float, ...], list[int]] = {}
+        self._cells: dict[tuple[int, int], list[int]] = {}
+        for c, p in enumerate(map(tuple, raw.tolist())):
+            self._exact.setdefault(p, []).append(c)
+            if grid > 0.0:
+                self._cells.setdefault(self._cell(p), []).append(c)
+
+    def _cell(self, p: tuple[float, ...]) -> tuple[int, int]:
+        return math.floor(p[0] / self._grid), math.floor(p[1] / self._grid)
+
+    def __call__(self, p: tuple[float, ...]) -> list[int]:
+        if p in self._exact or self._grid == 0.0:
+            return self._exact.get(p, [])
+        cx, cy = self._cell(p)
+        near = [c for dx in (-1, 0, 1) for dy in (-1, 0, 1)
+                for c in self._cells.get((cx + dx, cy + dy), [])
+                if max(abs(self._raw[c, 0] - p[0]), abs(self._raw[c, 1] - p[1])) <= self._grid]
+        return sorted(near)
 
 
 def _to_segment(p: np.ndarray, s: np.ndarray, e: np.ndarray) -> float:
@@ -836,7 +979,7 @@ def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndar
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
     patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
     state kernel: one object to unbox per shape, immutable and holding its data in
-    itself (about 2 us per shape)."""
+    itself."""
     return np.concatenate(
         ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
     ).tobytes()
@@ -850,51 +993,19 @@ def _bound(obj: Any, name: str) -> bool:
     return True
 
 
-def _point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-    d = b - a
-    den = float(d @ d)
-    t = min(1.0, max(0.0, float((p - a) @ d) / den)) if den > 0.0 else 0.0
-    return float(np.hypot(*(p - (a + t * d))))
-
-
-def _closest_features(loop: np.ndarray, ei: int, ej: int) -> tuple[float, int, int]:
-    """``(distance, vertex, edge)``: of the ends of edges ``ei`` and ``ej`` of one loop
-    (their shared vertex, if any, left out), the one nearest the other edge; distance 0
-    when the edges cross. For messages: how far apart the features that met are."""
-    n = len(loop)
-
-    def orient(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> float:
-        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
-
-    a, b = loop[ei], loop[(ei + 1) % n]
-    c, d = loop[ej], loop[(ej + 1) % n]
-    if orient(a, b, c) * orient(a, b, d) < 0.0 and orient(c, d, a) * orient(c, d, b) < 0.0:
-        return 0.0, ei, ej
-    ends_i = {ei, (ei + 1) % n}
-    ends_j = {ej, (ej + 1) % n}
-    shared = ends_i & ends_j
-    best = (np.inf, -1, -1)
-    for v, e in [(v, ej) for v in ends_i - shared] + [(v, ei) for v in ends_j - shared]:
-        p, q = loop[e], loop[(e + 1) % n]
-        best = min(best, (_point_segment(loop[v], p, q), v, e))
-    return best
-
-
-def _check_loops(loops: list[np.ndarray], eps: float, spacing: str) -> None:
+def _check_loops(loops: list[np.ndarray]) -> np.ndarray:
+    """Refuse loops that are not a valid polygon's (exactly: see
+    :mod:`polycontact._kernels.validate`); returns each loop's orientation (1
+    counter-clockwise, -1 clockwise)."""
     from ._kernels import validate as kv
 
     xy = np.ascontiguousarray(np.concatenate(loops))
     starts = np.zeros(len(loops) + 1, dtype=np.int64)
     starts[1:] = np.cumsum([len(r) for r in loops])
-    code, ki, ei, kj, ej, x, y = kv.first_defect(xy, starts, eps)
+    code, ki, ei, kj, ej, x, y = kv.first_defect(xy, starts)
     at = f"({_fmt(x)}, {_fmt(y)})"
-    if code in (kv.SELF_INTERSECTION, kv.SPIKE):
-        apart, v, e = _closest_features(loops[ki], ei, ej)
-        if apart > 0.0:
-            raise InvalidShapeError(
-                f"{_loop_name(ki)}: vertex {v} is {apart:.3g} from edge {e} (near {at}): "
-                f"closer than float64 can tell apart, below {spacing}"
-            )
+    if code == kv.ZERO_AREA:
+        raise InvalidShapeError(f"{_loop_name(ki)}: zero area (all vertices on one line)")
     if code == kv.SELF_INTERSECTION:
         raise InvalidShapeError(
             f"{_loop_name(ki)}: self-intersection at {at} between edge {ei} and edge {ej}"
@@ -909,15 +1020,42 @@ def _check_loops(loops: list[np.ndarray], eps: float, spacing: str) -> None:
             f"{_loop_name(kj)} crosses {'the ' if ki == 0 else ''}{_loop_name(ki)} at {at} "
             f"(edge {ej} of {_loop_name(kj)}, edge {ei} of {_loop_name(ki)})"
         )
+    return np.asarray(kv.loop_signs(xy, starts))
 
 
-def _collinear(ring: np.ndarray, eps: float) -> bool:
-    """All vertices within eps of the line through vertex 0 and the vertex farthest from it
-    (a length compared with a length)."""
-    d = ring - ring[0]
-    far = int(np.argmax(np.hypot(d[:, 0], d[:, 1])))
-    u = d[far] / np.hypot(*d[far])
-    return bool(np.all(np.abs(d[:, 0] * u[1] - d[:, 1] * u[0]) <= eps))
+def _area_clear(a2: float, x: np.ndarray, y: np.ndarray, nxt: np.ndarray,
+                span: np.ndarray) -> bool:
+    """Whether twice the area ``a2``, summed in floats from ``x``, ``y`` (coordinates less
+    the first vertex's, which rounds them by 2**-53 of themselves) over the edges
+    i -> ``nxt[i]``, is positive beyond its rounding: (n + 8) × 2**-52 × the sum of the
+    products' magnitudes, bounded first by the bounding box's sides ``span`` (two
+    multiplications), then, where that is not enough, summed."""
+    n = len(x)
+    unit = (n + 8) * 2.0**-52
+    cheap = unit * 2.0 * n * float(span[0]) * float(span[1])
+    if a2 > cheap:
+        return True
+    if cheap < 2.0**-1000:
+        return False  # (products near underflow: the exact sums decide)
+    return a2 > unit * float(np.abs(x * y[nxt]).sum() + np.abs(x[nxt] * y).sum())
+
+
+def _exact_area_centroid(xy: np.ndarray, nxt: np.ndarray) -> tuple[float, list[float]]:
+    """Twice the area and the centroid of packed loops (edges i -> ``nxt[i]``), summed
+    in exact rationals and rounded once: for slivers, whose float sums round to noise."""
+    from fractions import Fraction
+
+    pts = [(Fraction(a), Fraction(b)) for a, b in xy.tolist()]
+    a2 = sx = sy = Fraction(0)
+    for i, j in enumerate(nxt.tolist()):
+        (xi, yi), (xj, yj) = pts[i], pts[j]
+        c = xi * yj - xj * yi
+        a2 += c
+        sx += (xi + xj) * c
+        sy += (yi + yj) * c
+    if a2 <= 0:
+        return 0.0, [np.nan, np.nan]
+    return float(a2), [float(sx / (3 * a2)), float(sy / (3 * a2))]
 
 
 def _check_hole_placement(loops: list[np.ndarray], rings: Sequence[ArrayLike]) -> None:

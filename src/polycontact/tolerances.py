@@ -15,9 +15,11 @@ compared with ``eps``; areas with ``eps * length``. The same formula is compiled
 the kernels (:mod:`polycontact._kernels.tolerance`), so every path gives a pair the
 same tolerance.
 
-A polygon's own validity is judged on a finer scale: two of its features meet only
-when float64 cannot tell them apart (:func:`validation_tolerance`, 4 float spacings of
-its largest coordinate), so every polygon GEOS calls valid is accepted, at any scale.
+A polygon's own validity is judged with no tolerance at all: exactly, for the float64
+coordinates given (exact orientations, :class:`polycontact.Shape`). Two of its features
+make it invalid only when they truly meet, however close they come otherwise, so every
+polygon GEOS calls valid is accepted, at any scale and position; features of one body
+closer than ``eps`` are then decided as touching, like features of two bodies.
 
 Coordinates must lie in ``[-COORDINATE_LIMIT, COORDINATE_LIMIT]`` and every body must
 be larger than ``EXTENT_FLOOR``: the kernels form products of up to three coordinate
@@ -36,17 +38,14 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import InvalidShapeError
-from .limits import (COORDINATE_LIMIT, EXTENT_FLOOR, RELATIVE_TOLERANCE, ROUNDING_ULPS,
-                     VALIDATION_ULPS)
+from .limits import COORDINATE_LIMIT, EXTENT_FLOOR, RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = [
     "RELATIVE_TOLERANCE",
     "ROUNDING_ULPS",
     "COORDINATE_LIMIT",
     "EXTENT_FLOOR",
-    "VALIDATION_ULPS",
     "tolerance_for",
-    "validation_tolerance",
     "default_tolerance",
     "check_range",
     "snap_grid",
@@ -76,26 +75,21 @@ def tolerance_for(extent: float, magnitude: float) -> float:
     return max(RELATIVE_TOLERANCE * extent, ROUNDING_ULPS * _ULP * magnitude)
 
 
-def validation_tolerance(magnitude: float) -> float:
-    """Distance below which two features of one polygon whose coordinates reach
-    ``magnitude`` cannot be told apart in float64: ``VALIDATION_ULPS * 2**-52 *
-    magnitude``.
-
-    Examples
-    --------
-    >>> round(validation_tolerance(1e9) / 1e-7, 3)    # 4 float spacings at 1e9
-    8.882
-    """
-    return VALIDATION_ULPS * _ULP * magnitude
-
-
 def default_tolerance(*bodies: np.ndarray) -> float:
     """The absolute tolerance used when the caller gives none.
 
-    Each argument is the (N, 2) coordinate array of one body (or one loop of it):
-    ``extent`` is the largest side of any argument's own bounding box, so two unit
-    bodies far apart keep a tolerance of their size, and ``magnitude`` the largest
-    absolute coordinate of all. See :func:`tolerance_for`.
+    Parameters
+    ----------
+    *bodies : ndarray of shape (N, 2)
+        The coordinates of each body (or of one loop of it): ``extent`` is the largest
+        side of any argument's own bounding box, so two unit bodies far apart keep a
+        tolerance of their size, and ``magnitude`` the largest absolute coordinate of
+        all.
+
+    Returns
+    -------
+    float
+        :func:`tolerance_for` of that extent and magnitude.
 
     Examples
     --------

@@ -61,9 +61,9 @@ def raw_states(xa, xb, tol, rel, ulps, limit, floor, out):
 
     ``out`` is the tuple of arrays ``(states, eps, used_a, sign_a, used_b, sign_b)``
     (P each; int8, float64, int64, float64, int64, float64), written and returned: per
-    pair the state (-1 when either ring is not valid as given), the tolerance, and per
-    ring the vertices used (a repeated closing point dropped; -1 if invalid) and the
-    orientation sign (see :func:`polycontact._kernels.rings.raw_ring`). ``tol`` < 0
+    pair the state (-1 when either ring is not certified valid as given), the tolerance,
+    and per ring the vertices used (a repeated closing point dropped; -1 if not
+    certified) and the orientation sign (see :func:`polycontact._kernels.rings.raw_ring`). ``tol`` < 0
     means per pair the default tolerance
     (:func:`polycontact._kernels.rings.pair_tolerance` with ``rel`` and ``ulps``);
     ``limit`` and ``floor`` bound the coordinates and extents accepted.

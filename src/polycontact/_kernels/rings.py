@@ -1,10 +1,15 @@
 """Kernels: raw rings checked and classified in one call, without a Shape.
 
 A raw ring is an (N, 2) array, closed or not, either orientation. :func:`raw_ring`
-says whether it is a valid simple polygon within the coordinates the kernels carry (the
-rules of :func:`polycontact._kernels.validate.first_defect` for one loop), with its
-orientation, default tolerance and box: convex and most star-shaped rings are certified
-in O(n) (:func:`_star_ring_is_simple`), short ones pair by pair, long ones by a sweep.
+certifies that it is a valid simple polygon within the coordinates the kernels carry,
+with its orientation, default tolerance and box: convex and most star-shaped rings are
+certified in O(n) (:func:`_star_ring_is_simple`), short ones pair by pair, long ones by
+a sweep. The certificate is conservative: a ring passes only when no two of its
+features that may not meet come within its tolerance eps (at least 64 float spacings
+of its coordinates, far above the rounding of the tests), so it is valid by the exact
+rules of :func:`polycontact._kernels.validate.first_defect` too. A ring that fails
+(invalid, or valid with features closer than eps) is left to
+:class:`polycontact.Shape`, which decides exactly and explains.
 :func:`classify_raw` validates two rings and classifies them.
 """
 
@@ -156,11 +161,11 @@ def ring_is_simple_unswept(xy, n, eps):
 
 @njit(cache=True, nogil=True)
 def _ring_is_simple(xy, n, eps):
-    """No two edges of the ring meet except consecutive ones at their shared vertex,
-    and no two consecutive edges fold back: the rules of ``validate.first_defect`` for
-    one loop. Rings certified by :func:`_star_ring_is_simple` (convex ones, and most
-    star-shaped ones) pass in O(n); other short rings test every pair, long ones sweep
-    edges sorted by xmin."""
+    """No two edges of the ring come within eps of each other except consecutive ones
+    at their shared vertex, and no two consecutive edges fold back within eps: the rules
+    of ``validate.first_defect`` for one loop, with a margin of eps. Rings certified by
+    :func:`_star_ring_is_simple` (convex ones, and most star-shaped ones) pass in O(n);
+    other short rings test every pair, long ones sweep edges sorted by xmin."""
     known = ring_is_simple_unswept(xy, n, eps)
     if known >= 0:
         return known == 1
@@ -191,10 +196,11 @@ def raw_ring(xy, rel, ulps, limit, floor):
     """Check one raw (N, 2) ring; returns ``(n, sign, eps, box)``.
 
     ``n`` is the number of vertices used (a repeated closing point dropped), or -1 when
-    the ring is not a valid simple polygon as given, or lies outside the range the
-    kernels carry (|coordinate| above ``limit``, extent below ``floor``; the caller then
-    lets :class:`polycontact.Shape` explain or repair); ``sign`` is +1.0
-    counter-clockwise, -1.0 clockwise; ``eps`` the ring's own default tolerance
+    the ring is not certified a valid simple polygon as given (see the module's
+    docstring: it may be valid with features closer than eps), or lies outside the
+    range the kernels carry (|coordinate| above ``limit``, extent below ``floor``; the
+    caller then lets :class:`polycontact.Shape` decide, explain or repair); ``sign`` is
+    +1.0 counter-clockwise, -1.0 clockwise; ``eps`` the ring's own default tolerance
     (:func:`polycontact._kernels.tolerance.tolerance_for` of its extent and largest
     |coordinate|, with ``rel`` and ``ulps``); ``box`` the bounding box
     ``(xmin, xmax, ymin, ymax)``.

@@ -1,0 +1,125 @@
+"""Repairs of invalid polygons (``Shape(..., repair=True)``).
+
+GEOS's ``make_valid(method="structure")`` reads the loops' linework as a polygon. Its
+result is kept only when it is one polygon, valid exactly (the caller's check) and
+within the tolerance of the input's linework. Where it is not:
+
+- GEOS's floating overlay can fall back on snapping when its arithmetic fails, and
+  then moves nodes by about 1e-12 of the coordinates, beyond the tolerance: the loops
+  are then read as ``make_valid`` reads them from GEOS's noding (``shapely.node``, whose
+  nodes are within a few float spacings) and ``shapely.build_area``, holes cut on the
+  grid of :func:`polycontact.tolerances.snap_grid` (a power of two below 1/256 of the
+  tolerance), where GEOS's overlay is exact;
+- GEOS's result can still meet itself exactly where GEOS's arithmetic does not see it
+  (a vertex exactly on an edge that GEOS finds a float spacing away): it is then
+  snap-rounded onto that grid, which moves each vertex by less than a grid step.
+
+Every vertex of a repaired shape lies within the tolerance of the input's linework.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidShapeError
+from .tolerances import default_tolerance, snap_grid
+
+
+def repaired(rings: Sequence[np.ndarray], why: str,
+             check: Callable[[Any], None]) -> tuple[Any, float, str]:
+    """``(polygon, grid, note)``: the repair of the loops ``rings`` (float64 (N, 2)
+    arrays, outer loop first) refused because ``why``.
+
+    ``check`` raises :class:`InvalidShapeError` for a shapely polygon that is not valid
+    exactly. ``grid`` is the step the result was snapped onto (0.0 if it was not);
+    ``note`` says what was done and why. Raises :class:`InvalidShapeError` ("cannot
+    repair: ...") when the repair is not one polygon, or not within the tolerance.
+    """
+    import shapely
+
+    try:
+        raw = shapely.Polygon(rings[0], rings[1:])
+    except shapely.errors.ShapelyError as exc:  # rings shapely cannot even build
+        raise InvalidShapeError(f"cannot repair: {why} ({exc})") from None
+    eps = default_tolerance(*rings)
+    grid = snap_grid(eps) if eps > 0.0 else 0.0  # (0: a ring of one point at the origin)
+    lines = shapely.multilinestrings([np.vstack([r, r[:1]]) for r in rings if len(r)])
+    poly = _one_polygon(shapely.make_valid(raw, method="structure", keep_collapsed=False),
+                        why, "shapely.make_valid")
+    note = f"made valid with shapely.make_valid(method='structure') because {why}"
+    snapped = False
+    off = _farthest(poly, lines)
+    if off > eps - grid:
+        poly, snapped = _structure(rings, grid, why)
+        note = (f"made valid as shapely.make_valid(method='structure') does, from GEOS's "
+                f"noding of the loops (shapely.node, shapely.build_area), because {why} "
+                f"(shapely.make_valid itself moved the outline by {off:.3g}, beyond the "
+                f"tolerance {eps:.3g})")
+    try:
+        check(poly)
+    except InvalidShapeError as exc:
+        poly = _one_polygon(_snap(poly, grid, why), why, f"snapping onto a grid of {grid:.3g}")
+        note += (f"; then snapped onto a grid of {grid:.3g} (each vertex moved by at most "
+                 f"{grid * 0.5**0.5:.3g}, far below the tolerance) because {exc}")
+        snapped = True
+        try:
+            check(poly)
+        except InvalidShapeError as err:
+            raise InvalidShapeError(f"cannot repair: {why}; snapped: {err}") from None
+    off = _farthest(poly, lines)
+    if off > eps:
+        raise InvalidShapeError(f"cannot repair: {why}; the repair moves the outline by "
+                                f"{off:.3g}, beyond the tolerance {eps:.3g}")
+    return poly, grid if snapped else 0.0, note
+
+
+def _structure(rings: Sequence[np.ndarray], grid: float, why: str) -> tuple[Any, bool]:
+    """``(polygon, snapped)``: the loops read as ``make_valid(method="structure")`` reads
+    them (each loop's area by the even-odd rule of its noded linework; the holes' union
+    cut from the outer loop's), from GEOS's noding, which computes its nodes to a few
+    float spacings. The cut is snap-rounded onto the grid (``snapped``), where GEOS's
+    overlay is exact."""
+    import shapely
+
+    try:
+        areas = [shapely.build_area(shapely.node(shapely.linearrings(r))) for r in rings]
+        if len(areas) == 1:
+            return _one_polygon(areas[0], why, "the even-odd area of the loop"), False
+        cut = shapely.difference(areas[0], shapely.union_all(areas[1:], grid_size=grid),
+                                 grid_size=grid)
+    except shapely.errors.ShapelyError as exc:
+        raise InvalidShapeError(f"cannot repair: {why} ({exc})") from None
+    return _one_polygon(cut, why, "the outer loop's area less the holes'"), True
+
+
+def _one_polygon(geom: Any, why: str, how: str) -> Any:
+    """The one polygon of positive area in a repair's result ``geom`` (made by
+    ``how``); refuses others."""
+    import shapely
+
+    polys = [g for g in shapely.get_parts(geom) if g.geom_type == "Polygon" and g.area > 0]
+    if len(polys) != 1:
+        raise InvalidShapeError(f"cannot repair: {why}; {how} gives {len(polys)} polygons, "
+                                "not one")
+    return polys[0]
+
+
+def _snap(geom: Any, grid: float, why: str) -> Any:
+    """``geom`` snap-rounded onto a grid of step ``grid``, valid for GEOS."""
+    import shapely
+
+    try:
+        return shapely.set_precision(geom, grid)
+    except shapely.errors.GEOSException as exc:
+        raise InvalidShapeError(f"cannot repair: {why}; snapping onto a grid of {grid:.3g}, "
+                                f"GEOS fails: {exc}") from None
+
+
+def _farthest(poly: Any, lines: Any) -> float:
+    """The largest distance from a vertex of ``poly`` to the input's linework."""
+    import shapely
+
+    return float(shapely.distance(shapely.points(shapely.get_coordinates(poly)), lines).max())
