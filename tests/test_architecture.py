@@ -19,6 +19,10 @@ Rules:
    (``_checks``, ``_kernels``) may be imported: its underscore keeps it private to the
    package, and the names in it are what it offers to the package. Dunder names
    (``__version__``) are not private.
+4. Kernels are decorated with ``polycontact._kernels.jit.njit`` (Numba's ``njit``,
+   compiling one specialisation per kernel for read-only and writable arrays,
+   constants and variables), never Numba's own: no kernel module takes ``njit`` or
+   ``jit`` from ``numba``.
 """
 
 from __future__ import annotations
@@ -185,6 +189,18 @@ def test_no_private_name_is_imported_across_modules():
                     and node.value.id in aliases and _private(node.attr)):
                 wrong.append(f"{module}:{node.lineno} reads {node.attr} of "
                              f"{aliases[node.value.id]}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_kernels_take_njit_from_the_kernels_decorator_module():
+    wrong = []
+    for module in MODULES:
+        if not module.startswith(f"{KERNELS}.") or module == f"{KERNELS}.jit":
+            continue
+        for imp in _imports(module):
+            if imp.module.partition(".")[0] == "numba" and imp.name in ("njit", "jit"):
+                wrong.append(f"{module}:{imp.line} takes {imp.name} from numba: "
+                             f"take njit from {KERNELS}.jit")
     assert not wrong, "\n".join(wrong)
 
 

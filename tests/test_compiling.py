@@ -19,6 +19,8 @@ from polycontact import compiling
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 PACKAGE = Path(polycontact.__file__).resolve().parent
+#: The start of the notice of a compile.
+NOTICE = "polycontact is compiling the kernels this call needs"
 
 
 def _run(args: list[str], env: dict[str, str]) -> subprocess.CompletedProcess:
@@ -52,38 +54,97 @@ def test_numba_cache_dir_overrides_the_location(tmp_path):
     assert Path(out.stdout.strip()) == tmp_path
 
 
+@pytest.mark.slow
 def test_cold_cache_notice_goes_to_stderr_and_json_stays_parseable(tmp_path):
-    """A real first run: a fresh cache compiles the classification kernels (tens of
-    seconds), says so on stderr with one line per family, and stdout is the JSON alone."""
+    """A real first run: a fresh cache compiles the classification kernels the command
+    runs (seconds to tens of seconds), says so once on stderr, and stdout is the JSON
+    alone; the second run compiles nothing and says nothing."""
     out = _run(
         [sys.executable, "-m", "polycontact", "classify", str(EXAMPLES / "body-ell.json"),
          str(EXAMPLES / "body-frame.json"), "--json"],
-        {"NUMBA_CACHE_DIR": str(tmp_path)},
+        {"NUMBA_CACHE_DIR": str(tmp_path), "POLYCONTACT_NOTICE_AFTER": "inf"},
     )
     assert out.returncode == 0, out.stderr
-    assert "compiling kernels, first run only, about a minute" in out.stderr
-    assert "[1/1] classification" in out.stderr
+    assert out.stderr.count(NOTICE) == 1, out.stderr
     assert "compiling" not in out.stdout
     assert json.loads(out.stdout)["state"] == "contact"
     again = _run(
         [sys.executable, "-m", "polycontact", "classify", str(EXAMPLES / "body-ell.json"),
          str(EXAMPLES / "body-frame.json"), "--json"],
-        {"NUMBA_CACHE_DIR": str(tmp_path)},
+        {"NUMBA_CACHE_DIR": str(tmp_path), "POLYCONTACT_NOTICE_AFTER": "inf"},
     )
     assert again.returncode == 0 and again.stderr == ""
     assert json.loads(again.stdout) == json.loads(out.stdout)
 
 
-def test_warmup_command_reports_every_family(tmp_path):
+#: Two small kernels: compiling them is quick.
+SMALL_KERNELS = (
+    "from polycontact._kernels.advance import traversal_stack\n"
+    "from polycontact._kernels.packs import scratch_floats\n"
+    "traversal_stack()\n"
+    "scratch_floats(24)\n"
+)
+
+
+def test_a_call_that_compiles_says_so_once_and_logging_silences_it(tmp_path):
+    out = _run([sys.executable, "-c", SMALL_KERNELS], {"NUMBA_CACHE_DIR": str(tmp_path / "a")})
+    assert out.returncode == 0, out.stderr
+    assert out.stderr.count(NOTICE) == 1, out.stderr
+    assert str(tmp_path / "a") in out.stderr  # where the compiled kernels go
+    silenced = _run([sys.executable, "-c", "import logging\n"
+                     "logging.getLogger('polycontact').setLevel(logging.ERROR)\n"
+                     + SMALL_KERNELS], {"NUMBA_CACHE_DIR": str(tmp_path / "b")})
+    assert silenced.returncode == 0 and silenced.stderr == "", silenced.stderr
+    # loaded from the cache: nothing to say
+    again = _run([sys.executable, "-c", SMALL_KERNELS], {"NUMBA_CACHE_DIR": str(tmp_path / "a")})
+    assert again.returncode == 0 and again.stderr == "", again.stderr
+
+
+def test_installs_of_the_same_sources_in_two_places_share_the_compiled_kernels(tmp_path):
+    # (as an editable install and a regular one of the same release do)
+    import shutil
+
+    code = "import polycontact\nprint(polycontact.__file__)\n" + SMALL_KERNELS
+    cache = {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    for k, place in enumerate(("first", "second")):
+        shutil.copytree(PACKAGE, tmp_path / place / "polycontact",
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        out = _run([sys.executable, "-c", code], {**cache, "PYTHONPATH": str(tmp_path / place)})
+        assert out.returncode == 0, out.stderr
+        assert out.stdout.startswith(str(tmp_path / place))
+        assert out.stderr.count(NOTICE) == (1 if k == 0 else 0), out.stderr
+
+
+@pytest.mark.parametrize("processes", ["1", "2"])
+def test_warmup_command_reports_every_family(tmp_path, processes):
     # Without the JIT the "compilation" is instant; the reporting is the same.
-    out = _run([sys.executable, "-m", "polycontact", "warmup"],
+    out = _run([sys.executable, "-m", "polycontact", "warmup", "--processes", processes],
                {"NUMBA_CACHE_DIR": str(tmp_path), "NUMBA_DISABLE_JIT": "1"})
     assert out.returncode == 0, out.stderr
     for k, family in enumerate(compiling.FAMILIES, 1):
-        assert f"[{k}/{len(compiling.FAMILIES)}] {family}" in out.stderr
+        assert f"[{k}/{len(compiling.FAMILIES)}] {family} ... " in out.stderr
     assert out.stdout.startswith("kernels ready in")
 
 
+def test_warmup_workers_number_their_functions_apart_from_other_processes():
+    # two processes that compile into one cache must not give one name to different
+    # functions (numba/numba#10486): a worker's numbers start at its process id * 2**20
+    code = ("import os\n"
+            "from numba.core.bytecode import FunctionIdentity\n"
+            "from polycontact import compiling\n"
+            "compiling._worker_start()\n"
+            "print(next(FunctionIdentity._unique_ids) - (os.getpid() << 20))\n")
+    out = _run([sys.executable, "-c", code], {})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "0"
+
+
+def test_warmup_refuses_a_number_of_processes_below_one():
+    with pytest.raises(ValueError, match="processes: expected an int >= 1"):
+        compiling.warmup(["classification"], processes=0)
+
+
+@pytest.mark.slow
 def test_a_family_warmed_up_alone_is_warm(tmp_path):
     # is_warm reads the cache index of the kernels each family lists: they must be the
     # kernels the family's own functions compile (an entry point renamed or no longer

@@ -15,6 +15,8 @@ from polycontact.esicup import turned
 
 distributed = pytest.importorskip("distributed")
 
+pytestmark = pytest.mark.slow  # a cluster of worker processes
+
 SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
 ELL = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
 U = [[0, 0], [3, 0], [3, 3], [2, 3], [2, 1], [1, 1], [1, 3], [0, 3]]

@@ -39,6 +39,7 @@ print(got == [1] * 50 + [2] * 50 + [0] * 50)
 """
 
 
+@pytest.mark.slow  # compiles from an empty cache
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="compiled code only")
 def test_scratch_views_compiled_first_from_a_kernel_without_reference_counting(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}

@@ -30,8 +30,9 @@ needs it.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .convolution import DEPTH_MORE_ROWS, DEPTH_UNDECIDED, FEW_VERTICES, contact_depth_of, \
     depth_buffers
 from .depth import box_escape

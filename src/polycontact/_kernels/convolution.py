@@ -37,8 +37,8 @@ takes :func:`polycontact._kernels.depth.depth_from_pieces`.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .packs import scratch_floats, state_scratch_views
 from .primitives import (bbox, edge_rows, grow_rows, loop_prev, norm, origin_distance_sq,
                          origin_foot)

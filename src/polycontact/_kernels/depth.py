@@ -36,8 +36,9 @@ bodies to decompose once (see :func:`polycontact._depth.penetrations`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .cells import segment_grid
 from .convolution import FEW_VERTICES, contact_depth, penetrates
 from .decompose import ring_pieces

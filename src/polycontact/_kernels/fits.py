@@ -12,8 +12,8 @@ overlapping.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .cells import listed, polygon_grid, segment_cells, segment_grid
 from .minkowski import GRID_MIN_SUMS, in_some_listed
 from .primitives import append_part

@@ -23,8 +23,8 @@ Status codes returned by the searches (see :class:`polycontact.ImpactStatus`):
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .advance import STACK_SIZE, edge_table, line_time, pair_step, window_kinematics
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
 from .packs import scratch_floats, state_scratch_views, vector, view

@@ -10,7 +10,8 @@ sorted by x, and a grid whose cells remember the sums that contain them whole).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 from .cells import in_grid, polygon_grid, segment_cells
 from .reduced import admits, piece_cones

@@ -11,8 +11,8 @@ are ``int(E) \\ O`` (:mod:`polycontact._kernels.fits`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .decompose import ring_pieces
 from .fits import degenerate_contacts, exact_candidates
 from .minkowski import boxes, clip_tests, convex_sums, frames, mark_inner

@@ -19,8 +19,8 @@ nl[s]]`` and end at ``ls[lo[s] + nl[s]]``.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .fits import touching_contacts
 from .nfp import ring_entrance
 from .tolerance import tolerance_for

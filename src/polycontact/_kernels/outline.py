@@ -11,8 +11,8 @@ change nothing.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .minkowski import EDGE, GRID, clip_edge, sum_index
 from .primitives import append_part, closest_on_segment
 

@@ -28,8 +28,8 @@ are classified by the tolerance, an error of at most ``eps`` times their length.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import bbox, edge_rows, loop_next, orient, point_segment_distance
 
 

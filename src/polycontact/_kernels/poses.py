@@ -19,8 +19,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .tolerance import box_extent_magnitude, tolerance_for
 
 #: NumPy's pairwise summation: runs of up to this many terms are summed in 8 lanes.

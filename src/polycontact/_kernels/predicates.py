@@ -27,7 +27,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 _EPS = 2.0**-53
 #: Shewchuk's bound on the rounding of the filtered determinant (relative to the sum

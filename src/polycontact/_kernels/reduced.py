@@ -24,7 +24,8 @@ keeping an edge in excess only costs time.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 #: Slack (a sine) of the cone test: a direction within this angle outside a vertex's
 #: turning cone, or a vertex this close to straight, is kept (rounding of the edge

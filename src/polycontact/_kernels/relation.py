@@ -21,8 +21,8 @@ common bounding box, so the cost is O((m + n) log(m + n) + pairs whose boxes mee
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .cones import cones_overlap, pair_point
 from .packs import (STACK_FLOATS, STACK_VERTICES, stack_floats, state_scratch, state_scratch_views,
                     unpack_shape)

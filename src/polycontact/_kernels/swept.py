@@ -21,8 +21,8 @@ Batched search. :func:`impacts_chunk` runs, for a list of pairs, exactly what
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .impact import exact_query, sampled_query, unpack_body, work_floats
 
 

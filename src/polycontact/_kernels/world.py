@@ -30,8 +30,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .packs import state_scratch
 from .primitives import bbox
 from .relation import state_in

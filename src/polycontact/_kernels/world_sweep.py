@@ -26,8 +26,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .advance import edge_table
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
