@@ -595,8 +595,9 @@ def _compute(pieces: _Pieces, pairs: np.ndarray, reference: str) -> tuple[Packed
     :func:`polycontact.no_fit_polygon`, which gives the same answers. Returns the
     packed entries and the seconds spent on those (holding the GIL)."""
     from ._kernels.nfp_batch import nfp_pairs
+    from . import limits
     from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
-                         MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
+                         RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
 
     pairs = np.ascontiguousarray(pairs, dtype=np.int64)
     if pieces.centroids is None:
@@ -604,7 +605,8 @@ def _compute(pieces: _Pieces, pairs: np.ndarray, reference: str) -> tuple[Packed
     else:
         refs = np.ascontiguousarray(pieces.centroids[pairs[:, 0]])
     settings = (RELATIVE_TOLERANCE, ROUNDING_ULPS, ANGLE_TOLERANCE, SNAP_FACTOR,
-                HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX, MAX_SUM_VERTICES, reference == "origin")
+                HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX, limits.MAX_SUM_VERTICES, limits.MAX_CLIP_TESTS,
+                reference == "origin")
     blob, wkb_ends, fits, fit_ends, slides, slide_ends, tols, flagged = nfp_pairs(
         (pieces.xy, pieces.ls, pieces.lo, pieces.nl, pieces.magnitude, pieces.extent),
         pairs, refs, settings)

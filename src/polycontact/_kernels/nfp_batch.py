@@ -82,7 +82,7 @@ def nfp_pairs(shapes, pairs, refs, settings):
     ``shapes`` = ``(xy, ls, lo, nl, magnitude, extent)`` (the packing of the module's
     docstring, and each shape's largest |coordinate| and the larger side of its box);
     ``settings`` = ``(rel_tol, ulps, ang_tol, snap_f, near_f, max_ear, max_sum,
-    check_reference)``: the arguments of ``ring_entrance`` and whether the references
+    max_tests, check_reference)``: the arguments of ``ring_entrance`` and whether the references
     are the origin, refused (flagged) as ``polycontact.nfp`` refuses them when float64
     cannot tell the region's features apart there.
 
@@ -92,7 +92,8 @@ def nfp_pairs(shapes, pairs, refs, settings):
     and the indices k of the pairs left to the caller (nothing written for them).
     """
     xy, ls, lo, nl, magnitude, extent = shapes
-    rel_tol, ulps, ang_tol, snap_f, near_f, max_ear, max_sum, check_reference = settings
+    rel_tol, ulps, ang_tol, snap_f, near_f, max_ear, max_sum, max_tests, check_reference = (
+        settings)
     count = pairs.shape[0]
     blob = np.empty(count * 256, np.uint8)
     wkb_ends = np.empty(count, np.int64)
@@ -113,7 +114,7 @@ def nfp_pairs(shapes, pairs, refs, settings):
         ay = refs[k, 1]
         xa, sa = _ring(xy, ls, lo, a)
         xb, sb = _ring(xy, ls, lo, b)
-        head = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        head = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         buf = np.empty(0)
         eps = 0.0
         nv = 0
@@ -123,7 +124,7 @@ def nfp_pairs(shapes, pairs, refs, settings):
             ok = tolerance_for(0.0, reach, rel_tol, ulps) < min(extent[a], extent[b])
         if ok:
             head, buf = ring_entrance(xb, xa, ax, ay, -1.0, rel_tol, ulps, ang_tol, snap_f,
-                                      near_f, max_ear, max_sum)
+                                      near_f, max_ear, max_sum, max_tests)
             eps = head[1]
             nv = int(head[5])
             # done here: the sums made (ok), the outline linked (status 1), one ring that

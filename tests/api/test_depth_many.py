@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from profiles import examples
-from test_depth import _clipper_depth
+from .test_depth import _clipper_depth
 
 import polycontact as pc
 from polycontact import limits

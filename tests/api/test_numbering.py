@@ -25,7 +25,7 @@ from profiles import examples
 import polycontact as pc
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _to_edge(p: np.ndarray, ring: np.ndarray, k: int) -> float:

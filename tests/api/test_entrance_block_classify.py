@@ -8,7 +8,7 @@ import shapely
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from profiles import examples
-from test_entrance_block import FRAME, NOTCHED_HOLE, SQUARE, bodies, note_bodies
+from .test_entrance_block import FRAME, NOTCHED_HOLE, SQUARE, bodies, note_bodies
 
 import polycontact as pc
 

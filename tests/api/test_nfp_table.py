@@ -20,7 +20,7 @@ from polycontact.cli import main
 from polycontact.esicup import InvalidInstanceError, turned
 from polycontact.nfp_tables import SHARDS, CacheWarning, NfpTable
 
-SRC = str(Path(__file__).resolve().parents[1] / "src")
+SRC = str(Path(__file__).resolve().parents[2] / "src")
 
 SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
 BAR = [[0, 0], [2, 0], [2, 1], [0, 1], [0, 0]]  # closed ring, as some ESICUP files have

@@ -13,7 +13,7 @@ import polycontact as pc
 from polycontact import datasets
 from polycontact.cli import main as cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = Path(pc.__file__).resolve().parent
 
 

@@ -10,7 +10,7 @@ import shapely
 
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 DOVE_A = str(EXAMPLES / "nfp-dovetail-a.json")
 DOVE_B = str(EXAMPLES / "nfp-dovetail-b.json")
 SQUARE = str(EXAMPLES / "nfp-square.json")

@@ -10,7 +10,7 @@ import pytest
 
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _layout(tmp_path: Path) -> str:

@@ -19,7 +19,7 @@ import pytest
 import shapely
 from hypothesis import given
 from profiles import examples
-from test_nfp import CATALOGUE, ESICUP, _rotated, shape, star_shapes
+from .test_nfp import CATALOGUE, ESICUP, _rotated, shape, star_shapes
 
 import polycontact as pc
 from polycontact import nfp as nfp_module

@@ -24,7 +24,7 @@ import shapely
 
 import polycontact as pc
 
-GEOS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "geos"
+GEOS = Path(__file__).resolve().parents[3] / "shared" / "datasets" / "geos"
 _CODE = {pc.State.SEPARATE: 0, pc.State.CONTACT: 1, pc.State.PENETRATING: 2}
 
 

@@ -17,7 +17,7 @@ import pytest
 import polycontact
 from polycontact import compiling
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 PACKAGE = Path(polycontact.__file__).resolve().parent
 #: The start of the notice of a compile.
 NOTICE = "polycontact is compiling the kernels this call needs"

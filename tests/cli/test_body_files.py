@@ -17,7 +17,7 @@ import shapely
 
 from polycontact.cli import collide, main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 FRAME = str(EXAMPLES / "body-frame.json")
 ELL = [[0, 0], [3, 0], [3, 1], [1, 1], [1, 3], [0, 3]]
 

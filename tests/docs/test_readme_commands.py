@@ -24,7 +24,7 @@ import pytest
 
 import polycontact
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 README = ROOT / "README.md"
 
 #: Commands of the README that this test does not run, and why: the environment and

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+README = Path(__file__).resolve().parents[2] / "README.md"
 BLOCKS = [
     m.group(1)
     for m in re.finditer(r"```python\n(.*?)```", README.read_text(), flags=re.S)

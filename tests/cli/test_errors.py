@@ -14,7 +14,7 @@ import pytest
 
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
 HUGE = 10**400
 DEEP = "[" * 100_000 + "]" * 100_000

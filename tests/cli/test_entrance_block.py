@@ -9,7 +9,7 @@ import pytest
 
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 ELL = str(EXAMPLES / "body-ell.json")
 FRAME = str(EXAMPLES / "body-frame.json")
 

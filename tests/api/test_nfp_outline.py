@@ -19,12 +19,12 @@ from hypothesis import given
 from hypothesis import strategies as st
 from nfp_reference import reference_region, same_region
 from profiles import examples
-from test_nfp import grid_shapes, star_shapes
+from .test_nfp import grid_shapes, star_shapes
 
 import polycontact as pc
 from polycontact.cli import main
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _vertex_on_its_neighbours_segment(ring: np.ndarray, eps: float) -> list[int]:

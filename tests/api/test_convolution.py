@@ -13,8 +13,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from profiles import examples
-from test_depth import _clipper_depth, _convex_sum_depth
-from test_depth_fast import _from_box, _pairs, _star, _transformed
+from .test_depth import _clipper_depth, _convex_sum_depth
+from .test_depth_fast import _from_box, _pairs, _star, _transformed
 
 import polycontact as pc
 from polycontact._kernels import convolution as kc

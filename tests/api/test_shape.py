@@ -89,14 +89,14 @@ def test_centroid_with_hole_matches_shapely():
 
 # The shipped scenes hold the paper's Tables A1-A2 as printed (shared/paper/cases.json),
 # so these tests run in any checkout, not only one with shared/ beside it.
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _scene_bodies(name: str) -> list[dict]:
     return json.loads((EXAMPLES / name).read_text())["bodies"]
 
 
-CASES_JSON = Path(__file__).resolve().parents[2] / "shared" / "paper" / "cases.json"
+CASES_JSON = Path(__file__).resolve().parents[3] / "shared" / "paper" / "cases.json"
 
 
 @pytest.mark.skipif(not CASES_JSON.is_file(), reason="shared/paper/cases.json not beside")

@@ -43,7 +43,7 @@ from exact_overlap import is_valid, widest_section
 
 import polycontact as pc
 
-EXT3 = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "ext3"
+EXT3 = Path(__file__).resolve().parents[3] / "shared" / "datasets" / "ext3"
 _CODE = {pc.State.SEPARATE: 0, pc.State.CONTACT: 1, pc.State.PENETRATING: 2}
 
 

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from profiles import examples
-from test_depth import _clipper_depth, _convex_sum_depth
+from .test_depth import _clipper_depth, _convex_sum_depth
 
 import polycontact as pc
 from polycontact._kernels import depth as kd

@@ -15,12 +15,12 @@ import shapely
 from hypothesis import assume, given
 from hypothesis import strategies as st
 from profiles import examples
-from test_kernels_contact_geometry import offset
+from kernels.test_contact_geometry import offset
 
 import polycontact as pc
 import polycontact.world as world_module
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 # (outer loop as the caller gives it, holes): concave, with holes, clockwise, closed
 TEMPLATES = [

@@ -20,7 +20,7 @@ from polycontact.tolerances import default_tolerance
 
 # ../shared/datasets beside the repository (its parent, or the parent of a worktree's
 # directory).
-DATASETS = next((p / "shared" / "datasets" for p in Path(__file__).resolve().parents[1:4]
+DATASETS = next((p / "shared" / "datasets" for p in Path(__file__).resolve().parents[2:5]
                  if (p / "shared" / "datasets").is_dir()), Path("/nonexistent"))
 
 # Concave bodies and bodies with holes, on an integer grid.
