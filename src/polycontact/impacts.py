@@ -392,10 +392,10 @@ _EXTENT = operator.attrgetter("_extent")
 
 
 def time_of_impact_many(
-    shapes_a: Any,
-    motions_a: Any,
-    shapes_b: Any,
-    motions_b: Any,
+    shapes_a: Sequence[ShapeLike],
+    motions_a: Sequence[Motion] | np.ndarray,
+    shapes_b: Sequence[ShapeLike],
+    motions_b: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",
@@ -411,8 +411,8 @@ def time_of_impact_many(
 
     Pair k's answer is the one ``time_of_impact(shapes_a[k], motions_a[k], shapes_b[k],
     motions_b[k], t_max=..., ...)`` gives (the same kernel with the same arguments; times
-    within the time tolerance, see the module docstring); the pairs are shared among ``threads`` threads, since the compiled
-    search releases the GIL. A shape that appears in many pairs (the same object) has
+    within the time tolerance, see the module docstring); the pairs are shared among
+    ``threads`` threads, since the compiled search releases the GIL. A shape that appears in many pairs (the same object) has
     its tables built once.
 
     The result is a batch of arrays (``status``, ``collides``, ``times``,

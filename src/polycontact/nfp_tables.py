@@ -101,8 +101,8 @@ MANIFEST = "table.json"
 SHARDS = "shards"
 
 #: What starting one local worker process costs (seconds: the interpreter, the imports
-#: and loading the compiled kernels from the cache, measured at about a second): a
-#: build uses processes only where each has more work than this.
+#: and loading the compiled kernels from the cache): a build uses processes only where
+#: each has more work than this.
 PROCESS_START = 1.0
 
 #: Entries of the first chunk, computed in the calling process (or as the first Dask
