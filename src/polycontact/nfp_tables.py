@@ -39,9 +39,11 @@ of a large build, the build uses a pool of ``workers`` processes instead, but on
 where the work measured on a first chunk outweighs the processes' start
 (:data:`PROCESS_START`), so that processes never make a build slower; the pool is
 started once, after the kernels are compiled here, so the processes load them and never
-compile. Scripts that may build large tables with processes must guard their entry
-point with ``if __name__ == "__main__":`` (processes are spawned, as on macOS and
-Windows). With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
+compile. The processes are spawned (as on macOS and Windows), and a spawned process
+runs the main script's top-level code again: a build called from there, outside an
+``if __name__ == "__main__":`` block, runs on threads instead (with a warning when
+``workers`` asked for processes), since each process would otherwise start the build
+again. With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
 client is the default, the missing entries run as tasks on the cluster
 (:mod:`polycontact.distributed`), each of at least
 :data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task and
@@ -59,6 +61,7 @@ Examples
 
 from __future__ import annotations
 
+import ast
 import bisect
 import hashlib
 import json
@@ -80,6 +83,7 @@ from contextlib import closing
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -747,6 +751,14 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     n_proc = workers or 1
     if workers is None and gil_seconds > 0.5 * seconds:
         n_proc = min(threads, int(gil_seconds / first * rest / PROCESS_START))
+    if n_proc > 1 and _spawn_reruns_caller():
+        if workers is not None:
+            warnings.warn(
+                f"nfp_table: workers={workers} runs on threads: it is called from a "
+                "script's top-level code, which spawned processes would run again (put "
+                "the call under `if __name__ == '__main__':` to use processes)",
+                RuntimeWarning, stacklevel=4)
+        n_proc, workers = 1, None
     n_threads = 1 if n_proc > 1 or workers == 1 else useful(threads, seconds / first * rest)
     size = chunk_size or min(1024, max(64, math.ceil(rest / (4 * max(n_proc, n_threads)))))
     spans = _spans(first, count, size)
@@ -759,6 +771,49 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     with closing(results):  # type: ignore[type-var]
         for k, got in results:
             yield *spans[k], got
+
+
+def _spawn_reruns_caller() -> bool:
+    """Whether a spawned process would run this call again: the call comes (through any
+    number of functions) from the top-level code of the ``__main__`` module outside an
+    ``if __name__ == "__main__":`` block, and ``multiprocessing`` runs that module again
+    in a spawned process (a script run by path or ``python -m module``; not a package's
+    ``__main__.py``, nor an interactive session)."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if main is None or path is None or name == "__main__" or (
+            name is not None and name.endswith(".__main__")) or (
+            name is None and os.path.splitext(os.path.basename(path))[0] == "ipython"):
+        return False
+    frame: FrameType | None = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(main)
+                                     and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    if frame is None:
+        return False  # not called from the main module's top-level code
+    line = frame.f_lineno
+    try:
+        with open(path, "rb") as f:
+            tree = ast.parse(f.read())
+    except (OSError, SyntaxError, ValueError):
+        return True  # (the source cannot be read: taken as unguarded)
+    for statement in tree.body:
+        if statement.lineno <= line <= (statement.end_lineno or statement.lineno):
+            return not (isinstance(statement, ast.If) and _is_main_test(statement.test)
+                        and any(s.lineno <= line <= (s.end_lineno or s.lineno)
+                                for s in statement.body))
+    return True
+
+
+def _is_main_test(test: ast.expr) -> bool:
+    """Whether ``test`` is ``__name__ == "__main__"`` (either way round)."""
+    if (not isinstance(test, ast.Compare) or len(test.ops) != 1
+            or not isinstance(test.ops[0], ast.Eq)):
+        return False
+    sides = (test.left, test.comparators[0])
+    return (any(isinstance(x, ast.Name) and x.id == "__name__" for x in sides)
+            and any(isinstance(x, ast.Constant) and x.value == "__main__" for x in sides))
 
 
 def _progress_bar(progress: Progress, total: int) -> Any:
