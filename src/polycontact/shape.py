@@ -321,7 +321,8 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel",
+                 "_sizes")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -440,6 +441,9 @@ class Shape:
         # rule is a max of terms that grow with the extent and the magnitude)
         self._tolerance = tolerance_for(extent, magnitude)
         self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
+        # the centroid, the bounding radius and the extent as the bytes of four float64:
+        # what a batch of moving bodies reads of each shape, joined with the others'
+        self._sizes = np.array([*centroid, self._radius, extent], np.float64).tobytes()
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],
