@@ -37,9 +37,11 @@ threads (``threads=``, by the threading policy of :doc:`conventions`), in chunks
 (pieces with holes, rings too large for ear clipping) hold the GIL; when they are most
 of a large build, the build uses a pool of ``workers`` processes instead, but only
 where the work measured on a first chunk outweighs the processes' start
-(:data:`PROCESS_START`), so that processes never make a build slower; the pool is
-started once, after the kernels are compiled here, so the processes load them and never
-compile. The processes are spawned (as on macOS and Windows), and a spawned process
+(:data:`PROCESS_START`); the pool is started once, after the kernels are compiled here,
+so the processes load them and never compile. This process works alongside the pool,
+from the other end of the tasks, and computes the tasks of processes that are slow to
+start (or stop) itself, so that processes never make a build much slower than this
+process alone. The processes are spawned (as on macOS and Windows), and a spawned process
 runs the main script's top-level code again: a build called from there, outside an
 ``if __name__ == "__main__":`` block, runs on threads instead (with a warning when
 ``workers`` asked for processes), since each process would otherwise start the build
@@ -77,7 +79,7 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Generator, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import closing
 from dataclasses import dataclass
@@ -402,9 +404,10 @@ def nfp_table(
         Show a progress bar (tqdm on stderr), or call ``progress(done, total)`` after
         each batch of entries.
     workers : int, optional
-        Local processes when there is no Dask client. By default none, unless most of
-        the work holds the GIL (pieces with holes, large rings) and each process has
-        more of it than its start costs (:data:`PROCESS_START`); 1: in this process.
+        Local processes when there is no Dask client (besides this process, which works
+        alongside them). By default none, unless most of the work holds the GIL (pieces
+        with holes, large rings) and each process has more of it than its start costs
+        (:data:`PROCESS_START`); 1: in this process.
     threads : int, optional
         Threads of a local build (default and meaning: the threading policy of
         :doc:`conventions`: at most ``numba.get_num_threads()``, and no more than the
@@ -859,25 +862,63 @@ def _process_task(pairs: np.ndarray, reference: str) -> Packed:
 def _run_processes(
     n: int, pieces: _Pieces, tasks: list[np.ndarray], reference: str
 ) -> Generator[tuple[int, Packed], None, None]:
-    """Run the tasks on ``n`` spawned processes (one pool for the build); yield (task
-    index, result) as they end."""
+    """Run the tasks on ``n`` spawned processes (one pool for the build) and in this
+    process; yield (task index, result) as they end, each task once.
+
+    The pool takes tasks from the front, ``n + 1`` at a time, and this process from the
+    back, so it works while the processes start: when the processes are slow to start
+    (or stop), this process computes the tasks it handed them too (the first result
+    wins; both are the same), and the build takes no longer than here alone."""
     pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_init_process, initargs=(pieces, reference))
+    owner: dict[Future[Packed], int] = {}
+    done = np.zeros(len(tasks), bool)
+    front, back = 0, len(tasks)  # tasks[front:back]: handed to nobody yet
+    answered = broken = False
+
+    def finished(timeout: float | None) -> list[tuple[int, Packed]]:
+        nonlocal answered, broken
+        ended, _ = wait(list(owner), timeout=timeout, return_when=FIRST_COMPLETED)
+        out = []
+        for f in ended:
+            k = owner.pop(f)
+            try:
+                result = f.result()
+            except BrokenProcessPool:
+                if not broken:
+                    warnings.warn("nfp_table: the local worker processes stopped; the "
+                                  "build goes on in this process", RuntimeWarning,
+                                  stacklevel=5)
+                broken = True
+                continue
+            answered = True
+            if not done[k]:
+                done[k] = True
+                out.append((k, result))
+        return out
+
     try:
-        futures = {pool.submit(_process_task, t, reference): k for k, t in enumerate(tasks)}
-        pending = set(futures)
-        while pending:
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in finished:
-                try:
-                    result = f.result()
-                except BrokenProcessPool:
-                    raise RuntimeError(
-                        "the local worker processes of nfp_table stopped: a script that "
-                        "builds a large table must guard its entry point with "
-                        "`if __name__ == '__main__':` (processes are spawned), or pass "
-                        "workers=1") from None
-                yield futures[f], result
+        while not done.all():
+            for item in finished(0):
+                yield item
+            while not broken and front < back and len(owner) < n + 1:
+                owner[pool.submit(_process_task, tasks[front], reference)] = front
+                front += 1
+            if front < back:
+                back -= 1
+                k = back
+            else:  # every task handed out: compute the pool's, unless it is at work
+                left = [] if answered and not broken and owner else [
+                    k for k in range(front - 1, -1, -1) if not done[k]]
+                if not left:
+                    for item in finished(None):
+                        yield item
+                    continue
+                k = left[0]
+            result = _compute_chunk(pieces, tasks[k], reference)
+            if not done[k]:
+                done[k] = True
+                yield k, result
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
 
