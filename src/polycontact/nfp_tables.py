@@ -48,9 +48,9 @@ runs the main script's top-level code again: a build called from there, outside 
 again. With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
 client is the default, the missing entries run as tasks on the cluster
 (:mod:`polycontact.distributed`), each of at least
-:data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task and
-several per worker thread, the pieces sent to every worker once; the client writes the
-shards as results arrive.
+:data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task, up to
+four per worker thread in whole rounds, the pieces sent to every worker once; the
+client writes the shards as results arrive.
 
 Examples
 --------
