@@ -1,6 +1,7 @@
 """Kernels of a World's step: NumPy's summation order, the overlap of two regions
 against Shapely's intersection, the closest features against Shapely's distance, the
-depth's contact segment, and the state of a body moved from its edge table."""
+depth's contact segment and its search given a known witness, and the state of a body
+moved from its edge table."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact._kernels import contact_geometry as kg
-from polycontact._kernels.convolution import contact_depth_into, depth_buffers
+from polycontact._kernels.convolution import contact_depth_into, contact_depth_of, depth_buffers
 from polycontact._kernels.depth import box_escape
 from polycontact._kernels.overlap import overlap_moments, overlap_scratch, where
 from polycontact._kernels.packs import scratch_floats
@@ -213,3 +214,28 @@ def test_a_moved_body_gets_the_state_kernels_verdict_and_a_witness_that_holds(
     d2 = d * back
     if witness_holds(ta, tb, d2[0], d2[1], eps, witness, i, j, moved, touch):
         assert relate_state(xa + d2, sta, xb, stb, eps) == 2
+
+
+@examples(150)
+@given(placed, placed, frames, st.floats(0.0, 1.0), st.floats(0.0, 2 * math.pi))
+def test_a_known_witness_leaves_the_depth_as_it_was(sa, sb, frame, reach, turn):
+    """The depth's search given the witness of a penetration found at another
+    translation (tried before the state kernel at each point) finds what it finds
+    without: the same depth, escape, status and carrying features, to the bit."""
+    a, b = make(sa, frame), make(sb, frame)
+    (xa, sta), (xb, stb) = a.packed, b.packed
+    if len(xa) + len(xb) > 64:
+        return
+    eps = pc.default_tolerance(xa, xb)
+    ta, tb = tables(a), tables(b)
+    bound, bdx, bdy = box_escape(xa, xb)
+    d = reach * bound * np.array([math.cos(turn), math.sin(turn)])
+    moved = np.empty_like(xa)
+    scratch = np.empty(scratch_floats(len(xa) + len(xb)))
+    got, witness, i, j = moved_state(ta, tb, d[0], d[1], eps, moved, scratch)
+    if not got or relate_state(xa, sta, xb, stb, eps) != 2:
+        return
+    runs = [contact_depth_of(ta, tb, bound, bdx, bdy, eps, 0.0, known,
+                             depth_buffers(len(xa), len(xb)))
+            for known in ((NO_WITNESS, -1, -1), (witness, i, j))]
+    assert runs[0] == runs[1] or (runs[0][1] != runs[0][1] and runs[0][3:] == runs[1][3:])
