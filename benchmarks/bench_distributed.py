@@ -99,7 +99,7 @@ def spread(fn, count: int, repeat: int) -> tuple[float, float, float]:
 def same(x, y) -> bool:
     import numpy as np
 
-    return (np.array_equal(x.status, y.status)
+    return (np.array_equal(x.statuses, y.statuses)
             and np.array_equal(x.times, y.times, equal_nan=True)
             and np.array_equal(x.first_contacts, y.first_contacts, equal_nan=True))
 

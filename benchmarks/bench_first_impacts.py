@@ -98,14 +98,14 @@ def main() -> None:
     t_max = 1.0
     n = len(shapes)
     pairs = n * (n - 1) // 2
-    scene_obj = pc.Scene(tuple(pc.Body(f"b{k}", s, m) for k, s, m in
+    scene_obj = pc.Scene(tuple(pc.SceneBody(f"b{k}", s, m) for k, s, m in
                                zip(range(n), shapes, motions)), t_max)
     from polycontact.impacts import candidate_pairs
 
-    pc.first_impacts(shapes[:3], motions[:3], t_max)        # compile / load the kernels
+    pc.first_impacts(shapes[:3], motions[:3], t_max=t_max)  # compile / load the kernels
     print(f"== first impacts of {n} moving concave 12-gons over [0, {t_max:g}] "
           f"({pairs} pairs, {os.cpu_count()} CPUs) ==")
-    t_cand, cand = median_time(lambda: candidate_pairs(shapes, motions, t_max), 5)
+    t_cand, cand = median_time(lambda: candidate_pairs(shapes, motions, t_max=t_max), 5)
 
     def brute():
         out = []
@@ -121,11 +121,11 @@ def main() -> None:
     # that the ratio of a round compares runs under the same load of the machine
     rounds, fast_calls = [], []
     for _ in range(args.repeat):
-        calls, events = timings(lambda: pc.first_impacts(shapes, motions, t_max), 5)
+        calls, events = timings(lambda: pc.first_impacts(shapes, motions, t_max=t_max), 5)
         fast_calls += calls
         t_fast = float(np.median(calls))
-        t_one, first = median_time(lambda: pc.first_impact(shapes, motions, t_max), 5)
-        t_scene, (ba, bb, imp) = median_time(lambda: scene_obj.first_impact(), 1)
+        t_one, first = median_time(lambda: pc.first_impact(shapes, motions, t_max=t_max), 5)
+        t_scene, (si, sj, imp) = median_time(lambda: scene_obj.first_impact(), 1)
         t_brute, slow = median_time(brute, 1)
         rounds.append((t_fast, t_one, t_scene, t_brute))
     t_fast, t_one, t_scene, t_brute = np.median(rounds, axis=0)
@@ -137,12 +137,13 @@ def main() -> None:
           f"{len(cand)} candidate pairs; {len(events)} pairs meet, {hits} collide)")
     print(f"first_impact:  {1e3 * t_one:9.1f} ms  -> bodies {first.i}, {first.j} at "
           f"t = {first.impact.time:.6f} ({first.impact.status.value})")
-    print(f"Scene.first_impact (World): {t_scene:7.2f} s  -> {ba.name}, {bb.name} at "
+    print(f"Scene.first_impact (World): {t_scene:7.2f} s  -> {scene_obj.bodies[si].name}, "
+          f"{scene_obj.bodies[sj].name} at "
           f"t = {imp.time:.6f}")
     same = {(i, j): imp for i, j, imp in slow} == {(e.i, e.j): e.impact for e in events}
     print(f"double loop of time_of_impact:  {t_brute:7.2f} s  -> {len(slow)} pairs meet; "
           f"first_impacts gives the same pairs and Impacts: {same}")
-    agree = (first.i, first.j) == (int(ba.name[1:]), int(bb.name[1:])) and first.impact == imp
+    agree = (first.i, first.j) == (si, sj) and first.impact == imp
     print(f"first_impact agrees with Scene.first_impact: {agree}")
     print(f"speed-up (medians over {args.repeat} rounds of the per-round ratios): "
           f"first_impacts vs Scene.first_impact {r_scene:.0f}x, vs the double loop "

@@ -122,7 +122,7 @@ def impact_pairs(count: int, seed: int) -> tuple[list, list, list, list]:
 
 
 def same_batch(x: pc.ImpactBatch, y: pc.ImpactBatch) -> bool:
-    return (np.array_equal(x.status, y.status) and np.array_equal(x.collides, y.collides)
+    return (np.array_equal(x.statuses, y.statuses) and np.array_equal(x.collides, y.collides)
             and np.array_equal(x.times, y.times, equal_nan=True)
             and np.array_equal(x.first_contacts, y.first_contacts, equal_nan=True)
             and all(x.impact(k) == y.impact(k) and x.impact(k).features == y.impact(k).features
@@ -137,12 +137,12 @@ def test_time_of_impact_many_on_the_cluster_is_identical(client, method):
                                     chunk_size=37)
     assert len(remote) == len(a) and same_batch(local, remote)
     # the chosen cases: hit, slide, miss, overlap at the start, through a hole
-    assert remote.status[:8].tolist() == [1, 0, 0, 2, 1, 0, 0, 1]
+    assert remote.statuses[:8].tolist() == [1, 0, 0, 2, 1, 0, 0, 1]
     assert np.isnan(remote.first_contacts[[2, 5]]).all()  # they never touch
     assert not np.isnan(remote.first_contacts[[1, 6]]).any()  # they slide, touching
     assert remote.impact(4) == pc.time_of_impact(a[4], ma[4], b[4], mb[4], t_max=3,
                                                  method=method)
-    assert set(remote.status.tolist()) == {0, 1, 2}
+    assert set(remote.statuses.tolist()) == {0, 1, 2}
 
 
 def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):

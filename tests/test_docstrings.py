@@ -8,7 +8,7 @@ import inspect
 import re
 
 import polycontact as pc
-from polycontact import bodies, plotting
+from polycontact import plotting, shape
 
 ORDER = ["Parameters", "Attributes", "Returns", "Yields", "Raises", "Warns", "See Also",
          "Examples", "Notes", "References"]
@@ -21,7 +21,7 @@ def _sections(doc: str) -> list[str]:
 
 
 def _public() -> dict[str, object]:
-    found: dict[str, object] = {"bodies.as_shape": bodies.as_shape}
+    found: dict[str, object] = {"shape.as_shape": shape.as_shape}
     for name in pc.__all__:
         obj = getattr(pc, name)
         found[name] = obj

@@ -145,7 +145,7 @@ def test_time_of_impact_many_equals_time_of_impact_per_pair(scene, method):
         assert agree(got, want)
         if got == want:
             assert got.features == want.features
-        assert STATUS_CODES[want.status] == int(batch.status[k])
+        assert STATUS_CODES[want.status] == int(batch.statuses[k])
         assert bool(batch.collides[k]) == want.collides
         assert (math.isnan(batch.times[k]) if got.time is None
                 else batch.times[k] == got.time)
@@ -162,7 +162,7 @@ def test_time_of_impact_many_threads_give_the_same_answers():
     mb = [Motion()] * len(a)
     one = time_of_impact_many(a, ma, b, mb, t_max=2, threads=1)
     two = time_of_impact_many(a, ma, b, mb, t_max=2, threads=2)
-    assert one.status.tolist() == two.status.tolist() and one.collides.any()
+    assert one.statuses.tolist() == two.statuses.tolist() and one.collides.any()
     assert list(one) == list(two)
     assert np.array_equal(one.times, two.times, equal_nan=True)
 
@@ -206,14 +206,14 @@ def test_time_of_impact_many_empty_and_arrays_untouched():
      ValueError, "threads: expected an integer >= 1"),
     (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1, samples=1),
      ValueError, "samples"),
-    (lambda: first_impacts([SQ, SQ, SQ], [Motion()] * 2, 1),
+    (lambda: first_impacts([SQ, SQ, SQ], [Motion()] * 2, t_max=1),
      ValueError, r"motions: expected 3 motions \(one per shape of shapes\), got 2"),
-    (lambda: first_impacts([SQ, 3], [Motion()] * 2, 1), TypeError,
-     r"shapes\[1\]: expected a body \(.*\), got int"),
-    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, 1), ValueError,
-     r"shapes\[1\]: "),  # text is WKT (bodies.as_shape): a wrong value, not type
-    (lambda: first_impacts([SQ, SQ], [Motion(), None], 1), TypeError, r"motions\[1\]: "),
-    (lambda: first_impacts([SQ, SQ], [Motion()] * 2, math.nan), ValueError, "t_max"),
+    (lambda: first_impacts([SQ, 3], [Motion()] * 2, t_max=1), TypeError,
+     r"shapes\[1\]: expected a shape \(.*\), got int"),
+    (lambda: first_impacts([SQ, "x"], [Motion()] * 2, t_max=1), ValueError,
+     r"shapes\[1\]: "),  # text is WKT (as_shape): a wrong value, not type
+    (lambda: first_impacts([SQ, SQ], [Motion(), None], t_max=1), TypeError, r"motions\[1\]: "),
+    (lambda: first_impacts([SQ, SQ], [Motion()] * 2, t_max=math.nan), ValueError, "t_max"),
     (lambda: time_of_impact_many([SQ], [Motion()], [SQ], [Motion()], t_max=1).impact(1),
      IndexError, r"k: expected a pair index in \[0, 1\), got 1"),
 ])
@@ -228,48 +228,56 @@ def test_bad_arguments_are_named_with_their_index(call, error, message):
 def test_first_impacts_equals_brute_force_over_all_pairs(scene, method):
     bodies, moves, t_max = scene
     want = brute(bodies, moves, t_max, max_iterations=BUDGET, method=method)
-    events = first_impacts(bodies, moves, t_max, max_iterations=BUDGET, method=method)
+    events = first_impacts(bodies, moves, t_max=t_max, max_iterations=BUDGET, method=method)
     assert same_events({(e.i, e.j): e.impact for e in events}, want)
     keys = [(event_time(e.impact), e.i, e.j) for e in events]
     assert keys == sorted(keys)
     if method == "sampled":
         return
-    first = first_impact(bodies, moves, t_max, max_iterations=BUDGET)
+    first = first_impact(bodies, moves, t_max=t_max, max_iterations=BUDGET)
     if not want:
         assert first is None
         return
     # Scene.first_impact, the all-pairs loop, picks the same pair and the same impact
-    scene_obj = pc.Scene(tuple(pc.Body(str(k), s, m) for k, (s, m) in
+    scene_obj = pc.Scene(tuple(pc.SceneBody(str(k), s, m) for k, (s, m) in
                                enumerate(zip(bodies, moves))), t_max)
-    a, b, imp = _scene_first(scene_obj)
-    assert (first.i, first.j) == (int(a.name), int(b.name)) and agree(first.impact, imp)
+    i, j, imp = _loop_first(scene_obj)
+    assert (first.i, first.j) == (i, j) and agree(first.impact, imp)
+    assert scene_obj.first_impact(max_iterations=BUDGET)[:2] == (i, j)
 
 
-def _scene_first(scene_obj):
-    from polycontact import scene as sc
+def first_order(imp):
+    """The order of the first event: collisions (penetrating at the start, hits,
+    searches without a verdict) by time before any touch, touches by time."""
+    touch_only = imp.status is pc.ImpactStatus.NO_HIT
+    return (math.inf if touch_only else event_time(imp), event_time(imp) if touch_only else 0.0)
 
+
+def _loop_first(scene_obj):
+    """The first event of a scene by the loop of time_of_impact over every pair."""
     results = []
     for i, a in enumerate(scene_obj.bodies):
-        for b in scene_obj.bodies[i + 1:]:
-            results.append((a, b, pc.time_of_impact(a.shape, a.motion, b.shape, b.motion,
+        for j in range(i + 1, len(scene_obj.bodies)):
+            b = scene_obj.bodies[j]
+            results.append((i, j, pc.time_of_impact(a.shape, a.motion, b.shape, b.motion,
                                                     t_max=scene_obj.t_max,
                                                     max_iterations=BUDGET)))
-    return min(results, key=lambda r: sc._event_order(r[2]))
+    return min(results, key=lambda r: first_order(r[2]))
 
 
 def test_first_impacts_reports_hits_touches_and_start_overlaps_in_time_order():
     shapes = [SQ, SQ.moved((3, 0)), SQ.moved((1.5, 1)), SQ.moved((0, 30)),
               SQ.moved((0, 30.5)), SQ.moved((10, 10))]
     moves = [Motion(velocity=(1, 0)), Motion(), Motion(), Motion(), Motion(), Motion()]
-    events = first_impacts(shapes, moves, 5)
+    events = first_impacts(shapes, moves, t_max=5)
     assert [(e.i, e.j, e.impact.status.value) for e in events] == [
         (3, 4, "penetrating-at-start"), (0, 2, "no-hit"), (0, 1, "hit")]
     assert events[1].impact.state is pc.State.CONTACT
-    assert first_impact(shapes, moves, 5)[:2] == (3, 4)
+    assert first_impact(shapes, moves, t_max=5)[:2] == (3, 4)
     # without the overlapping pair the hit comes first, although the touch is earlier
-    assert first_impact(shapes[:3], moves[:3], 5)[:2] == (0, 1)
-    assert first_impact(shapes[:1] + shapes[3:4], moves[:2], 5) is None
-    assert first_impacts([SQ], [Motion()], 5) == [] and first_impacts([], [], 5) == []
+    assert first_impact(shapes[:3], moves[:3], t_max=5)[:2] == (0, 1)
+    assert first_impact(shapes[:1] + shapes[3:4], moves[:2], t_max=5) is None
+    assert first_impacts([SQ], [Motion()], t_max=5) == [] and first_impacts([], [], t_max=5) == []
 
 
 # -- the swept bounds -------------------------------------------------------------------
@@ -315,7 +323,7 @@ def swarms(draw):
 @given(swarms())
 def test_swept_bounds_never_drop_a_pair_the_pairwise_call_searches(swarm):
     shapes, moves, t_max = swarm
-    found = {tuple(p) for p in candidate_pairs(shapes, moves, t_max).tolist()}
+    found = {tuple(p) for p in candidate_pairs(shapes, moves, t_max=t_max).tolist()}
     for i in range(len(shapes)):
         for j in range(i + 1, len(shapes)):
             if len(intervals_array(shapes[i], moves[i], shapes[j], moves[j], t_max)):
@@ -348,7 +356,8 @@ def test_swept_bounds_keep_a_grazing_pass_and_drop_far_pairs():
     a = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])
     b = a.moved((5, 2 * r))
     far = a.moved((0, 50))
-    pairs = candidate_pairs([a, b, far], [Motion(velocity=(1, 0)), Motion(), Motion()], 10)
+    pairs = candidate_pairs([a, b, far], [Motion(velocity=(1, 0)), Motion(), Motion()],
+                            t_max=10)
     assert pairs.tolist() == [[0, 1]]
 
 
@@ -357,14 +366,14 @@ def test_swept_bounds_far_from_the_origin_grow_by_the_float_spacing():
     # positions there (~3e-5), as the pairwise broad phase is, not by a fraction of the
     # offset (1e-6 of it made every body within 1e3 a candidate)
     far = [SQ.moved((1e9 + 10.0 * k, -1e9)) for k in range(3)]
-    assert candidate_pairs(far, [Motion()] * 3, 1e3).tolist() == []
+    assert candidate_pairs(far, [Motion()] * 3, t_max=1e3).tolist() == []
     # ...and a grazing pass there is kept (circles of radius sqrt(1/2), sqrt(2) apart
     # as a passes b: the pairwise broad phase sees them meet)
     a = Shape([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]).moved((1e9, 1e9))
     pair = [a, a.moved((5, math.sqrt(2)))]
     moves = [Motion(velocity=(1, 0)), Motion()]
     assert len(intervals_array(pair[0], moves[0], pair[1], moves[1], 10.0))
-    assert candidate_pairs(pair, moves, 10.0).tolist() == [[0, 1]]
+    assert candidate_pairs(pair, moves, t_max=10.0).tolist() == [[0, 1]]
 
 
 @examples(200)
@@ -390,15 +399,15 @@ def test_swept_bounds_keep_pairs_within_the_pairwise_rounding_allowance(
     b = b.moved(a.centroid + d - b.centroid)
     if not len(intervals_array(a, m, b, m, t_max)):
         return          # the rounding of the placement took the pair out of reach
-    assert candidate_pairs([a, b], [m, m], t_max).tolist() == [[0, 1]]
+    assert candidate_pairs([a, b], [m, m], t_max=t_max).tolist() == [[0, 1]]
 
 
 @pytest.mark.parametrize("call, error, message", [
     (lambda: candidate_pairs([SQ, SQ.moved((50, 0))],
                              [Motion(velocity=(1e300, 0), acceleration=(-1e300, 0)), Motion()],
-                             1e10), ValueError, r"motions\[0\]: the body's coordinates reach"),
+                             t_max=1e10), ValueError, r"motions\[0\]: the body's coordinates reach"),
     (lambda: first_impacts([SQ, SQ.moved((3, 0)), SQ.moved((9, 0))],
-                           [Motion(), Motion(), Motion(velocity=(1e60, 0))], 1e50),
+                           [Motion(), Motion(), Motion(velocity=(1e60, 0))], t_max=1e50),
      ValueError, r"motions\[2\]: the body's coordinates reach .*overflow"),
     (lambda: time_of_impact_many([SQ, SQ], [Motion()] * 2, [SQ, SQ.moved((3, 0))],
                                  [Motion(), Motion(angular_velocity=1e120)], t_max=1),
@@ -428,7 +437,7 @@ def test_first_impacts_equals_brute_force_at_any_scale_and_offset(scale, offset)
                             acceleration=rng.uniform(-1, 1, 2) * scale,
                             angular_velocity=rng.uniform(-1, 1)))
     want = brute(shapes, moves, 1.5, max_iterations=BUDGET)
-    events = first_impacts(shapes, moves, 1.5, max_iterations=BUDGET)
+    events = first_impacts(shapes, moves, t_max=1.5, max_iterations=BUDGET)
     assert same_events({(e.i, e.j): e.impact for e in events}, want)
     assert any(e.impact.collides for e in events)
 
@@ -463,5 +472,6 @@ def test_regression_cases_batched_answers_equal_the_pairwise_ones(case):
     assert batch.impact(0).features == want.features
     # with a bystander far off the path: the one event is the pair's
     away = SQ.moved((-50, 1e3))
-    events = first_impacts([a, b, away], [ma, mb, Motion()], t_max, time_tolerance=tol)
+    events = first_impacts([a, b, away], [ma, mb, Motion()], t_max=t_max,
+                           time_tolerance=tol)
     assert [(e.i, e.j) for e in events] == [(0, 1)] and agree(events[0].impact, want)

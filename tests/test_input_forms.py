@@ -11,7 +11,7 @@ import pytest
 import shapely
 
 import polycontact as pc
-from polycontact.bodies import as_shape
+from polycontact.shape import as_shape
 
 # A 10 x 10 square with a hole; B a 3 x 3 square with a hole, touching A's right side.
 A_OUTER = [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)]

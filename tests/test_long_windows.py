@@ -43,12 +43,12 @@ def test_a_long_window_keeps_the_hit():
                            rtol=1e-14, atol=0.0), hit.broad_phase
         fast = pc.time_of_impact(a, pc.Motion(velocity=(1e6, 0)), b, still, t_max=t_max)
         assert fast.collides and fast.time <= 2e-6 + 1e-4
-    (i, j, first), = pc.first_impacts([a, b], [go, still], 1e27)
+    (i, j, first), = pc.first_impacts([a, b], [go, still], t_max=1e27)
     assert (i, j) == (0, 1) and first.collides and abs(first.time - 2.0) <= 1e-4
     world = pc.World()
     world.add(a, motion=go)
     world.add(b)
-    _, _, impact = world.first_impact(1e27)
+    _, _, impact = world.first_impact(t_max=1e27)
     assert impact.collides and abs(impact.time - 2.0) <= 1e-4
 
 

@@ -72,8 +72,8 @@ def test_paper_case_2_reports_the_files_vertex():
     edge of the file."""
     data = json.loads((EXAMPLES / "paper-case-2.json").read_text())
     scene = pc.load_scene(EXAMPLES / "paper-case-2.json", repair=True)
-    body_a, body_b, impact = scene.first_impact()
-    assert impact.collides and (body_a.name, body_b.name) == ("red", "blue")
+    i, j, impact = scene.first_impact()
+    assert impact.collides and (scene.bodies[i].name, scene.bodies[j].name) == ("red", "blue")
     files = {b["name"]: np.array(b["vertices"], dtype=float) for b in data["bodies"]}
     (f,) = [f for f in impact.features if f.vertex is not None]
     assert (f.body, f.vertex, f.edge) == ("a", 17, 30)
@@ -86,13 +86,13 @@ def test_paper_case_2_reports_the_files_vertex():
         return np.array([cs * q[0] - sn * q[1], sn * q[0] + cs * q[1]]) + c
 
     red = files["red"]
-    p = in_frame(body_a, impact.time)
+    p = in_frame(scene.bodies[i], impact.time)
     gaps = np.hypot(*(red - p).T)
     # the features hold at a time within the tolerance (1e-4 s) of `time`: the point
     # moved less than 0.05 in that time; the other vertices are metres away
     assert int(np.argmin(gaps)) == f.vertex and gaps[f.vertex] < 0.05
     assert np.sort(gaps)[1] > 1.0
-    q = in_frame(body_b, impact.time)
+    q = in_frame(scene.bodies[j], impact.time)
     blue = files["blue"]
     dist = [_to_edge(q, blue, k) for k in range(len(blue))]
     assert int(np.argmin(dist)) == f.edge and dist[f.edge] < 0.05

@@ -78,7 +78,7 @@ NUMBER_CALLS = {
     "broad_phase_intervals t_max": ("t_max", lambda bad: pc.broad_phase_intervals(
         SQ, pc.Motion(velocity=(1, 0)), SQ.moved((3, 0)), pc.Motion(), t_max=bad), True),
     "first_impacts t_max": ("t_max", lambda bad: pc.first_impacts(
-        [SQ, SQ.moved((3, 0))], [pc.Motion(velocity=(1, 0)), pc.Motion()], bad), True),
+        [SQ, SQ.moved((3, 0))], [pc.Motion(velocity=(1, 0)), pc.Motion()], t_max=bad), True),
 }
 
 #: (argument name, call with one point argument set to ``bad``)
@@ -110,7 +110,7 @@ MOTION_CALLS = {
     "time_of_impact_many motions_a": ("motions_a", lambda bad: pc.time_of_impact_many(
         [SQ], [bad], [SQ.moved((3, 0))], [pc.Motion()], t_max=5.0)),
     "first_impacts motions": ("motions", lambda bad: pc.first_impacts(
-        [SQ, SQ.moved((3, 0))], [pc.Motion(), bad], 5.0)),
+        [SQ, SQ.moved((3, 0))], [pc.Motion(), bad], t_max=5.0)),
     "World.add motion": ("motion", lambda bad: pc.World().add(SQ, motion=bad)),
     "Shape.at motion": ("motion", lambda bad: SQ.at(bad, 1.0)),
 }

@@ -69,8 +69,9 @@ def test_no_fit_polygon_to_dict_is_the_cli_json(tmp_path, capsys):
 def test_impact_to_dict_is_the_cli_json(tmp_path, capsys):
     scene = {"t_max": 5, "bodies": [{"name": "box", **A},
                                     {"name": "ring", **B_SEPARATE, "velocity": [-1, 0]}]}
-    a, b, impact = pc.load_scene(scene).first_impact()
-    d = _round_trip(impact.to_dict((a.name, b.name)))
+    loaded = pc.load_scene(scene)
+    i, j, impact = loaded.first_impact()
+    d = _round_trip(impact.to_dict((loaded.bodies[i].name, loaded.bodies[j].name)))
     assert d == _cli_json(capsys, "collide", _write(tmp_path, "scene.json", scene))
     assert d["status"] == "hit" and d["pair"] == ["box", "ring"]
     assert {f["body"] for f in d["features"]} <= {"box", "ring"}
@@ -94,7 +95,7 @@ def _results() -> dict:
     world = pc.World(container=A)
     world.add(B)
     world.add(B_PENETRATING)
-    return {"Relation": pc.classify(A, B), "Impact": scene.first_impact()[2],
+    return {"Relation": pc.classify(A, B), "Impact": scene.first_impact().impact,
             "EntranceBlock": pc.entrance_block(A, B), "NoFitPolygon": pc.no_fit_polygon(A, B),
             "Contacts": world.contacts()}
 

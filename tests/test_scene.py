@@ -102,16 +102,16 @@ def test_first_impact_among_three_bodies():
         body("far", 20, 0),
         body("right", 5, 0, velocity=[-1, 0]),
     ]})
-    a, b, impact = scene.first_impact()
-    assert (a.name, b.name) == ("left", "right")
+    i, j, impact = scene.first_impact()
+    assert (scene.bodies[i].name, scene.bodies[j].name) == ("left", "right")
     assert impact.time == pytest.approx(2.0, abs=1e-4)
 
 
 def test_first_impact_prefers_penetration_at_start_and_reports_contacts():
     scene = pc.Scene.from_dict({"t_max": 10, "bodies": [
         body("a", velocity=[1, 0]), body("b", 5, 0), body("c", 20.5, 0), body("d", 20, 0)]})
-    a, b, impact = scene.first_impact()
-    assert (a.name, b.name) == ("c", "d")
+    i, j, impact = scene.first_impact()
+    assert (scene.bodies[i].name, scene.bodies[j].name) == ("c", "d")
     assert impact.status is ImpactStatus.PENETRATING_AT_START
     touching = pc.Scene.from_dict({"t_max": 1, "bodies": [body("a"), body("b", 1, 0)]})
-    assert touching.first_impact()[2].first_contact == 0.0
+    assert touching.first_impact().impact.first_contact == 0.0

@@ -113,7 +113,7 @@ def test_contacts_equal_brute_force_at_any_scale_and_offset(op_list, frame):
 @given(ops, st.sampled_from([0.0, 1e-3, 0.5]))
 def test_contacts_with_a_tolerance_equal_brute_force(op_list, tolerance):
     world = build(op_list)
-    got = world.contacts(tolerance)
+    got = world.contacts(tolerance=tolerance)
     pairs, states = brute_contacts(world, tolerance)
     assert got.pairs.tolist() == [list(p) for p in pairs]
     assert got.states.tolist() == states
@@ -284,7 +284,7 @@ def test_bad_input_is_refused_with_the_argument_named():
     with pytest.raises(ValueError, match="angles"):
         world.query_many(TEMPLATES[3], [(1.0, 2.0)], [0.0, 1.0])
     with pytest.raises(ValueError, match="tolerance"):
-        world.contacts(-1.0)
+        world.contacts(tolerance=-1.0)
     with pytest.raises(ValueError, match="position: .* beyond"):
         world.add(TEMPLATES[3], (1e200, 0))
 
@@ -310,7 +310,7 @@ def test_published_layouts_are_feasible(path):
     for k, item in enumerate(data["placed"]):
         world.add(pc.Shape(item["vertices"]), name=str(k))
     got = world.contacts()
-    assert not (got.states == 2).any(), got.penetrating.tolist()
+    assert not (got.states == 2).any(), got.penetrating_pairs.tolist()
     assert not (got.container_states == 2).any(), got.container_ids.tolist()
 
 
@@ -522,10 +522,10 @@ def test_contacts_each_pair_once_with_a_wide_tolerance(count):
         x, y = k % side, k // side
         world.add(unit, (1.4 * x + 0.2 * (y % 2), 1.5 * y + (0.1 if x % 3 == 0 else 0.0)))
     for tol in (0.5, None):
-        got = world.contacts(tol)
+        got = world.contacts(tolerance=tol)
         pairs, states = brute_contacts(world, tol)
         assert got.pairs.tolist() == [list(p) for p in pairs] and got.states.tolist() == states
-    assert len(world.contacts(0.5)) > 0
+    assert len(world.contacts(tolerance=0.5)) > 0
 
 
 def test_contacts_in_merged_far_cells():

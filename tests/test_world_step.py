@@ -402,7 +402,7 @@ def test_sweep_agrees_with_time_of_impact_on_every_pair(spec, frame, moves, dt):
             k = got[key]
             code = {"no-hit": 0, "hit": 1, "penetrating-at-start": 2,
                     "out-of-iterations": 3}[imp.status.value]
-            assert s.status[k] == code
+            assert s.statuses[k] == code
             assert s.states[k] == (2 if code in (1, 2) else 1)
             if code == 1:
                 assert abs(s.penetration_times[k] - imp.time) <= 2 * imp.time_tolerance
@@ -448,7 +448,7 @@ def test_sweep_in_parallel_chunks_equals_one_chunk(monkeypatch):
     one = world.sweep(0.5, vel, spin)
     monkeypatch.setattr(world_module, "_chunks", lambda count, work=1.0: 3)
     many = world.sweep(0.5, vel, spin)
-    for name in ("pairs", "times", "states", "penetration_times", "status", "points",
+    for name in ("pairs", "times", "states", "penetration_times", "statuses", "points",
                  "normals"):
         assert np.array_equal(getattr(one, name), getattr(many, name), equal_nan=True), name
 

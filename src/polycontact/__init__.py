@@ -20,7 +20,7 @@ from typing import Any
 
 from .errors import (DepthTooLargeError, InvalidSceneError, InvalidShapeError, NfpTooLargeError,
                      PolycontactError)
-from .shape import Shape
+from .shape import Shape, ShapeLike
 
 __version__ = "0.1.0"
 
@@ -54,7 +54,7 @@ _LAZY = {
     "first_impact": "impacts",
     "PairImpact": "impacts",
     "Scene": "scene",
-    "Body": "scene",
+    "SceneBody": "scene",
     "load_scene": "scene",
     # no-fit polygon
     "NoFitPolygon": "nfp",
@@ -62,6 +62,7 @@ _LAZY = {
     "inner_fit_polygon": "nfp",
     # many bodies
     "World": "world",
+    "WorldBody": "world",
     "Contacts": "world",
     "Query": "world",
     "Sweep": "world",
@@ -79,6 +80,7 @@ __all__ = [
     "DepthTooLargeError",
     "InvalidSceneError",
     "Shape",
+    "ShapeLike",
     *_LAZY,
 ]
 

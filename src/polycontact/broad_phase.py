@@ -21,8 +21,7 @@ import numpy as np
 
 from ._checks import finite_number
 from .motion import Motion
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .limits import BROAD_PHASE_INFLATION, COORDINATE_LIMIT
 from .tolerances import check_range
 
@@ -112,13 +111,13 @@ def intervals_array(a: Shape, ma: Motion, b: Shape, mb: Motion, t_max: float) ->
 
 
 def broad_phase_intervals(
-    a: BodyLike, motion_a: Motion, b: BodyLike, motion_b: Motion, *, t_max: float
+    a: ShapeLike, motion_a: Motion, b: ShapeLike, motion_b: Motion, *, t_max: float
 ) -> tuple[tuple[float, float], ...]:
     """Closed time intervals within ``[0, t_max]`` when the bounding circles overlap.
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
+    a, b : ShapeLike
         The bodies at t = 0.
     motion_a, motion_b : Motion
         Their motions (about their area centroids).

@@ -123,7 +123,7 @@ def _run(family: str) -> None:
 
         for method in ("exact", "sampled"):
             first_impacts([Shape(sq), Shape(sq + (3.0, 0.0))], [Motion(velocity=(1.0, 0.0)),
-                          Motion()], 5.0, method=method, threads=1)
+                          Motion()], t_max=5.0, method=method, threads=1)
     else:
         raise ValueError(f"family: expected one of {', '.join(FAMILIES)}, got {family!r}")
 

@@ -336,7 +336,7 @@ def time_of_impact_many(
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
     ...                             [sq.moved((3, 0)), sq.moved((0, 5))], [Motion()] * 2, 5)
-    >>> batch.status.tolist(), batch.times.round(3).tolist()
+    >>> batch.statuses.tolist(), batch.times.round(3).tolist()
     ([1, 0], [2.0, nan])
     """
     from . import impacts

@@ -32,15 +32,20 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple, cast
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 import numpy.typing as npt
 
 from ._checks import point as point_arg
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, default_tolerance, snap_grid
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
+
+    from .relation import Relation
 
 __all__ = ["Component", "ComponentsAt", "Element", "EntranceBlock", "entrance_block"]
 
@@ -86,11 +91,19 @@ class Component:
         The closed region of reference-point positions: a Polygon (with holes when the
         body has holes), a MultiPolygon, a LineString for a zero-width parallelogram, or
         a GeometryCollection when a swept region has zero-width parts.
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> c = pc.entrance_block(a, a.moved((3, 0))).components[0]
+    >>> c.kind, c.family, c.label, c.geometry.area
+    ('A2-B0', 'A2-B0', 'E(A(2), B(0))[B vertex 0]', 1.0)
     """
 
     kind: str
     features: tuple[Element, ...]
-    geometry: Any
+    geometry: BaseGeometry
 
     @property
     def family(self) -> str:
@@ -143,6 +156,16 @@ class EntranceBlock:
     tolerance : float
         Absolute tolerance: zero-width parallelograms and "on the boundary" in
         :meth:`components_at`.
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> eb = pc.entrance_block(a, a.moved((3, 0)))
+    >>> eb
+    <EntranceBlock method='swept', components: A2-B0 4, A0-B2 4, A1-B1 4>
+    >>> eb.area, eb.classify(eb.reference).state.value
+    (4.0, 'separate')
     """
 
     a: Shape
@@ -153,18 +176,48 @@ class EntranceBlock:
     tolerance: float
 
     def of_family(self, family: str) -> tuple[Component, ...]:
-        """The components of one term of paper Eq. 1: "A2-B0", "A0-B2" or "A1-B1"."""
+        """The components of one term of paper Eq. 1.
+
+        Parameters
+        ----------
+        family : {"A2-B0", "A0-B2", "A1-B1"}
+
+        Returns
+        -------
+        tuple of Component
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> eb = pc.entrance_block(a, a.moved((3, 0)), method="pairs")
+        >>> len(eb.of_family("A1-B1")), eb.of_family("A0-B2")[0].label
+        (16, 'E(A(0), B(2))[A vertex 0]')
+        """
         if family not in set(FAMILIES.values()):
             raise ValueError(f"family must be one of 'A2-B0', 'A0-B2', 'A1-B1', got {family!r}")
         return tuple(c for c in self.components if c.family == family)
 
-    def to_shapely(self) -> Any:
+    def to_shapely(self) -> BaseGeometry:
         """The entrance block as one shapely (Multi)Polygon: the union of the components.
 
         Zero-width components are left out: each lies in the union of the others (an
         edge sliding along a parallel edge has an end vertex on the other edge). Holes
         and pieces no wider than the tolerance, which rounding can leave where many
         components meet, are dropped. Computed once, on first use.
+
+        Returns
+        -------
+        shapely geometry
+            A Polygon or MultiPolygon.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> region = pc.entrance_block(a, a.moved((3, 0))).to_shapely()
+        >>> region.geom_type, region.area, region.bounds
+        ('Polygon', 4.0, (2.5, -0.5, 4.5, 1.5))
         """
         return self._union
 
@@ -205,10 +258,13 @@ class EntranceBlock:
         """The entrance block as a JSON-ready dict: the object
         ``polycontact entrance-block --json`` prints.
 
-        Keys ``method``, ``reference`` (a0 as ``[x, y]``), ``components`` (the count of
-        each family, "A2-B0", "A0-B2", "A1-B1"), ``zero_width_components``, ``area``,
-        ``region`` (GeoJSON of :meth:`to_shapely`) and ``relation`` (the
-        :meth:`Relation.to_dict` of A and B at a0).
+        Returns
+        -------
+        dict
+            ``method``, ``reference`` (a0 as ``[x, y]``), ``components`` (the count of
+            each family, "A2-B0", "A0-B2", "A1-B1"), ``zero_width_components``,
+            ``area``, ``region`` (GeoJSON of :meth:`to_shapely`) and ``relation`` (the
+            :meth:`Relation.to_dict` of A and B at a0).
 
         Examples
         --------
@@ -230,12 +286,29 @@ class EntranceBlock:
             "relation": self.classify(self.reference).to_dict(),
         }
 
-    def plot(self, ax: Any = None) -> Any:
-        """Draw the entrance block; returns the matplotlib Axes of E(A, B).
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """Draw the entrance block.
 
-        Without ``ax``, the four panels of :func:`polycontact.plotting.plot_entrance_block`
-        (one per family, then the union) and the union's Axes is returned; with ``ax``,
-        only the union panel: B, A, E(A, B) with its outline and a0.
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Without it, the four panels of
+            :func:`polycontact.plotting.plot_entrance_block` (one per family, then the
+            union) in a new figure; with it, only the union panel: B, A, E(A, B) with
+            its outline and a0.
+
+        Returns
+        -------
+        matplotlib Axes
+            The Axes of E(A, B).
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> a = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> ax = pc.entrance_block(a, a.moved((3, 0))).plot()
+        >>> len(ax.figure.axes)
+        4
         """
         from .plotting.entrance_block import plot_entrance_block, plot_union
 
@@ -243,12 +316,23 @@ class EntranceBlock:
             return plot_entrance_block(self).axes[3]
         return plot_union(self, ax)
 
-    def classify(self, point: Any, *, tolerance: float | None = None) -> Any:
+    def classify(self, point: npt.ArrayLike, *, tolerance: float | None = None) -> Relation:
         """Relation of A, moved so that its reference point is at ``point``, to B.
 
         Exactly :func:`polycontact.classify` of ``a.moved(point - reference)`` and ``b``:
         penetrating when ``point`` is inside the entrance block, contact on its boundary
         (an exact fit included), separate outside.
+
+        Parameters
+        ----------
+        point : (x, y)
+            Where A's reference point goes.
+        tolerance : float, optional
+            As for :func:`polycontact.classify`.
+
+        Returns
+        -------
+        Relation
 
         Examples
         --------
@@ -262,12 +346,23 @@ class EntranceBlock:
 
         return classify(self.a.moved(point_arg(point, "point") - self.reference), self.b, tolerance=tolerance)
 
-    def components_at(self, point: Any) -> ComponentsAt:
+    def components_at(self, point: npt.ArrayLike) -> ComponentsAt:
         """The components that hold ``point`` in their interior or on their boundary.
 
         This is the paper's reading of the cover (for teaching and for the features);
         it is not a verdict: a point on the boundaries of several components can be
         inside their union. Use :meth:`classify` for the relation.
+
+        Parameters
+        ----------
+        point : (x, y)
+            A position of A's reference point.
+
+        Returns
+        -------
+        ComponentsAt
+            ``interior``: the components holding it inside; ``boundary``: those within
+            the tolerance of their outline.
 
         Examples
         --------
@@ -304,14 +399,14 @@ class EntranceBlock:
 
 
 def entrance_block(
-    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, b: ShapeLike, reference: npt.ArrayLike | None = None, *,
     method: str = "swept"
 ) -> EntranceBlock:
     """The entrance block of A to B and its components (paper §2.3–2.4).
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
+    a, b : ShapeLike
         The moving body A and the fixed body B.
     reference : array_like of shape (2,), optional
         The reference point a0 of A; default A's area centroid (paper Eq. 3–4).

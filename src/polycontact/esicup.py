@@ -66,6 +66,13 @@ class Instance:
         How many copies of each piece are to be placed.
     strip_height : float
         The height of the strip.
+
+    Examples
+    --------
+    >>> from polycontact import datasets
+    >>> inst = datasets.instance("jakobs1")
+    >>> inst.name, len(inst.pieces), inst.orientations[0]
+    ('jakobs1', 25, (0.0, 90.0, 180.0, 270.0))
     """
 
     name: str

@@ -1,18 +1,18 @@
 """Time of impact of two moving bodies: the paper's sampled search and a continuous one.
 
-Vocabulary (paper §5(1)): bodies **collide** when their interiors come to overlap
-(penetration). Touching without penetrating — sliding along each other (paper Fig. 16),
-or grazing a corner — is a **contact**, reported by ``first_contact`` while
-``collides`` stays False. A flush approach (paper Fig. 17) is a collision at the
-moment the edges meet: the interiors overlap right after.
+Bodies **collide** when their interiors come to overlap (penetration); touching without
+penetrating (sliding along each other, grazing a corner) is a **contact**, reported by
+``first_contact`` while ``collides`` stays False. :func:`time_of_impact` reports the
+first penetration located to within the time tolerance from above; the exact meaning,
+the method and its contract are in the theory page of the documentation.
 
-What ``time`` means: the first instant of penetration, located to within the time
-tolerance **from above**: the bodies penetrate at ``time`` (``state`` is PENETRATING)
-and do not at ``time_bracket[0]``, which is less than ``Impact.time_tolerance``
-earlier (``time_tolerance``, or the float spacing of t when that is coarser).
-``features``, ``point`` and ``normal`` describe the touching configuration at
-``time_bracket[0]``, the moment just before the interiors overlap (for ``"sampled"``:
-the penetrating configuration at ``time``, as the paper records it).
+Examples
+--------
+>>> from polycontact import Motion, Shape
+>>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+>>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(), t_max=5)
+>>> hit.collides, round(hit.time, 3)
+(True, 2.0)
 """
 
 from __future__ import annotations
@@ -31,11 +31,13 @@ from .broad_phase import (base_reach, check_motion, check_reach, check_t_max, in
                           reach_excess)
 from .motion import Motion
 from .relation import Feature, Relation, State, classify
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS,
                      RELATIVE_TOLERANCE, SAMPLES, TIME_TOLERANCE)
 from .tolerances import ROUNDING_FACTOR, check_range
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["Impact", "ImpactStatus", "time_of_impact", "CONTACT_RESOLUTION", "MAX_ITERATIONS"]
 
@@ -43,7 +45,13 @@ _METHODS = ("exact", "sampled")
 
 
 class ImpactStatus(str, enum.Enum):
-    """How a time-of-impact search ended."""
+    """How a time-of-impact search ended.
+
+    Examples
+    --------
+    >>> ImpactStatus("hit") is ImpactStatus.HIT, ImpactStatus.NO_HIT.value
+    (True, 'no-hit')
+    """
 
     #: The bodies penetrate: ``time`` is the first instant (to the tolerance).
     HIT = "hit"
@@ -113,6 +121,16 @@ class Impact:
         Contact point at the moment of impact (or of first contact).
     normal : ndarray of shape (2,) or None
         Unit contact normal there, from A towards B.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(), t_max=5)
+    >>> hit.collides, hit.status.value, round(hit.time, 3), hit.normal.tolist()
+    (True, 'hit', 2.0, [1.0, 0.0])
+    >>> [round(t, 3) for t in hit.broad_phase[0]], hit.time_bracket[0] < hit.time
+    ([1.586, 4.414], True)
     """
 
     collides: bool
@@ -249,10 +267,30 @@ class Impact:
             "searched_to": self.searched_to,
         }
 
-    def plot(self, ax: Any = None, *, names: tuple[str, str] = ("A", "B")) -> Any:
+    def plot(self, ax: Axes | None = None, *, names: tuple[str, str] = ("A", "B")) -> Axes:
         """Draw both bodies at t = 0 and at the event, their centroid paths and the
-        contact; returns the matplotlib Axes (see
-        :func:`polycontact.plotting.plot_impact`)."""
+        contact.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (see
+            :func:`polycontact.plotting.plot_impact`).
+        names : (str, str), default ("A", "B")
+            The bodies' names in the legend.
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> hit = time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)), Motion(),
+        ...                      t_max=5)
+        >>> ax = hit.plot(names=("red", "blue"))
+        """
         from .plotting.impact import plot_impact
 
         a, ma, b, mb, _ = self._bodies
@@ -308,9 +346,9 @@ def _relation_at(a: Shape, ma: Motion, b: Shape, mb: Motion, t: float, eps_rel: 
 
 
 def time_of_impact(
-    a: BodyLike,
+    a: ShapeLike,
     motion_a: Motion,
-    b: BodyLike,
+    b: ShapeLike,
     motion_b: Motion,
     *,
     t_max: float,
@@ -327,29 +365,28 @@ def time_of_impact(
     searched. ``method="exact"`` (default) is continuous and cannot miss a penetration
     deeper than the contact resolution; ``method="sampled"`` is the paper's §3 and can
     tunnel. Lengths and times are in any consistent units (those of the coordinates
-    and of the motions); the contract, the proof and the tolerances are under Notes.
+    and of the motions).
 
     Parameters
     ----------
-    a, b : body
-        The bodies at t = 0, holes allowed, in any form :func:`polycontact.bodies.as_shape`
-        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, body mapping, WKT, WKB).
+    a, b : ShapeLike
+        The shapes at t = 0, holes allowed, in any form :func:`polycontact.shape.as_shape`
+        takes (Shape, (N, 2) array, shapely Polygon, GeoJSON, vertices mapping, WKT, WKB).
     motion_a, motion_b : Motion
         Their motions about their area centroids.
     t_max : float
         End of the time window searched, in the motions' time unit: the search covers
         [0, ``t_max``]; a number >= 0.
-    method : {"exact", "sampled"}
+    method : {"exact", "sampled"}, default "exact"
         "exact": conservative advancement, never tunnels (see Notes). "sampled": the
         paper's §3 steps 3–6, ``samples`` points per round.
-    time_tolerance : float
-        Accuracy of ``time`` (default the paper's threshold,
-        :data:`~polycontact.limits.TIME_TOLERANCE`); any value > 0. Below what float64
+    time_tolerance : float, default :data:`~polycontact.limits.TIME_TOLERANCE`
+        Accuracy of ``time`` (the paper's threshold); any value > 0. Below what float64
         resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there, and the
         result's ``time_tolerance`` says so.
-    samples : int
+    samples : int, default :data:`~polycontact.limits.SAMPLES`
         Points per round of the sampled method (>= 2); ignored by "exact".
-    max_iterations : int
+    max_iterations : int, default :data:`~polycontact.limits.MAX_ITERATIONS`
         Budget of the exact method; when spent, the status is OUT_OF_ITERATIONS (no
         verdict), never a hang.
 
@@ -367,7 +404,7 @@ def time_of_impact(
         An invalid body (:class:`~polycontact.InvalidShapeError`), a bad ``t_max``,
         ``time_tolerance``, ``method``, ``samples`` or ``max_iterations``, or
         coordinates, speeds or accelerations that would overflow float64 within
-        [0, ``t_max``] (see ``tolerances.COORDINATE_LIMIT``).
+        [0, ``t_max``] (see :data:`~polycontact.limits.COORDINATE_LIMIT`).
 
     Examples
     --------
@@ -387,108 +424,9 @@ def time_of_impact(
 
     Notes
     -----
-    ``method="sampled"`` is the paper's §3 steps 3–6, literally: n = ``samples`` time
-    points over [T1, T2] including both ends (spacing (T2 − T1)/(n − 1)), the first
-    penetrating one t0, the new interval [t0 − (T2 − T1)/n, t0], until it is shorter
-    than ``time_tolerance``; ``time`` is T2. Note the paper shrinks by (T2 − T1)/n
-    although its samples are (T2 − T1)/(n − 1) apart, so the new T1 lies after the last
-    non-penetrating sample and is not known to be free of penetration; the result can
-    then be later than the true first penetration by up to one sample spacing. **It
-    can tunnel**: a penetration that starts and ends between two samples of the first
-    round is not seen (paper §5(3)), e.g. a fast-spinning thin bar clipping a body.
-
-    ``method="exact"`` (default) is continuous, by conservative advancement.
-    Why it cannot skip a contact: a point p of A moves as
-    p(t) = c_A(t) + R(θ_A(t)) r with ‖r‖ ≤ L_A, so for points p of A and q of B
-
-        ‖ṗ − q̇‖ ≤ ‖Δv + Δa t‖ + abs(ω_A + α_A t) L_A + abs(ω_B + α_B t) L_B =: s(t),
-
-    and each term is the norm of an affine function of t, so its maximum S over a
-    window [t, t + H] is at an end of the window (accelerations included, however
-    many turns the bodies make). The distance d(t) between the boundaries is a minimum
-    of distances ‖p(t) − q(t)‖ of material points, hence S-Lipschitz on the window:
-    the boundaries cannot meet before t + d(t)/S, and interiors cannot begin to overlap
-    without the boundaries meeting (at the first overlap the boundaries touch). So
-    each step min(H, d/S) lands no later than the first contact. The step actually
-    taken is longer and has the same guarantee: boundaries meet first where a vertex
-    reaches an edge, so it is enough that no vertex p comes within λ' of any edge e of
-    the other body (λ' = λ until the first contact is found, λ/64 after it, so that
-    fewer probes remain before the hit). Each such pair is held apart by a
-    second-order bound: along its fixed normal n (from the nearest point of e to p),
-    dist(p, e) ≥ min over the ends x of e of n·(p − x) (a straight edge lies between
-    its ends), and each n·(p − x) has its slope now known exactly (the velocities at t)
-    and its second derivative bounded by ‖Δa‖ + (abs(α_A) + ω_A²)‖r_p‖ + (abs(α_B) + ω_B²)‖r_x‖
-    over the window (p̈ = a + (α J − ω²) R r for a point of a turning body), so it
-    stays positive until the first root of g + r τ − K τ²/2; when p is outside the
-    edge's line, its distance to the line turning with e's body (in that body's frame,
-    with the Coriolis and centripetal terms) gives a second bound, and the plain
-    (d − λ')/S a third; the pair gets the longest. A separating or slowly closing pair
-    thus keeps long steps however fast the bodies spin. Pairs are found through a tree
-    of smallest enclosing circles over each body's edges: a pair of circles held apart
-    by the same second-order bound on their centres for the whole step stands for
-    every vertex–edge pair under it. The step is the least pair time, both ways.
-
-    Near contact the steps shrink fast (the bounds converge quadratically). After a
-    step to t + h that is shorter than the time tolerance or than a fifth of the step
-    before, the bodies are classified at t + h + 0.99 × the time tolerance:
-    penetrating there ends the search with ``time_bracket`` = (t + h, that time) — no
-    penetration began before t + h. Otherwise, below the probe length τ = λ / S, the
-    search steps by τ and classifies the end. A penetrating end is the hit: the probe
-    (non-penetrating start, penetrating end) is narrowed by bisection to the time
-    tolerance, which thus decides how precisely ``time`` is reported, never whether a
-    hit is found nor how many probes are taken. Not penetrating at the end means
-    either no penetration began in the probe, or one began and ended inside it with no
-    point moving more than λ relative to the other body: a penetration shallower than
-    the contact resolution λ. ``features``, ``point`` and ``normal`` are computed when
-    first asked for, from the bracket narrowed by the same search to τ, so that they
-    describe the touch and not a configuration up to a tolerance later.
-
-    **Tolerances are local to the time examined**, never scaled by ``t_max`` or by the
-    length of the travel: at time t the distance tolerance is
-    ``tolerance_for(extent, magnitude)`` (:mod:`polycontact.tolerances`) with the
-    bodies' size and a bound of their absolute coordinates over the step; the contact
-    resolution is λ = max(:data:`CONTACT_RESOLUTION` · (L_A + L_B), 128 · eps,
-    S · 4 · 2⁻⁵² · abs(t)) (well above the rounding of the coordinates, and at least the
-    distance moved in one float step of t); the time tolerance used at t is
-    max(``time_tolerance``, 4 · 2⁻⁵² · abs(t)) — a tolerance float64 cannot resolve at t is
-    clamped there, and :attr:`Impact.time_tolerance` says which one was honoured.
-
-    **Contract** (``method="exact"``): whatever the speed, spin, acceleration, travel
-    length or time tolerance,
-
-    - a penetration inside [0, t_max] deeper than the distance tolerance eps at its
-      time (1e-12 of the bodies' size, or 64 float spacings of their coordinates
-      there) is found, unless it both begins and ends within one probe — then it is
-      shallower than λ (1e-6 of L_A + L_B for bodies near the origin);
-    - ``time`` is within :attr:`Impact.time_tolerance` after the first such
-      penetration (an overlap within eps is contact, as in :func:`classify`);
-    - bodies already penetrating at t = 0 have status ``penetrating-at-start``;
-    - the answer does not depend on ``t_max`` beyond it (up to the time tolerance);
-    - shapes with coordinates beyond ``tolerances.COORDINATE_LIMIT``, and motions that
-      carry coordinates, point speeds or accelerations beyond it within [0, t_max],
-      are refused with an error naming the argument (float64 products would
-      overflow); they are never answered wrongly.
-
-    A sliding contact (paper Fig. 16) is followed by long steps, not probes. Once the
-    bodies touch, each step holds the touching vertex–edge pairs (those within λ/64)
-    differently: every other pair must stay apart, as before, and every touching pair
-    must keep its vertex no more than the rounding tolerance behind its edge's turning
-    line (second-order bound). An overlap can only begin where a vertex crosses an
-    edge, so none begins; this follows a translating body along an edge, under an
-    overhang or not. Where that step is still short (at a corner, where a vertex must
-    stay in front of both edges' lines), the line ℓ of a touching edge e of body E
-    (turning with E) is tried as a separator. If every vertex of E lies behind ℓ, E
-    stays behind it (it is rigid); each edge of the other body V is charged the time
-    during which both its ends stay on or in front of ℓ (at their rate towards the
-    turning line) or it stays outside E's bounding circle. Until the least of these
-    times no edge of V meets W = (open half-plane behind ℓ) ∩ (open circle), a convex
-    set moving with E that holds E's interior; a point of E's interior is outside V now
-    (no penetration) and cannot cross V's boundary, so W and V stay disjoint: no
-    penetration can begin. (Both certificates allow the rounding tolerance, so an
-    overlap thinner than that is not looked for; it is contact.) When both fail (a
-    contact that lasts while the bodies turn), the touch is stepped through by probes;
-    the number of iterations is bounded by ``max_iterations`` (status
-    OUT_OF_ITERATIONS, never a hang).
+    What ``time`` means, the proof that the exact method cannot skip a penetration, how
+    it follows a sliding contact, its tolerances and its contract are in the theory
+    page of the documentation (:doc:`/theory`, "Time of impact").
     """
     # Shapes and Motions (a simulation's loop) pass as they are; their arrays have the
     # types the compiled code was found for (see :mod:`polycontact._dispatch`)

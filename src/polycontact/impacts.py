@@ -1,17 +1,21 @@
 """Time of impact for many pairs, and the first impacts among many moving bodies.
 
-:func:`time_of_impact_many` answers a list of pairs the caller chose; :func:`first_impacts`
-finds, among N moving bodies, every pair that meets within ``[0, t_max]`` without
-looking at all N(N − 1)/2 pairs: each body's swept region over ``[0, t_max]`` is bounded
-by space–time boxes (its bounding circle along its centroid's path, one box per time
-slice, :func:`polycontact._kernels.swept.swept_boxes`), a compiled sort-and-sweep lists
-the pairs whose boxes meet, and only those go to the exact search. Both run the pairs on
-threads (the compiled searches release the GIL), and every answer agrees with the one
-:func:`polycontact.time_of_impact` gives for that pair: the same kernel with the same
-arguments (the same status and state, times within the time tolerance; usually equal bit
-for bit, but the kernel compiled inside the batch loop may round a last place
-differently, which can take a search down another, equally valid path), and pairs the boxes leave out are pairs whose bounding circles never meet in
-``[0, t_max]`` (``time_of_impact`` reports nothing for them either).
+:func:`time_of_impact_many` answers a list of pairs the caller chose;
+:func:`first_impacts` finds, among N moving bodies, every pair that meets within
+``[0, t_max]`` without looking at all N(N − 1)/2 pairs (swept bounds, then a
+sort-and-sweep: :func:`candidate_pairs`). Both run the pairs on threads, and every
+answer agrees with the one :func:`polycontact.time_of_impact` gives for that pair (the
+same status and state, times within the time tolerance; the theory page of the
+documentation says why, under "Many moving bodies").
+
+Examples
+--------
+>>> from polycontact import Motion, Shape
+>>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+>>> [(e.i, e.j) for e in first_impacts([sq, sq.moved((3, 0)), sq.moved((0, 9))],
+...                                    [Motion(velocity=(1, 0)), Motion(), Motion()],
+...                                    t_max=5)]
+[(0, 1)]
 """
 
 from __future__ import annotations
@@ -31,8 +35,7 @@ from .impact import Impact, ImpactStatus, body_frame, check_options, impact_from
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS, MAX_SLICES,
                      RELATIVE_TOLERANCE, SAMPLES, SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
-from .bodies import as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR
 
 __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
@@ -46,34 +49,68 @@ class ImpactBatch:
 
     Attributes
     ----------
-    status : ndarray of shape (P,), int8
+    statuses : ndarray of shape (P,), int8
         0 no hit, 1 hit, 2 penetrating at the start, 3 out of iterations (the codes
         of the compiled search; ``impact(k).status`` is the matching
         :class:`~polycontact.ImpactStatus`).
     collides : ndarray of shape (P,), bool
-        ``status == 1``.
+        ``statuses == 1``.
     times : ndarray of shape (P,), float64
         First penetration time of a hit, NaN otherwise.
     first_contacts : ndarray of shape (P,), float64
         ``Impact.first_contact`` (0 when penetrating at the start), NaN when None.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
+    ...                             [sq.moved((3, 0)), sq.moved((0.5, 0))], [Motion()] * 2,
+    ...                             t_max=5)
+    >>> len(batch), batch.statuses.tolist(), batch.first_contacts.round(3).tolist()
+    (2, [1, 2], [2.0, 0.0])
     """
 
-    status: np.ndarray
+    statuses: np.ndarray
     collides: np.ndarray
     times: np.ndarray
     first_contacts: np.ndarray
     _make: Callable[[int], Impact] = field(repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for array in (self.status, self.collides, self.times, self.first_contacts):
+        for array in (self.statuses, self.collides, self.times, self.first_contacts):
             array.flags.writeable = False  # a result cannot be changed
 
     def __len__(self) -> int:
-        return int(self.status.shape[0])
+        return int(self.statuses.shape[0])
 
     def impact(self, k: int) -> Impact:
         """The :class:`~polycontact.Impact` of pair ``k``, agreeing with what
-        :func:`polycontact.time_of_impact` returns for it (see the module docstring)."""
+        :func:`polycontact.time_of_impact` returns for it (see the module docstring).
+
+        Parameters
+        ----------
+        k : int
+            A pair index, from ``-len(batch)`` to ``len(batch) - 1``.
+
+        Returns
+        -------
+        Impact
+
+        Raises
+        ------
+        IndexError
+            ``k`` is not a pair index.
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> batch = time_of_impact_many([sq], [Motion(velocity=(1, 0))],
+        ...                             [sq.moved((3, 0))], [Motion()], t_max=5)
+        >>> batch.impact(0).status.value, batch.impact(-1).collides
+        ('hit', True)
+        """
         n = len(self)
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
             raise IndexError(f"k: expected a pair index in [0, {n}), got {k!r}")
@@ -84,10 +121,29 @@ class ImpactBatch:
 
 
 class PairImpact(NamedTuple):
-    """One pair's first impact in :func:`first_impacts`: the two bodies' indices in the
-    caller's numbering (``i < j``; body i is ``a`` of the impact) and the
-    :class:`~polycontact.Impact` of ``time_of_impact(shapes[i], motions[i], shapes[j],
-    motions[j])``."""
+    """One pair of moving bodies that meets, and how: an entry of the answers of
+    :func:`first_impacts`, :func:`first_impact`, :meth:`polycontact.World.first_impacts`
+    and :meth:`polycontact.Scene.impacts`.
+
+    Attributes
+    ----------
+    i, j : int
+        The two bodies in the caller's numbering, ``i < j``: their indices in the
+        sequences given to :func:`first_impacts` or in :attr:`polycontact.Scene.bodies`,
+        their ids in a :class:`polycontact.World`. Body ``i`` is ``a`` of the impact.
+    impact : Impact
+        What :func:`polycontact.time_of_impact` answers for body ``i`` against body
+        ``j``.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> event = first_impact([sq, sq.moved((3, 0))], [Motion(velocity=(1, 0)), Motion()],
+    ...                      t_max=5)
+    >>> event.i, event.j, round(event.impact.time, 3)
+    (0, 1, 2.0)
+    """
 
     i: int
     j: int
@@ -319,7 +375,7 @@ def time_of_impact_many(
     >>> batch = time_of_impact_many([sq, sq], [Motion(velocity=(1, 0))] * 2,
     ...                             [sq.moved((3, 0)), sq.moved((0, 5))], [Motion()] * 2,
     ...                             t_max=5)
-    >>> batch.collides.tolist(), batch.times.round(3).tolist(), batch.status.tolist()
+    >>> batch.collides.tolist(), batch.times.round(3).tolist(), batch.statuses.tolist()
     ([True, False], [2.0, nan], [1, 0])
     >>> batch.impact(0).status.value
     'hit'
@@ -385,7 +441,7 @@ def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Moti
     make = _maker(lambda p, s: pairs[s][p], lambda p, s: moves[s][p], raw, t_max, method,
                   eps_rel, tol)
     return ImpactBatch(
-        status=code,
+        statuses=code,
         collides=collides,
         times=np.where(collides, t_hi, np.nan),
         first_contacts=np.where(code == 2, 0.0, np.where(contact >= 0.0, contact, np.nan)),
@@ -394,23 +450,40 @@ def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Moti
 
 
 # -- many moving bodies ----------------------------------------------------------------
-def candidate_pairs(shapes: Sequence[Shape], motions: Sequence[Motion],
+def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
                     t_max: float) -> np.ndarray:
-    """Pairs ``(i, j)``, i < j, whose swept bounds over ``[0, t_max]`` meet: a superset of
-    the pairs whose bounding circles come within reach of each other in that window,
-    hence of every pair that can touch. Shape (K, 2), sorted, int64. The boxes are
-    widened as :func:`polycontact.time_of_impact`'s broad phase widens the circles (a
-    relative inflation and the rounding of positions far from the origin), so every
-    pair it would search is here. Motions it refuses (coordinates, speeds or
-    accelerations that would overflow float64) are refused here too, naming
-    ``motions[k]``.
+    """Pairs of moving bodies whose swept bounds over ``[0, t_max]`` meet: the pairs
+    :func:`first_impacts` searches.
+
+    A superset of the pairs whose bounding circles come within reach of each other in
+    the window, hence of every pair that can touch. The boxes are widened as
+    :func:`polycontact.time_of_impact`'s broad phase widens the circles (a relative
+    inflation and the rounding of positions far from the origin), so every pair it would
+    search is here.
+
+    Parameters
+    ----------
+    shapes, motions, t_max
+        As for :func:`first_impacts`: the bodies at t = 0, one motion per body, the end
+        of the time window.
+
+    Returns
+    -------
+    ndarray of shape (K, 2), int64
+        Pairs ``(i, j)``, ``i < j``, sorted.
+
+    Raises
+    ------
+    TypeError, ValueError, InvalidShapeError
+        As :func:`first_impacts`, naming ``shapes[k]`` or ``motions[k]``.
 
     Examples
     --------
     >>> from polycontact import Motion, Shape
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> shapes = [sq, sq.moved((3, 0)), sq.moved((0, 30))]
-    >>> candidate_pairs(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5).tolist()
+    >>> motions = [Motion(velocity=(1, 0)), Motion(), Motion()]
+    >>> candidate_pairs(shapes, motions, t_max=5).tolist()
     [[0, 1]]
     """
     shapes = check_shapes(shapes, "shapes")
@@ -435,10 +508,22 @@ def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.
 
 
 def event_time(impact: Impact) -> float:
-    """When a pair's event happens: 0 when penetrating at the start, the first
-    penetration time of a hit, the time the search stopped when it ran out of
-    iterations, else the first contact (inf when the bodies never touch).
+    """When a pair's event happens: the time :func:`first_impacts` sorts by.
 
+    Parameters
+    ----------
+    impact : Impact
+        The pair's answer.
+
+    Returns
+    -------
+    float
+        0 when penetrating at the start, the first penetration time of a hit, the time
+        the search stopped when it ran out of iterations, else the first contact (inf
+        when the bodies never touch).
+
+    Examples
+    --------
     >>> from polycontact import Motion, Shape, time_of_impact
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> round(event_time(time_of_impact(sq, Motion(velocity=(1, 0)), sq.moved((3, 0)),
@@ -455,10 +540,10 @@ def event_time(impact: Impact) -> float:
 
 
 def first_impacts(
-    shapes: Any,
-    motions: Any,
-    t_max: float,
+    shapes: Sequence[ShapeLike],
+    motions: Sequence[Motion],
     *,
+    t_max: float,
     method: str = "exact",
     time_tolerance: float = TIME_TOLERANCE,
     samples: int = SAMPLES,
@@ -484,21 +569,27 @@ def first_impacts(
 
     Parameters
     ----------
-    shapes : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
+    shapes : sequence of ShapeLike
         The bodies at t = 0.
     motions : sequence of Motion
         One per body.
     t_max : float
         End of the time window (>= 0).
-    method, time_tolerance, samples, max_iterations
+    method : {"exact", "sampled"}, default "exact"
         As for :func:`polycontact.time_of_impact`.
+    time_tolerance : float, default :data:`~polycontact.limits.TIME_TOLERANCE`
+        As for :func:`polycontact.time_of_impact`.
+    samples : int, default :data:`~polycontact.limits.SAMPLES`
+        As for :func:`polycontact.time_of_impact`.
+    max_iterations : int, default :data:`~polycontact.limits.MAX_ITERATIONS`
+        As for :func:`polycontact.time_of_impact`, per pair.
     threads : int, optional
-        Threads for the exact searches (default: one per CPU).
+        Threads for the searches (default: one per CPU).
 
     Returns
     -------
     list of PairImpact
-        ``(i, j, impact)`` named tuples.
+        ``(i, j, impact)`` records.
 
     Raises
     ------
@@ -558,25 +649,49 @@ def _first_order(event: PairImpact) -> tuple[Any, ...]:
 
 
 def first_impact(
-    shapes: Any,
-    motions: Any,
+    shapes: Sequence[ShapeLike],
+    motions: Sequence[Motion],
+    *,
     t_max: float,
-    **options: Any,
+    method: str = "exact",
+    time_tolerance: float = TIME_TOLERANCE,
+    samples: int = SAMPLES,
+    max_iterations: int = MAX_ITERATIONS,
+    threads: int | None = None,
 ) -> PairImpact | None:
-    """The first event among many moving bodies: the earliest collision (a pair
-    penetrating at the start counts at t = 0, a search without a verdict at the time it
-    stopped), or, if no pair collides, the earliest touch; None when no pair meets.
-    This is the order of :meth:`polycontact.Scene.first_impact`; ties go to the lowest
-    ``(i, j)``. ``options`` are those of :func:`first_impacts`.
+    """The first event among many moving bodies.
+
+    The earliest collision (a pair penetrating at the start counts at t = 0, a search
+    without a verdict at the time it stopped), or, if no pair collides, the earliest
+    touch; ties go to the lowest ``(i, j)``. This is the order of
+    :meth:`polycontact.Scene.first_impact`.
+
+    Parameters
+    ----------
+    shapes, motions, t_max, method, time_tolerance, samples, max_iterations, threads
+        As for :func:`first_impacts`.
+
+    Returns
+    -------
+    PairImpact or None
+        ``(i, j, impact)``, or None when no pair meets within ``[0, t_max]``.
+
+    Raises
+    ------
+    TypeError, ValueError, InvalidShapeError
+        As :func:`first_impacts`.
 
     Examples
     --------
     >>> from polycontact import Motion, Shape
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
     >>> shapes = [sq, sq.moved((3, 0)), sq.moved((1.5, 1))]
-    >>> i, j, imp = first_impact(shapes, [Motion(velocity=(1, 0)), Motion(), Motion()], 5)
+    >>> motions = [Motion(velocity=(1, 0)), Motion(), Motion()]
+    >>> i, j, imp = first_impact(shapes, motions, t_max=5)
     >>> i, j, round(imp.time, 3)
     (0, 1, 2.0)
     """
-    events = first_impacts(shapes, motions, t_max, **options)
+    events = first_impacts(shapes, motions, t_max=t_max, method=method,
+                           time_tolerance=time_tolerance, samples=samples,
+                           max_iterations=max_iterations, threads=threads)
     return min(events, key=_first_order) if events else None

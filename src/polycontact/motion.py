@@ -89,10 +89,32 @@ class Motion:
         object.__setattr__(self, "_largest", max(self._norms))
 
     def pose(self, t: float) -> tuple[np.ndarray, float]:
-        """``(translation, angle)`` at time ``t``: centroid displacement and rotation.
+        """Where the motion has taken a body at time ``t``.
 
-        The placed body is the body at t = 0 rotated by ``angle`` about its centroid,
-        then translated by ``translation`` (what :meth:`polycontact.Shape.moved` does).
+        Parameters
+        ----------
+        t : float
+            The time (finite).
+
+        Returns
+        -------
+        translation : ndarray of shape (2,)
+            The centroid's displacement, ``v t + a t² / 2``.
+        angle : float
+            The turn, ``ω t + α t² / 2`` radians. The placed body is the body at t = 0
+            rotated by ``angle`` about its centroid, then translated by
+            ``translation`` (what :meth:`polycontact.Shape.moved` does).
+
+        Raises
+        ------
+        ValueError
+            ``t`` is not finite, or the motion carries the body beyond ±1e100 by then.
+
+        Examples
+        --------
+        >>> translation, angle = Motion(velocity=(1, 0), angular_velocity=0.5).pose(2.0)
+        >>> translation.tolist(), angle
+        ([2.0, 0.0], 1.0)
         """
         t = finite_number(t, "t")
         v = np.asarray(self.velocity)

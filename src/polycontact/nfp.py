@@ -51,12 +51,17 @@ import shapely.affinity
 from ._checks import finite_number
 from ._checks import point as point_arg
 from ._pieces import pieces_of_geometry, pieces_packed
-from .bodies import BodyLike, as_shape
 from .errors import InvalidShapeError, NfpTooLargeError
 from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR, MAX_SUM_VERTICES,
                      RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, snap_grid, tolerance_for
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
+
+    from .relation import State
 
 __all__ = ["NoFitPolygon", "no_fit_polygon", "inner_fit_polygon", "fallback_count"]
 
@@ -116,10 +121,9 @@ class NoFitPolygon:
     ``region`` is built on first access and cached: :func:`no_fit_polygon` keeps the
     outline's rings as its kernel returned them (private arrays) and makes the Shapely
     geometry only when asked for it, as a nesting code that tests a few placements
-    against most of its no-fit polygons never needs (building it was about a third of
-    a small NFP's time). The object is immutable, so the cached geometry cannot go
-    stale; pickling and copying carry the built geometry. The coordinates are also
-    offered as data, without a geometry: :attr:`rings`.
+    against most of its no-fit polygons never needs. The object is immutable, so the
+    cached geometry cannot go stale; pickling and copying carry the built geometry. The
+    coordinates are also offered as data, without a geometry: :attr:`rings`.
 
     Attributes
     ----------
@@ -140,9 +144,18 @@ class NoFitPolygon:
         The orbiting and the fixed shape.
     tolerance : float
         Absolute distance tolerance used.
+
+    Examples
+    --------
+    >>> import polycontact as pc
+    >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> slot = pc.Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)])
+    >>> nfp = pc.no_fit_polygon(sq, slot, reference="origin")
+    >>> nfp.region.area, nfp.exact_fits.tolist(), nfp.slides.tolist()
+    (16.0, [], [[[1.0, 1.0], [1.0, 3.0]]])
     """
 
-    region: Any
+    region: BaseGeometry
     exact_fits: np.ndarray
     slides: np.ndarray
     reference: np.ndarray
@@ -185,6 +198,10 @@ class NoFitPolygon:
 
         A region of one ring (the common case) is given without building ``region``.
 
+        Returns
+        -------
+        tuple of ndarray of shape (n, 2)
+
         Examples
         --------
         >>> import polycontact as pc
@@ -208,13 +225,23 @@ class NoFitPolygon:
                 out.append(xy)
         return tuple(out)
 
-    def contains(self, point: Any, *, tolerance: float | None = None) -> Any:
-        """How A placed with its reference at ``point`` relates to B: a ``State``.
+    def contains(self, point: npt.ArrayLike, *, tolerance: float | None = None) -> State:
+        """How A placed with its reference at ``point`` relates to B.
 
-        The answer of :func:`polycontact.classify` (same ``tolerance``) for A moved so
-        that its reference is at ``point``, against B:
-        ``PENETRATING`` inside the region (except on exact fits and slides),
-        ``CONTACT`` on its boundary, exact fits and slides, ``SEPARATE`` outside.
+        Parameters
+        ----------
+        point : (x, y)
+            Where A's reference point goes.
+        tolerance : float, optional
+            As for :func:`polycontact.classify`.
+
+        Returns
+        -------
+        State
+            The state :func:`polycontact.classify` gives for A moved so that its
+            reference is at ``point``, against B: ``PENETRATING`` inside the region
+            (except on exact fits and slides), ``CONTACT`` on its boundary, exact fits
+            and slides, ``SEPARATE`` outside.
 
         Examples
         --------
@@ -231,7 +258,7 @@ class NoFitPolygon:
         return classify(moved, self.b, tolerance=tolerance).state
 
     @property
-    def outline(self) -> Any:
+    def outline(self) -> BaseGeometry:
         """The region's boundary (every ring) as a shapely geometry."""
         return self.region.boundary
 
@@ -245,9 +272,12 @@ class NoFitPolygon:
         """The no-fit polygon as a JSON-ready dict: the object ``polycontact nfp --json``
         prints.
 
-        Keys ``reference`` (``[x, y]``), ``region`` (GeoJSON), ``area``, ``holes`` (their
-        number), ``exact_fits`` (``[[x, y], ...]``), ``slides`` (``[[[x0, y0], [x1, y1]],
-        ...]``) and ``tolerance``.
+        Returns
+        -------
+        dict
+            ``reference`` (``[x, y]``), ``region`` (GeoJSON), ``area``, ``holes`` (their
+            number), ``exact_fits`` (``[[x, y], ...]``), ``slides`` (``[[[x0, y0],
+            [x1, y1]], ...]``) and ``tolerance``.
 
         Examples
         --------
@@ -269,24 +299,43 @@ class NoFitPolygon:
             "tolerance": float(self.tolerance),
         }
 
-    def plot(self, ax: Any = None, *, placement: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None, *,
+             placement: npt.ArrayLike | None = None) -> Axes:
         """Draw B, the region with its holes, exact fits and slides, and A at
-        ``placement``; returns the matplotlib Axes (see
-        :func:`polycontact.plotting.plot_nfp`)."""
+        ``placement``.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted.
+        placement : (x, y), optional
+            Where A's reference point is drawn (see
+            :func:`polycontact.plotting.plot_nfp`).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> ax = pc.no_fit_polygon(sq, sq.moved((3, 0))).plot(placement=(2.5, 0.5))
+        """
         from .plotting.nfp import plot_nfp
 
         return plot_nfp(self, placement, ax)
 
 
 def no_fit_polygon(
-    a: BodyLike, b: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, b: ShapeLike, reference: npt.ArrayLike | None = None, *,
     tolerance: float | None = None
 ) -> NoFitPolygon:
     """No-fit polygon of ``a`` orbiting the fixed ``b``.
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon or array_like of shape (N, 2)
+    a, b : ShapeLike
         The orbiting and the fixed shape; holes allowed.
     reference : None, "centroid", "origin" or array_like of shape (2,)
         A's reference point: its area centroid (default), the origin (plain
@@ -362,9 +411,9 @@ _set_dict = object.__setattr__
 
 
 def inner_fit_polygon(
-    a: BodyLike, container: BodyLike, reference: npt.ArrayLike | None = None, *,
+    a: ShapeLike, container: ShapeLike, reference: npt.ArrayLike | None = None, *,
     tolerance: float | None = None
-) -> Any:
+) -> BaseGeometry:
     """Reference positions at which ``a`` lies inside ``container`` (touching allowed).
 
     The inner-fit polygon of nesting: with ``container`` a bin (or a hole, passed as a
@@ -376,7 +425,7 @@ def inner_fit_polygon(
 
     Parameters
     ----------
-    a, container : Shape, shapely Polygon or array_like of shape (N, 2)
+    a, container : ShapeLike
     reference, tolerance :
         As in :func:`no_fit_polygon`.
 

@@ -80,8 +80,7 @@ from . import __version__
 from ._json import load_json
 from .esicup import Instance, turned
 from .nfp import NoFitPolygon, no_fit_polygon
-from .bodies import as_shape
-from .shape import Shape
+from .shape import Shape, as_shape
 
 __all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_POOL_MIN_ENTRIES"]
 

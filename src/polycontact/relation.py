@@ -27,15 +27,14 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Generic, TypeVar, cast, overload
+from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast, overload
 
 import numpy as np
 
 from ._checks import finite_number
 from ._dispatch import entry_point
 from .errors import InvalidShapeError
-from .bodies import BodyLike, as_shape
-from .shape import Shape
+from .shape import Shape, ShapeLike, as_shape
 from .tolerances import (
     COORDINATE_LIMIT,
     EXTENT_FLOOR,
@@ -43,11 +42,23 @@ from .tolerances import (
     ROUNDING_ULPS,
 )
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
 __all__ = ["State", "Feature", "Relation", "RelationBatch", "classify", "classify_many"]
 
 
 class State(str, enum.Enum):
-    """How two bodies lie: apart, touching, or with overlapping interiors."""
+    """How two bodies lie: apart, touching, or with overlapping interiors.
+
+    Arrays of states use the codes 0 separate, 1 contact, 2 penetrating (the order of
+    the members).
+
+    Examples
+    --------
+    >>> [s.value for s in State], State("contact") is State.CONTACT
+    (['separate', 'contact', 'penetrating'], True)
+    """
 
     SEPARATE = "separate"
     CONTACT = "contact"
@@ -154,7 +165,12 @@ class Feature:
     own_edge: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The feature as a JSON-ready dict (``own_edge`` only for an edge crossing).
+        """The feature as a JSON-ready dict.
+
+        Returns
+        -------
+        dict
+            The attributes by name (``own_edge`` only for an edge crossing).
 
         Examples
         --------
@@ -201,14 +217,23 @@ class Relation:
         the direction opposite the smallest separating translation of A. Separate: None.
     escape : ndarray of shape (2,) or None
         Penetrating only: the smallest translation of A that ends the overlap.
+
+    Examples
+    --------
+    >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    >>> r = classify(sq, [(0.75, 0), (2, 0), (2, 1), (0.75, 1)])
+    >>> r
+    Relation(state='penetrating', tolerance=1.25e-12)
+    >>> r.distance, r.normal.tolist(), r.escape.tolist()
+    (-0.25, [1.0, 0.0], [-0.25, 0.0])
     """
 
-    # Built by classify with four slot stores (a frozen dataclass's instance dict cost
-    # 0.15-0.2 us more per call, a sixth of classify on two prebuilt 12-gons taking
-    # turns with GEOS); nothing can be changed: ``state`` and ``tolerance`` are
-    # properties without setters, the lazy parts are cached in ``_cache`` and there is
-    # no instance dict to add attributes to. ``_a`` and ``_b`` are the bodies (a Shape,
-    # or the bytes, vertex count and orientation of a raw ring).
+    # Built by classify with four slot stores (a frozen dataclass's instance dict is a
+    # noticeable part of the cost of classify on two small prebuilt shapes); nothing can
+    # be changed: ``state`` and ``tolerance`` are properties without setters, the lazy
+    # parts are cached in ``_cache`` and there is no instance dict to add attributes to.
+    # ``_a`` and ``_b`` are the bodies (a Shape, or the bytes, vertex count and
+    # orientation of a raw ring).
     __slots__ = ("_state", "_tolerance", "_a", "_b", "_cache")
     _state: State
     _tolerance: float
@@ -240,10 +265,14 @@ class Relation:
         """The relation as a JSON-ready dict: the object ``polycontact classify --json``
         prints.
 
-        Keys ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
-        ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``. Only what is
-        returned is computed: separate bodies have no features (nothing touches), so
-        their feature search is skipped.
+        Only what is returned is computed: separate bodies have no features (nothing
+        touches), so their feature search is skipped.
+
+        Returns
+        -------
+        dict
+            ``state``, ``distance``, ``features`` (each :meth:`Feature.to_dict`),
+            ``point``, ``normal`` (``[x, y]`` or None) and ``tolerance``.
 
         Examples
         --------
@@ -265,7 +294,7 @@ class Relation:
             "tolerance": float(self.tolerance),
         }
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """Draw both bodies, the witness point and the normal; returns the matplotlib Axes.
 
         Parameters
@@ -508,13 +537,14 @@ _state_into: Callable[[bytes, bytes, float], int] = _bind_state_into
 _state_full: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], int] = (
     _bind_state_full)
 
-def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Relation:
+def classify(a: ShapeLike, b: ShapeLike, *, tolerance: float | None = None) -> Relation:
     """Classify two bodies: separate, contact or penetrating.
 
     Parameters
     ----------
-    a, b : Shape, shapely Polygon, or array_like of shape (N, 2)
-        The bodies. An array is an outer loop (closed or not, either orientation).
+    a, b : ShapeLike
+        The bodies, in any form :func:`polycontact.shape.as_shape` takes. An array is an
+        outer loop (closed or not, either orientation).
         C-contiguous float64 arrays take a lean path: one compiled call validates both
         rings and classifies them; a ring it cannot certify (an invalid one, or a valid
         one with features closer than the tolerance) goes through :class:`Shape`, which
@@ -552,8 +582,8 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
         # types: see polycontact._dispatch) with one bytes object per shape (its kernel
         # pack, which holds its bounding box and its default-tolerance term too: -1.0
         # asks the kernel for the larger of the two, so that no float object of the
-        # shapes is read here; reading them cost 0.1 us when GEOS had emptied the
-        # caches); its scratch is on its stack (nothing allocated).
+        # shapes is read here: reading them is slow when GEOS has emptied the caches);
+        # its scratch is on its stack (nothing allocated).
         eps = -1.0 if tolerance is None else _check_tolerance(tolerance)
         code = _state_into(a._kernel, b._kernel, eps)
         if code < 0:  # more vertices than the stack scratch holds
@@ -569,7 +599,7 @@ def classify(a: BodyLike, b: BodyLike, *, tolerance: float | None = None) -> Rel
     return _classify_other(a, b, tolerance)
 
 
-def _classify_other(a: BodyLike, b: BodyLike, tolerance: float | None) -> Relation:
+def _classify_other(a: ShapeLike, b: ShapeLike, tolerance: float | None) -> Relation:
     """:func:`classify` of bodies that are not both Shapes (and its first call)."""
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
     if (
@@ -611,6 +641,13 @@ class RelationBatch:
     distances : ndarray of shape (P,), float64
         Signed distances as in :attr:`Relation.distance`; computed (in parallel) on
         first access and cached.
+
+    Examples
+    --------
+    >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    >>> batch = classify_many([sq, sq], [[(1, 0), (2, 0), (2, 1)], [(3, 0), (4, 0), (4, 1)]])
+    >>> batch.states.tolist(), batch.distances.tolist(), batch.state(1)
+    ([1, 0], [0.0, 2.0], <State.SEPARATE: 'separate'>)
     """
 
     states: np.ndarray
@@ -621,7 +658,24 @@ class RelationBatch:
         return int(self.states.shape[0])
 
     def state(self, i: int) -> State:
-        """The :class:`State` of pair ``i``."""
+        """The :class:`State` of one pair.
+
+        Parameters
+        ----------
+        i : int
+            A pair index.
+
+        Returns
+        -------
+        State
+            ``State`` of ``states[i]``.
+
+        Examples
+        --------
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> classify_many([sq], [[(0.5, 0), (2, 0), (2, 1)]]).state(0)
+        <State.PENETRATING: 'penetrating'>
+        """
         return _STATES[int(self.states[i])]
 
     def __post_init__(self) -> None:
@@ -715,8 +769,8 @@ def _classify_arrays(
 class _BufferPool:
     """Float64 buffers for the copies of :func:`classify_many`'s ring arrays, reused once
     the batch that held one is gone. A fresh array of tens of megabytes has its pages
-    mapped on first touch, which cost a fifth of a batch's classification (100 000 pairs
-    of 12-gons: 7 of 35 ms); a loop of batches reuses the same few buffers instead.
+    mapped on first touch, a sizeable part of a batch's classification; a loop of
+    batches reuses the same few buffers instead.
 
     >>> pool = _BufferPool()
     >>> b = pool.take(10); pool.give(b); pool.take(8) is b
@@ -819,7 +873,7 @@ def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[A
 
 
 def classify_many(
-    shapes_a: Sequence[BodyLike] | np.ndarray, shapes_b: Sequence[BodyLike] | np.ndarray, *,
+    shapes_a: Sequence[ShapeLike] | np.ndarray, shapes_b: Sequence[ShapeLike] | np.ndarray, *,
     tolerance: float | None = None
 ) -> RelationBatch:
     """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.

@@ -25,15 +25,15 @@ from typing import Any
 
 from ._checks import shown
 from ._json import load_json
-from .bodies import as_shape
 from .broad_phase import check_reach
 from .errors import InvalidSceneError, InvalidShapeError
-from .impact import Impact, ImpactStatus, time_of_impact
-from .limits import SAMPLES, TIME_TOLERANCE
+from .impact import time_of_impact
+from .impacts import PairImpact, first_impact, first_impacts
+from .limits import MAX_ITERATIONS, SAMPLES, TIME_TOLERANCE
 from .motion import Motion
-from .shape import Shape
+from .shape import Shape, as_shape
 
-__all__ = ["Body", "Scene", "load_scene"]
+__all__ = ["SceneBody", "Scene", "load_scene"]
 
 _TOP_KEYS = {"t_max", "bodies", "time_tolerance", "description"}
 _BODY_KEYS = {
@@ -44,8 +44,25 @@ _BODY_KEYS = {
 
 
 @dataclass(frozen=True)
-class Body:
-    """A named shape and its motion."""
+class SceneBody:
+    """One body of a :class:`Scene`: a named shape and its motion.
+
+    Attributes
+    ----------
+    name : str
+        Unique in its scene (``"body<k>"`` when the file gives none).
+    shape : Shape
+        The body at t = 0.
+    motion : Motion
+        How it moves about its area centroid.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> body = SceneBody("red", Shape([(0, 0), (1, 0), (0, 1)]), Motion(velocity=(1, 0)))
+    >>> body.name, body.motion.velocity
+    ('red', (1.0, 0.0))
+    """
 
     name: str
     shape: Shape
@@ -54,27 +71,63 @@ class Body:
 
 @dataclass(frozen=True)
 class Scene:
-    """Bodies moving over ``[0, t_max]``.
+    """Bodies moving over ``[0, t_max]``, as a scene file describes them.
+
+    Attributes
+    ----------
+    bodies : tuple of SceneBody
+        Two or more, in file order; :class:`~polycontact.PairImpact` entries number
+        them by their index here.
+    t_max : float
+        End of the time window.
+    time_tolerance : float or None
+        The file's time tolerance (the default of :meth:`first_impact` and
+        :meth:`impacts`), None when it gives none.
+    description : str or None
 
     Examples
     --------
     >>> scene = Scene.from_dict({"t_max": 5, "bodies": [
     ...     {"name": "a", "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]], "velocity": [1, 0]},
     ...     {"name": "b", "vertices": [[3, 0], [4, 0], [4, 1], [3, 1]]}]})
-    >>> a, b, impact = scene.first_impact()
-    >>> a.name, b.name, round(impact.time, 3)
+    >>> i, j, impact = scene.first_impact()
+    >>> scene.bodies[i].name, scene.bodies[j].name, round(impact.time, 3)
     ('a', 'b', 2.0)
     """
 
-    bodies: tuple[Body, ...]
+    bodies: tuple[SceneBody, ...]
     t_max: float
     time_tolerance: float | None = None
     description: str | None = None
 
     @classmethod
-    def from_dict(cls, data: Any, *, repair: bool = False) -> Scene:
-        """Build a scene from parsed JSON (lists or tuples); ``repair`` is passed to
-        :func:`~polycontact.bodies.as_shape`."""
+    def from_dict(cls, data: object, *, repair: bool = False) -> Scene:
+        """Build a scene from parsed JSON (lists or tuples).
+
+        Parameters
+        ----------
+        data : dict
+            The scene, in the format of the module docstring (anything else is
+            refused with an :class:`~polycontact.InvalidSceneError`).
+        repair : bool, default False
+            Passed to :func:`~polycontact.shape.as_shape` for every body.
+
+        Returns
+        -------
+        Scene
+
+        Raises
+        ------
+        InvalidSceneError
+            A bad key, named (``bodies[1].velocity: ...``).
+
+        Examples
+        --------
+        >>> sq = [[0, 0], [1, 0], [1, 1], [0, 1]]
+        >>> Scene.from_dict({"t_max": 2, "bodies": [{"vertices": sq},
+        ...                  {"vertices": sq, "velocity": [0, 3]}]}).t_max
+        2.0
+        """
         if not isinstance(data, dict):
             raise InvalidSceneError(f"expected a JSON object, got {type(data).__name__}")
         _no_unknown(data, _TOP_KEYS, "")
@@ -107,38 +160,53 @@ class Scene:
         method: str = "exact",
         time_tolerance: float | None = None,
         samples: int = SAMPLES,
-    ) -> tuple[Body, Body, Impact]:
-        """The earliest event among all pairs: ``(body_a, body_b, impact)``.
+        max_iterations: int = MAX_ITERATIONS,
+        threads: int | None = None,
+    ) -> PairImpact:
+        """The earliest event among all pairs of bodies.
 
-        Order of events: a pair already penetrating at t = 0, then the earliest
-        collision; a pair whose search ran out of iterations before that time is
-        reported instead (no verdict). Without collision, the pair that touched first,
-        else the first pair.
+        A pair already penetrating at t = 0, then the earliest collision; a pair whose
+        search ran out of iterations before that time is reported instead (no
+        verdict). Without collision, the pair that touched first, else the first pair
+        (with its :class:`~polycontact.Impact` saying that nothing happened). The order
+        of :func:`polycontact.first_impact`, which it uses for three bodies or more.
+
+        Parameters
+        ----------
+        method, samples, max_iterations, threads
+            As for :func:`polycontact.first_impacts`.
+        time_tolerance : float, optional
+            Default the scene's :attr:`time_tolerance`, else
+            :data:`~polycontact.limits.TIME_TOLERANCE`.
+
+        Returns
+        -------
+        PairImpact
+            ``(i, j, impact)``, ``i < j`` indices into :attr:`bodies`.
+
+        Examples
+        --------
+        >>> from polycontact import Motion, Shape
+        >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> scene = Scene((SceneBody("a", sq, Motion(velocity=(1, 0))),
+        ...                SceneBody("b", sq.moved((0, 3)), Motion())), t_max=5)
+        >>> i, j, impact = scene.first_impact()
+        >>> i, j, impact.status.value
+        (0, 1, 'no-hit')
         """
-        tol = time_tolerance if time_tolerance is not None else self.time_tolerance
-        tol_ = TIME_TOLERANCE if tol is None else tol
+        tol = self._time_tolerance(time_tolerance)
         if len(self.bodies) >= 3:
-            # only the pairs whose swept bounds meet are searched (same answer as the
-            # loop over all pairs below: tests/test_impacts_many.py)
-            from .impacts import first_impact
-
+            # only the pairs whose swept bounds meet are searched (the same answer as
+            # every pair's time_of_impact)
             ev = first_impact([b.shape for b in self.bodies], [b.motion for b in self.bodies],
-                              self.t_max, method=method, time_tolerance=tol_, samples=samples)
+                              t_max=self.t_max, method=method, time_tolerance=tol,
+                              samples=samples, max_iterations=max_iterations, threads=threads)
             if ev is not None:
-                return self.bodies[ev.i], self.bodies[ev.j], ev.impact
-            a, b = self.bodies[0], self.bodies[1]  # nothing meets: the first pair
-            return a, b, time_of_impact(a.shape, a.motion, b.shape, b.motion, t_max=self.t_max,
-                                        method=method, time_tolerance=tol_, samples=samples)
-        results = []
-        for i, a in enumerate(self.bodies):
-            for b in self.bodies[i + 1:]:
-                imp = time_of_impact(
-                    a.shape, a.motion, b.shape, b.motion, t_max=self.t_max, method=method,
-                    time_tolerance=tol_, samples=samples,
-                )
-                results.append((a, b, imp))
-        return min(results, key=lambda r: _event_order(r[2]))
-
+                return ev
+        a, b = self.bodies[0], self.bodies[1]  # two bodies, or nothing meets: the first pair
+        return PairImpact(0, 1, time_of_impact(
+            a.shape, a.motion, b.shape, b.motion, t_max=self.t_max, method=method,
+            time_tolerance=tol, samples=samples, max_iterations=max_iterations))
 
     def impacts(
         self,
@@ -146,40 +214,45 @@ class Scene:
         method: str = "exact",
         time_tolerance: float | None = None,
         samples: int = SAMPLES,
-    ) -> list[tuple[Body, Body, Impact]]:
+        max_iterations: int = MAX_ITERATIONS,
+        threads: int | None = None,
+    ) -> list[PairImpact]:
         """Every pair that meets within ``[0, t_max]`` (touches, penetrates, or has no
-        verdict), sorted by time: ``(body_a, body_b, impact)`` in file order
-        (:func:`polycontact.first_impacts`; what ``polycontact collide --all`` lists).
+        verdict), sorted by time: what ``polycontact collide --all`` lists.
+
+        Parameters
+        ----------
+        method, time_tolerance, samples, max_iterations, threads
+            As for :meth:`first_impact`.
+
+        Returns
+        -------
+        list of PairImpact
+            ``(i, j, impact)``, ``i < j`` indices into :attr:`bodies`, as
+            :func:`polycontact.first_impacts` gives them.
 
         Examples
         --------
         >>> from polycontact import Motion, Shape
         >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-        >>> scene = Scene((Body("a", sq, Motion(velocity=(1, 0))),
-        ...                Body("b", sq.moved((3, 0)), Motion()),
-        ...                Body("c", sq.moved((1.5, 1)), Motion())), t_max=5)
-        >>> [(a.name, b.name, imp.status.value) for a, b, imp in scene.impacts()]
+        >>> scene = Scene((SceneBody("a", sq, Motion(velocity=(1, 0))),
+        ...                SceneBody("b", sq.moved((3, 0)), Motion()),
+        ...                SceneBody("c", sq.moved((1.5, 1)), Motion())), t_max=5)
+        >>> [(scene.bodies[i].name, scene.bodies[j].name, imp.status.value)
+        ...  for i, j, imp in scene.impacts()]
         [('a', 'c', 'no-hit'), ('a', 'b', 'hit')]
         """
-        from .impacts import first_impacts
+        return first_impacts([b.shape for b in self.bodies], [b.motion for b in self.bodies],
+                             t_max=self.t_max, method=method,
+                             time_tolerance=self._time_tolerance(time_tolerance),
+                             samples=samples, max_iterations=max_iterations, threads=threads)
 
-        tol = time_tolerance if time_tolerance is not None else self.time_tolerance
-        events = first_impacts([b.shape for b in self.bodies], [b.motion for b in self.bodies],
-                               self.t_max, method=method,
-                               time_tolerance=TIME_TOLERANCE if tol is None else tol,
-                               samples=samples)
-        return [(self.bodies[e.i], self.bodies[e.j], e.impact) for e in events]
-
-
-def _event_order(imp: Impact) -> tuple[float, float]:
-    if imp.status is ImpactStatus.PENETRATING_AT_START:
-        return (0.0, 0.0)
-    if imp.status is ImpactStatus.HIT and imp.time is not None:
-        return (imp.time, 0.0)
-    if imp.status is ImpactStatus.OUT_OF_ITERATIONS:
-        return (imp.searched_to, 0.0)
-    contact = imp.first_contact if imp.first_contact is not None else math.inf
-    return (math.inf, contact)
+    def _time_tolerance(self, asked: float | None) -> float:
+        """The time tolerance of a search: the one asked for, else the scene's, else
+        the default."""
+        if asked is not None:
+            return asked
+        return TIME_TOLERANCE if self.time_tolerance is None else self.time_tolerance
 
 
 def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) -> Scene:
@@ -190,7 +263,7 @@ def load_scene(path: str | Path | Mapping[str, Any], *, repair: bool = False) ->
     path : str, Path or mapping
         The file's path, or the parsed scene itself (as :meth:`Scene.from_dict`).
     repair : bool, default False
-        Passed to :func:`polycontact.bodies.as_shape` for every body.
+        Passed to :func:`polycontact.shape.as_shape` for every body.
 
     Returns
     -------
@@ -281,7 +354,7 @@ def _angle(data: dict[str, Any], key: str, where: str) -> float:
     return 0.0
 
 
-def _body(data: Any, i: int, repair: bool, t_max: float) -> Body:
+def _body(data: Any, i: int, repair: bool, t_max: float) -> SceneBody:
     where = f"bodies[{i}]"
     if not isinstance(data, dict):
         raise InvalidSceneError(f"{where}: expected an object, got {type(data).__name__}")
@@ -313,4 +386,4 @@ def _body(data: Any, i: int, repair: bool, t_max: float) -> Body:
         check_reach(shape, motion, t_max, f"{where[:-1]} ({name!r})")
     except ValueError as exc:  # its motion would overflow float64 within t_max
         raise InvalidSceneError(str(exc)) from None
-    return Body(name, shape, motion)
+    return SceneBody(name, shape, motion)

@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._checks import finite_number, is_real, point, real_array, shown
 from ._json import load_json
@@ -34,7 +35,12 @@ from .tolerances import (
     tolerance_for,
 )
 
-__all__ = ["Shape"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely import Polygon
+    from shapely.geometry.base import BaseGeometry
+
+__all__ = ["Shape", "ShapeLike", "GeoInterface", "as_shape", "SHAPE_FORMS"]
 
 ArrayLike = Any
 
@@ -78,38 +84,55 @@ def _clean_ring(ring: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
-def _whole_body(obj: Any) -> bool:
-    """Whether ``obj`` is a body in a form other than an array of vertices: a Shape, a
+def _whole_shape(obj: Any) -> bool:
+    """Whether ``obj`` is a shape in a form other than an array of vertices: a Shape, a
     Shapely geometry, anything with ``__geo_interface__``, a mapping, text or WKB."""
     return (isinstance(obj, (Shape, str, bytes, bytearray, memoryview, Mapping))
             or hasattr(obj, "__geo_interface__") or hasattr(obj, "geom_type"))
 
 
 def _other_form(obj: Any, holes: Sequence[ArrayLike], repair: bool) -> Shape:
-    """The Shape of a body given in a form other than an array (see :func:`_whole_body`),
-    through :func:`as_shape`; such a body carries its own holes."""
+    """The Shape of a shape given in a form other than an array (see
+    :func:`_whole_shape`), through :func:`as_shape`; such a form carries its own holes."""
     if len(list(holes)):
-        raise TypeError(f"holes: a {type(obj).__name__} body carries its own holes; pass "
+        raise TypeError(f"holes: a {type(obj).__name__} carries its own holes; pass "
                         "holes only with an array of vertices")
     return as_shape(obj, "vertices", repair=repair)
 
 
-#: The forms a body may take, as error messages list them.
-BODY_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or body mapping, WKT, WKB"
+#: The forms a shape may take, as error messages list them.
+SHAPE_FORMS = "Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB"
 
-_BODY_KEYS = {"vertices", "holes", "name"}
+_MAPPING_KEYS = {"vertices", "holes", "name"}
 _HEX = re.compile(r"(?:[0-9A-Fa-f]{2})+")
 
 
-def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
-    """``obj`` as a :class:`Shape`, whatever accepted form it takes (the forms
-    :mod:`polycontact.bodies` lists; offered to the package from there).
+def as_shape(obj: ShapeLike, what: str = "shape", *, repair: bool = False) -> Shape:
+    """``obj`` as a :class:`Shape`, whatever form it is given in.
+
+    Everywhere polycontact takes a shape (the functions, :class:`Shape` itself,
+    ``classify_many``, worlds, scenes, the command line) it accepts the same forms:
+
+    - a :class:`Shape` (returned as it is);
+    - an array-like of shape (N, 2): the outer loop, closed or not, either orientation;
+    - a Shapely ``Polygon`` (or a ``MultiPolygon`` of exactly one part);
+    - anything with ``__geo_interface__`` (GeoPandas, other geometry libraries);
+    - a GeoJSON mapping: ``Polygon``, a ``MultiPolygon`` of one part, or a ``Feature``
+      holding one;
+    - a vertices mapping ``{"vertices": [[x, y], ...], "holes": [...]}`` (an optional
+      ``"name"`` is ignored), the form of the scene files' bodies;
+    - WKT text (``"POLYGON ((0 0, 1 0, 0 1, 0 0))"``), JSON text of one of the mappings
+      above or of a list of vertices (``"[[0, 0], [1, 0], [0, 1]]"``), WKB bytes or hex
+      WKB text.
+
+    ``Shape(obj)`` takes every one of these forms too; ``as_shape`` names the argument
+    in its errors, which is what a function of your own wants.
 
     Parameters
     ----------
-    obj : body
-        One of the forms listed in :mod:`polycontact.bodies`.
-    what : str
+    obj : ShapeLike
+        One of the forms above.
+    what : str, default "shape"
         The argument's name, put at the start of every error message.
     repair : bool, default False
         Passed to :class:`Shape`: try ``shapely.make_valid`` on an invalid polygon.
@@ -122,9 +145,27 @@ def as_shape(obj: Any, what: str = "shape", *, repair: bool = False) -> Shape:
     Raises
     ------
     TypeError
-        ``obj`` is of no accepted type.
+        ``obj`` is of no accepted type (the message names ``what``).
     InvalidShapeError
-        ``obj`` is of an accepted type but not a valid polygon.
+        ``obj`` is of an accepted type but not a valid polygon (a ``ValueError``).
+
+    Examples
+    --------
+    >>> import shapely
+    >>> forms = [
+    ...     [(0, 0), (1, 0), (1, 1), (0, 1)],
+    ...     shapely.box(0, 0, 1, 1),
+    ...     {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]]]},
+    ...     {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+    ...     "POLYGON ((0 0, 1 0, 1 1, 0 1, 0 0))",
+    ...     shapely.box(0, 0, 1, 1).wkb,
+    ... ]
+    >>> [as_shape(f).area for f in forms]
+    [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
+    >>> as_shape(3, "a")
+    Traceback (most recent call last):
+    ...
+    TypeError: a: expected a shape (Shape, (N, 2) array, shapely Polygon, GeoJSON or vertices mapping, WKT, WKB), got int
     """
     if isinstance(obj, Shape):
         return obj
@@ -150,24 +191,24 @@ def _coerce(obj: Any, repair: bool) -> Shape:
         return _from_mapping(geo, repair)
     if isinstance(obj, (np.ndarray, list, tuple)):
         return Shape(obj, repair=repair)
-    raise TypeError(f"expected a body ({BODY_FORMS}), got {type(obj).__name__}")
+    raise TypeError(f"expected a shape ({SHAPE_FORMS}), got {type(obj).__name__}")
 
 
 def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
     if "vertices" in data:
-        unknown = sorted(set(data) - _BODY_KEYS)
+        unknown = sorted(set(data) - _MAPPING_KEYS)
         if unknown:
             raise InvalidShapeError(
-                f"unknown key {unknown[0]!r} (a body mapping has 'vertices', 'holes', 'name')"
+                f"unknown key {unknown[0]!r} (a vertices mapping has 'vertices', 'holes', 'name')"
             )
         holes = data.get("holes", ())
         if holes is None or isinstance(holes, (str, bytes, Mapping)):
-            raise InvalidShapeError("body mapping: 'holes' must be a list of rings")
+            raise InvalidShapeError("vertices mapping: 'holes' must be a list of rings")
         return Shape(data["vertices"], holes, repair=repair)
     if "type" in data:
         return Shape.from_geojson(dict(data), repair=repair)
     raise InvalidShapeError(
-        "expected a GeoJSON mapping (with 'type') or a body mapping (with 'vertices'), "
+        "expected a GeoJSON mapping (with 'type') or a vertices mapping (with 'vertices'), "
         f"got keys {sorted(map(str, data))}"
     )
 
@@ -175,7 +216,7 @@ def _from_mapping(data: Mapping[str, Any], repair: bool) -> Shape:
 def _from_text(text: str, repair: bool) -> Shape:
     stripped = text.strip()
     if not stripped:
-        raise InvalidShapeError("empty text: no body in it")
+        raise InvalidShapeError("empty text: no shape in it")
     if stripped.startswith(("{", "[")):
         try:
             data = load_json(text)
@@ -195,7 +236,7 @@ def _from_wkb(data: bytes) -> Any:
     import shapely
 
     if not data:
-        raise InvalidShapeError("empty WKB: no body in it")
+        raise InvalidShapeError("empty WKB: no shape in it")
     try:
         return shapely.from_wkb(data)
     except Exception as exc:  # noqa: BLE001 - GEOS raises its own error types
@@ -228,10 +269,10 @@ class Shape:
 
     Parameters
     ----------
-    vertices : array_like of shape (N, 2), or a whole body
-        The outer loop, closed or not, in either orientation. Or a body in any other
-        form polycontact takes (:mod:`polycontact.bodies`), holes included: a Shape, a
-        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or body
+    vertices : array_like of shape (N, 2), or a whole shape (ShapeLike)
+        The outer loop, closed or not, in either orientation. Or a shape in any other
+        form polycontact takes (:func:`as_shape`), holes included: a Shape, a
+        Shapely ``Polygon``, anything with ``__geo_interface__``, a GeoJSON or vertices
         mapping ``{"vertices": ..., "holes": ...}``, WKT or JSON text, WKB.
     holes : sequence of array_like of shape (M, 2), optional
         Hole loops, closed or not, in either orientation (None or empty: no holes).
@@ -262,7 +303,7 @@ class Shape:
         touching by the functions that take the shape.
     TypeError
         Coordinates that are not real numbers (strings, booleans, complex numbers: the
-        message names the loop and the vertex), or ``holes`` with a body that carries
+        message names the loop and the vertex), or ``holes`` with a form that carries
         its own.
 
     A Shape is immutable: its arrays are read-only and no attribute can be rebound.
@@ -300,7 +341,7 @@ class Shape:
     ) -> None:
         if holes is None:
             holes = ()
-        if _whole_body(vertices):
+        if _whole_shape(vertices):
             self._adopt(_other_form(vertices, holes, repair))
             return
         if isinstance(holes, np.ndarray) and holes.ndim == 2:
@@ -386,7 +427,7 @@ class Shape:
         if not a2 > 0.0:
             # (a rigid motion far from the origin rounded the body away)
             raise InvalidShapeError(
-                f"shape: coordinates up to {magnitude:g} cannot carry a body of size "
+                f"shape: coordinates up to {magnitude:g} cannot carry a shape of size "
                 f"{extent:g}: rounded to float64 there, it has no area"
             )
         self._area = 0.5 * a2
@@ -460,9 +501,18 @@ class Shape:
         return self._loops
 
     def input_loop(self, loop: int) -> int | None:
-        """The caller's index of stored loop ``loop``: the same index (0 the outer loop,
-        1.. the holes in the order given), or None for a loop that ``repair=True`` made
-        and that holds none of the caller's vertices.
+        """The caller's index of a stored loop.
+
+        Parameters
+        ----------
+        loop : int
+            A stored loop (0 the outer loop, 1.. the holes).
+
+        Returns
+        -------
+        int or None
+            The same index (the holes are kept in the order given), or None for a loop
+            that ``repair=True`` made and that holds none of the caller's vertices.
 
         Examples
         --------
@@ -474,11 +524,21 @@ class Shape:
         return None if k < 0 else k
 
     def input_vertex(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored vertex ``i`` of loop ``loop``.
+        """The caller's index of a stored vertex.
 
-        That is its position in the vertices as passed (0-based, repeated and closing
-        points counted), whatever the stored orientation; None for a vertex that
-        ``repair=True`` created (where the repair cut an edge).
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            A vertex of that loop as stored (:attr:`loops`).
+
+        Returns
+        -------
+        int or None
+            Its position in the vertices as passed (0-based, repeated and closing points
+            counted), whatever the stored orientation; None for a vertex that
+            ``repair=True`` created (where the repair cut an edge).
 
         Examples
         --------
@@ -489,13 +549,22 @@ class Shape:
         return self._lookup(loop, i, 0)
 
     def input_edge(self, loop: int, i: int) -> int | None:
-        """The caller's index of stored edge ``i`` of loop ``loop``.
+        """The caller's index of a stored edge.
 
-        Stored edge ``i`` joins stored vertices ``i`` and ``i + 1``; the answer ``k`` is
-        the caller's edge joining their vertices ``k`` and ``k + 1`` (mod the number of
-        vertices passed) that holds it: where repeated points were dropped, the one edge
-        of non-zero length between them. None for an edge that ``repair=True`` made and
-        that lies on no single edge of the caller's.
+        Parameters
+        ----------
+        loop : int
+            A stored loop.
+        i : int
+            An edge of that loop as stored: it joins stored vertices ``i`` and ``i + 1``.
+
+        Returns
+        -------
+        int or None
+            The caller's edge ``k``, joining their vertices ``k`` and ``k + 1`` (mod the
+            number of vertices passed), that holds it: where repeated points were
+            dropped, the one edge of non-zero length between them. None for an edge
+            that ``repair=True`` made and that lies on no single edge of the caller's.
 
         Examples
         --------
@@ -553,11 +622,26 @@ class Shape:
 
     # -- rigid motions ------------------------------------------------------------
     def moved(self, translation: ArrayLike = (0.0, 0.0), angle: float = 0.0) -> Shape:
-        """This shape rotated by ``angle`` (radians, CCW) about its centroid, then translated.
+        """This shape rotated by ``angle`` about its centroid, then translated.
 
-        ``translation`` is two real numbers and ``angle`` one, finite (strings, booleans
-        and complex numbers raise ``TypeError``, other bad values ``ValueError``, naming
-        the argument), and the moved coordinates must stay within ±1e100.
+        Parameters
+        ----------
+        translation : (dx, dy), default (0, 0)
+            Two finite real numbers.
+        angle : float, default 0
+            Radians, counter-clockwise.
+
+        Returns
+        -------
+        Shape
+            The moved shape (numbered as this one).
+
+        Raises
+        ------
+        TypeError
+            Strings, booleans or complex numbers, naming the argument.
+        ValueError
+            Other bad values, or moved coordinates beyond ±1e100.
 
         Examples
         --------
@@ -580,7 +664,27 @@ class Shape:
             raise InvalidShapeError(f"translation: the moved {exc}") from None
 
     def at(self, motion: Motion, t: float) -> Shape:
-        """The shape placed by ``motion`` at time ``t`` (see :class:`polycontact.Motion`)."""
+        """The shape placed by a motion at a time.
+
+        Parameters
+        ----------
+        motion : Motion
+            How the shape moves about its area centroid from where it is.
+        t : float
+            The time.
+
+        Returns
+        -------
+        Shape
+            ``self.moved(*motion.pose(t))``.
+
+        Examples
+        --------
+        >>> from polycontact import Motion
+        >>> sq = Shape([(0, 0), (2, 0), (2, 2), (0, 2)])
+        >>> sq.at(Motion(velocity=(1, 0), acceleration=(0, 2)), 3.0).centroid.tolist()
+        [4.0, 10.0]
+        """
         if not isinstance(motion, Motion):
             raise TypeError(f"motion: expected a polycontact.Motion, got "
                             f"{type(motion).__name__}")
@@ -589,7 +693,7 @@ class Shape:
 
     # -- interchange ----------------------------------------------------------------
     @classmethod
-    def from_shapely(cls, geom: Any, *, repair: bool = False) -> Shape:
+    def from_shapely(cls, geom: BaseGeometry, *, repair: bool = False) -> Shape:
         """Shape from a shapely Polygon (or a MultiPolygon of exactly one part).
 
         Examples
@@ -622,7 +726,7 @@ class Shape:
                 shape._input[1]))
         return shape
 
-    def to_shapely(self) -> Any:
+    def to_shapely(self) -> Polygon:
         """The shape as a ``shapely.Polygon``."""
         import shapely
 
@@ -677,7 +781,7 @@ class Shape:
         rings = [np.vstack([r, r[:1]]).tolist() for r in self._loops]
         return {"type": "Polygon", "coordinates": rings}
 
-    def plot(self, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+    def plot(self, ax: Axes | None = None, *, numbers: bool = False, **style: Any) -> Axes:
         """Draw the shape (solid filled, holes open); returns the matplotlib Axes.
 
         Parameters
@@ -781,6 +885,18 @@ def _input_maps(
     return frozen_ints(np.arange(len(maps))), frozen_ints(np.concatenate(maps))
 
 
+class GeoInterface(Protocol):
+    """Anything with ``__geo_interface__`` (the Python geo interface)."""
+
+    @property
+    def __geo_interface__(self) -> Mapping[str, Any]: ...
+
+
+#: The type of a shape argument: every form :func:`as_shape` takes (WKT and JSON text
+#: are ``str``, WKB ``bytes``; Shapely geometries have ``__geo_interface__``).
+ShapeLike = Union[Shape, GeoInterface, Mapping[str, Any], npt.ArrayLike]
+
+
 def _repaired_maps(shape: Shape, rings: Sequence[ArrayLike], grid: float) -> tuple[Any, ...]:
     """The map of a repaired shape to the caller's ``rings``.
 
@@ -865,7 +981,7 @@ def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndar
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
     patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
     state kernel: one object to unbox per shape, immutable and holding its data in
-    itself (about 2 us per shape)."""
+    itself."""
     return np.concatenate(
         ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
     ).tobytes()

@@ -78,10 +78,18 @@ def tolerance_for(extent: float, magnitude: float) -> float:
 def default_tolerance(*bodies: np.ndarray) -> float:
     """The absolute tolerance used when the caller gives none.
 
-    Each argument is the (N, 2) coordinate array of one body (or one loop of it):
-    ``extent`` is the largest side of any argument's own bounding box, so two unit
-    bodies far apart keep a tolerance of their size, and ``magnitude`` the largest
-    absolute coordinate of all. See :func:`tolerance_for`.
+    Parameters
+    ----------
+    *bodies : ndarray of shape (N, 2)
+        The coordinates of each body (or of one loop of it): ``extent`` is the largest
+        side of any argument's own bounding box, so two unit bodies far apart keep a
+        tolerance of their size, and ``magnitude`` the largest absolute coordinate of
+        all.
+
+    Returns
+    -------
+    float
+        :func:`tolerance_for` of that extent and magnitude.
 
     Examples
     --------

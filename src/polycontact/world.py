@@ -30,10 +30,10 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -42,12 +42,16 @@ from ._checks import finite_number, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .bodies import BodyLike, as_shape
+from .impacts import PairImpact, first_impact, first_impacts
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
-                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SWEPT_ROUNDING_ULPS,
+                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, SWEPT_ROUNDING_ULPS,
                      TIME_TOLERANCE)
-from .shape import Shape, frozen_ints
+from .shape import Shape, ShapeLike, as_shape, frozen_ints
 from .tolerances import ROUNDING_FACTOR, check_range, default_tolerance
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
 
 __all__ = ["World", "WorldBody", "Contacts", "Query", "Sweep"]
 
@@ -116,6 +120,14 @@ class WorldBody:
         Turn about that centroid, radians, counter-clockwise.
     motion : Motion or None
         The motion given to :meth:`World.add` (not used by the static queries).
+
+    Examples
+    --------
+    >>> w = World()
+    >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), angle=0.5, name="plate")
+    >>> body = w.body(i)
+    >>> body.id, body.name, body.position.tolist(), body.angle
+    (0, 'plate', [5.0, 5.0], 0.5)
     """
 
     id: int
@@ -184,6 +196,16 @@ class Contacts:
         The world's container.
     margin : float
         The margin asked for.
+
+    Examples
+    --------
+    >>> w = World(container=[(0, 0), (2.5, 0), (2.5, 1), (0, 1)])
+    >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.25, 2.2)]
+    >>> c = w.contacts()
+    >>> c.pairs.tolist(), c.states.tolist(), c.overlap_areas.round(9).tolist()
+    ([[0, 1], [1, 2]], [2, 2], [0.25, 0.05])
+    >>> c.container_ids.tolist(), c.container_states.tolist()
+    ([0, 1, 2], [1, 1, 2])
     """
 
     pairs: np.ndarray
@@ -251,7 +273,24 @@ class Contacts:
 
     def relation(self, k: int) -> Relation:
         """The full :class:`~polycontact.Relation` of pair ``k`` (features, point,
-        normal, depth), as :func:`polycontact.classify` gives it."""
+        normal, depth), as :func:`polycontact.classify` gives it.
+
+        Parameters
+        ----------
+        k : int
+            A row of :attr:`pairs`.
+
+        Returns
+        -------
+        Relation
+
+        Examples
+        --------
+        >>> w = World()
+        >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.5)]
+        >>> w.contacts().relation(0).state.value
+        'contact'
+        """
         k = _integer(k, "k")
         if not 0 <= k < len(self.states):
             raise IndexError(f"k: pair {k} out of range (0..{len(self.states) - 1})")
@@ -260,18 +299,37 @@ class Contacts:
                         tolerance=self._tolerance)
 
     @property
-    def penetrating(self) -> np.ndarray:
-        """The pairs that penetrate, (P, 2)."""
+    def penetrating_pairs(self) -> np.ndarray:
+        """The pairs that penetrate, (P, 2): the rows of :attr:`pairs` whose state is 2."""
         return cast("np.ndarray", self.pairs[self.states == 2])
 
     def shape(self, id: int) -> Shape:
-        """The Shape of body ``id`` as it was when the contacts were found."""
+        """The shape of a body where it stood when the contacts were found.
+
+        Parameters
+        ----------
+        id : int
+            One of :attr:`ids`.
+
+        Returns
+        -------
+        Shape
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> c = w.contacts()
+        >>> w.move(i, (5, 5))
+        >>> c.shape(i).centroid.tolist()
+        [0.5, 0.5]
+        """
         id = _integer(id, "id")
         if id not in set(self.ids.tolist()):
             raise IndexError(f"id: no body {id} among the contacts' bodies")
         return _snapshot_shape(self._store, int(id))
 
-    def to_dict(self, names: Any = None) -> dict[str, Any]:
+    def to_dict(self, names: Sequence[str] | Mapping[int, str] | None = None) -> dict[str, Any]:
         """The contacts as a JSON-ready dict: the object ``polycontact contacts --json``
         prints.
 
@@ -314,11 +372,25 @@ class Contacts:
         return {"bodies": len(self.ids), "container": self.container is not None,
                 "contacts": pairs, "container_contacts": container}
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """Draw the bodies (penetrating ones red, those leaving the container orange),
-        the container, the contact points and penetrations; returns the matplotlib Axes.
+        the container, the contact points and penetrations.
 
-        See :func:`polycontact.plotting.plot_contacts`.
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Drawn into a new figure when omitted (see
+            :func:`polycontact.plotting.plot_contacts`).
+
+        Returns
+        -------
+        matplotlib Axes
+
+        Examples
+        --------
+        >>> w = World()
+        >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 1.2)]
+        >>> ax = w.contacts().plot()
         """
         from .plotting.world import plot_contacts
 
@@ -342,6 +414,14 @@ class Query:
         Inside the container and penetrating no body (touching allowed).
     shape : Shape
         The shape as placed.
+
+    Examples
+    --------
+    >>> w = World()
+    >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> q = w.query([(0, 0), (1, 0), (1, 1), (0, 1)], (1.0, 0.5))
+    >>> q.ids.tolist(), q.states.tolist(), q.fits
+    ([0], [2], False)
     """
 
     ids: np.ndarray
@@ -384,7 +464,7 @@ class Sweep:
     penetration_times : ndarray of shape (K,)
         The first penetration time (``time_of_impact(...).time``; 0 when penetrating at
         the start), NaN for a pair that only touches.
-    status : ndarray of shape (K,), int8
+    statuses : ndarray of shape (K,), int8
         The search's code: 0 no penetration, 1 hit, 2 penetrating at the start, 3 out of
         iterations (no verdict).
     dt : float
@@ -393,13 +473,21 @@ class Sweep:
         Contact point and unit normal (from the first body of the pair towards the
         second) at ``times``, as :attr:`Contacts.points` and :attr:`Contacts.normals`
         give them for the bodies placed there.
+
+    Examples
+    --------
+    >>> w = World()
+    >>> ids = [w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (x, 0.5)) for x in (0.5, 3.5)]
+    >>> s = w.sweep(2.0, [(1.0, 0.0), (-1.0, 0.0)])
+    >>> s.pairs.tolist(), s.times.round(4).tolist(), s.statuses.tolist()
+    ([[0, 1]], [1.0], [1])
     """
 
     pairs: np.ndarray
     times: np.ndarray
     states: np.ndarray
     penetration_times: np.ndarray
-    status: np.ndarray
+    statuses: np.ndarray
     dt: float
     _events: tuple[Any, ...] = field(repr=False)  # what the points and normals come from
 
@@ -594,7 +682,7 @@ class World:
 
     Parameters
     ----------
-    container : Shape, shapely Polygon or array_like of shape (N, 2), optional
+    container : ShapeLike, optional
         The region bodies must stay in (holes are defects to avoid). Without one,
         nothing is outside.
 
@@ -626,7 +714,7 @@ class World:
     _live: np.ndarray
     _stamp: np.ndarray
 
-    def __init__(self, container: BodyLike | None = None) -> None:
+    def __init__(self, container: ShapeLike | None = None) -> None:
         # id -> [name, base, motion, shape, version of shape]; base and shape are None
         # until asked for (bodies added by add_many are kept as coordinates); shape is
         # rebuilt when the body's pose version (_ver) has moved on.
@@ -715,7 +803,31 @@ class World:
         return tuple(self.body(i) for i in sorted(self._records))
 
     def body(self, id: int) -> WorldBody:
-        """The body with this id (a read-only record)."""
+        """One body of the world, as a read-only record.
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+
+        Returns
+        -------
+        WorldBody
+            Its id, name, shape where it stands, shape as added, pose and motion.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), name="plate")
+        >>> b = w.body(i)
+        >>> b.name, b.position.tolist(), b.shape.centroid.tolist(), b.base.centroid.tolist()
+        ('plate', [5.0, 5.0], [5.0, 5.0], [1.0, 1.0])
+        """
         rec = self._record(id, "id")
         b = int(id)
         if rec[3] is None or rec[4] != self._ver[b]:
@@ -739,20 +851,34 @@ class World:
         return _body_shape(xy, self._ls, self._lmap, self._vmap, int(self._lo[b]),
                            int(self._nl[b]), () if base is None else base.repairs)
 
-    def add(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
+    def add(self, shape: ShapeLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
             motion: Motion | None = None, name: str | None = None) -> int:
-        """Add a body; returns its id (ids are never reused).
+        """Add a body: a shape placed in the world (:meth:`add_many` adds many in one
+        call).
 
         Parameters
         ----------
-        shape : Shape, shapely Polygon or array_like of shape (N, 2)
+        shape : ShapeLike
+            The body's shape, in any form :func:`polycontact.shape.as_shape` takes.
         position : (x, y), optional
             Where the shape's area centroid goes; None keeps the shape where it is.
-        angle : float
+        angle : float, default 0
             Radians, counter-clockwise, about the centroid.
         motion : Motion, optional
-            Stored with the body for the moving-body queries.
+            Stored with the body for :meth:`first_impacts` and :meth:`first_impact`.
         name : str, optional
+
+        Returns
+        -------
+        int
+            The body's id (ids are never reused).
+
+        Examples
+        --------
+        >>> w = World()
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> w.add(sq), w.add(sq, (3, 0), angle=0.25, name="b")
+        (0, 1)
         """
         base = as_shape(shape, "shape")
         pos = None if position is None else point_arg(position, "position")
@@ -777,8 +903,9 @@ class World:
         self._records[b] = [name, base, motion, placed, 0]
         return b
 
-    def add_many(self, shapes: Any, positions: npt.ArrayLike | None = None,
-                 angles: npt.ArrayLike | None = None, *, names: Any = None) -> np.ndarray:
+    def add_many(self, shapes: Sequence[ShapeLike] | np.ndarray,
+                 positions: npt.ArrayLike | None = None, angles: npt.ArrayLike | None = None,
+                 *, names: Sequence[str] | None = None) -> np.ndarray:
         """Add many bodies; returns their ids.
 
         Each body goes where :meth:`add` would put it: with ``positions``, its area
@@ -791,13 +918,19 @@ class World:
 
         Parameters
         ----------
-        shapes : sequence of bodies, or ndarray of shape (P, N, 2)
+        shapes : sequence of ShapeLike, or ndarray of shape (P, N, 2)
             As for :func:`polycontact.classify_many`.
         positions : array_like of shape (P, 2), optional
             Where each body's area centroid goes.
         angles : array_like of shape (P,), optional
             Turn of each body about its centroid (radians); 0 when omitted.
         names : sequence of str, optional
+            One per body.
+
+        Returns
+        -------
+        ndarray of shape (P,), int64
+            The new bodies' ids, in the order given.
 
         Examples
         --------
@@ -910,14 +1043,58 @@ class World:
         self._write_poses(idx, pos, ang)
 
     def poses(self, ids: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (area centroids, (P, 2)) and angles ((P,), radians) of the bodies
-        ``ids`` (default: every body, by id), as new arrays."""
+        """Where the bodies stand: their positions and angles, as new arrays.
+
+        Parameters
+        ----------
+        ids : array_like of int, shape (P,), optional
+            Bodies of this world; default every body, by id.
+
+        Returns
+        -------
+        positions : ndarray of shape (P, 2)
+            Where each body's area centroid is.
+        angles : ndarray of shape (P,)
+            Its turn about that centroid, radians, counter-clockwise.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)], (5, 5), angle=0.5)
+        >>> positions, angles = w.poses()
+        >>> positions.tolist(), angles.tolist()
+        ([[5.0, 5.0]], [0.5])
+        """
         idx = self.ids if ids is None else self._ids(ids, "ids", unique=False)
         return self._pos[idx].copy(), self._ang[idx].copy()
 
-    def move(self, id: int, position: Any = None, angle: float | None = None) -> None:
-        """Put body ``id`` at a new pose (None keeps the current position or angle); the
-        pose applies to the shape as added."""
+    def move(self, id: int, position: npt.ArrayLike | None = None,
+             angle: float | None = None) -> None:
+        """Put one body at a new pose (:meth:`set_poses` moves many in one call).
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+        position : (x, y), optional
+            Where its area centroid goes; None keeps the current position.
+        angle : float, optional
+            Its turn (radians, counter-clockwise) from the shape as added; None keeps
+            the current angle.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (2, 0), (2, 2), (0, 2)])
+        >>> w.move(i, (10, 0))
+        >>> w.body(i).shape.centroid.tolist()
+        [10.0, 0.0]
+        """
         self._record(id, "id")
         b = int(id)
         pos = self._pos[b].copy() if position is None else point_arg(position, "position")
@@ -928,7 +1105,25 @@ class World:
         self._write_poses(idx, pos[None], np.array([ang]))
 
     def remove(self, id: int) -> None:
-        """Take body ``id`` out of the world."""
+        """Take a body out of the world (its id is not given again).
+
+        Parameters
+        ----------
+        id : int
+            A body of this world.
+
+        Raises
+        ------
+        KeyError
+            ``id`` is not a body of this world.
+
+        Examples
+        --------
+        >>> w = World()
+        >>> i = w.add([(0, 0), (1, 0), (0, 1)])
+        >>> w.remove(i); i in w, len(w)
+        (False, 0)
+        """
         self._record(id, "id")
         self._unindex(id)
         lo, nl = self._lo[id], self._nl[id]
@@ -1170,7 +1365,7 @@ class World:
         return (self._hxy, self._hls, self._hlo, self._hnl, self._cbox, self._ceps)
 
     # -- queries ---------------------------------------------------------------------
-    def contacts(self, tolerance: float | None = None, *, margin: float = 0.0) -> Contacts:
+    def contacts(self, *, tolerance: float | None = None, margin: float = 0.0) -> Contacts:
         """Every pair of bodies in contact or penetrating, with the geometry of each
         contact, and the bodies that touch or leave the container.
 
@@ -1237,15 +1432,36 @@ class World:
         return Contacts(pairs, states, used, c_ids, c_states, store,
                         None if tolerance is None else tol, alive, self._container, gap)
 
-    def query(self, shape: BodyLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
+    def query(self, shape: ShapeLike, position: npt.ArrayLike | None = None, angle: float = 0.0, *,
               tolerance: float | None = None) -> Query:
         """How ``shape``, placed like :meth:`add` would place it, lies among the bodies.
+
+        Parameters
+        ----------
+        shape : ShapeLike
+            The shape to place (it is not added).
+        position : (x, y), optional
+            Where its area centroid goes; None keeps it where it is.
+        angle : float, default 0
+            Radians, counter-clockwise, about the centroid.
+        tolerance : float, optional
+            Absolute tolerance for every pair; default per pair as in
+            :func:`polycontact.classify`.
 
         Returns
         -------
         Query
             ``ids`` and ``states`` of the bodies it touches or penetrates,
             ``container_state``, ``inside_container`` and ``fits``.
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (4, 0), (4, 2), (0, 2)])
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> i = w.add(sq, (0.5, 0.5))
+        >>> q = w.query(sq, (1.5, 0.5))
+        >>> q.ids.tolist(), q.states.tolist(), q.container_state, q.fits
+        ([0], [1], 1, True)
         """
         base = as_shape(shape, "shape")
         pos = None if position is None else point_arg(position, "position")
@@ -1264,23 +1480,37 @@ class World:
             cstate = int(k.query_container((qxy, qs, qeps), tol, self._hazards()))
         return Query(ids, states, cstate, placed)
 
-    def query_many(self, shape: BodyLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
+    def query_many(self, shape: ShapeLike, positions: npt.ArrayLike, angles: npt.ArrayLike = 0.0, *,
                    tolerance: float | None = None) -> np.ndarray:
         """Worst state over every body and the container (outside counts as 2) of
         ``shape`` placed at each of P poses, in one compiled call.
 
         Parameters
         ----------
-        shape : Shape, shapely Polygon or array_like of shape (N, 2)
+        shape : ShapeLike
+            The shape to place (it is not added).
         positions : array_like of shape (P, 2)
             Where the shape's area centroid goes: real numbers (not strings, booleans
             or complex numbers), finite and within ±1e100.
-        angles : float or array_like of shape (P,)
+        angles : float or array_like of shape (P,), default 0
             Radians, about the centroid.
+        tolerance : float, optional
+            As for :meth:`query`.
 
         Returns
         -------
         ndarray of shape (P,), int8
+            0 where the placed shape is apart from everything, 1 where it touches a
+            body or the container's boundary, 2 where it penetrates a body or leaves the
+            container.
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (4, 0), (4, 2), (0, 2)])
+        >>> sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        >>> i = w.add(sq, (0.5, 0.5))
+        >>> w.query_many(sq, [(2.5, 1.0), (1.5, 0.5), (1.2, 0.5), (3.9, 1.0)]).tolist()
+        [0, 1, 2, 2]
         """
         base = as_shape(shape, "shape")
         pos = points(positions, "positions")
@@ -1298,8 +1528,7 @@ class World:
         sxy, ss = base.packed
         c = base.centroid
         has_c = self._container is not None
-        # A few bodies: testing every box is cheaper than visiting the grid's cells
-        # (measured on the swim layout, 43 bodies: ~140 vs ~270 ns per placement).
+        # A few bodies: testing every box is cheaper than visiting the grid's cells.
         scan = self._alive() if len(self._records) <= _SCAN_BODIES else np.empty(0, np.int64)
         hz = self._hazards() if has_c else (np.zeros((1, 2)), np.zeros(2, np.int64),
                                             np.zeros(0, np.int64), np.zeros(0, np.int64),
@@ -1476,15 +1705,31 @@ class World:
                          (tint, tflt, tio, tfo))
         self._frames = (tint, tflt, tio, tfo, itop, ftop)
 
-    def first_impacts(self, t_max: float, **options: Any) -> list[tuple[int, int, Any]]:
+    def first_impacts(self, *, t_max: float, method: str = "exact",
+                      time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
+                      max_iterations: int = MAX_ITERATIONS,
+                      threads: int | None = None) -> list[PairImpact]:
         """Every pair of bodies that meets within ``[0, t_max]`` as they follow their
-        motions (the ``motion`` given to :meth:`add`; a body without one stays put),
-        sorted by time: ``(id_a, id_b, impact)`` with ``id_a < id_b``.
+        motions, sorted by time.
 
-        ``impact`` equals :func:`polycontact.time_of_impact` of the two bodies as placed
-        now; only pairs whose swept bounds meet are searched
-        (:func:`polycontact.first_impacts`, whose ``options`` these are). The container
-        is not a moving hazard: leaving it is not reported here.
+        Each body follows the ``motion`` given to :meth:`add` (a body without one stays
+        put) from where it stands now; only pairs whose swept bounds meet are searched,
+        as by :func:`polycontact.first_impacts`. The container is not a moving hazard:
+        leaving it is not reported here.
+
+        Parameters
+        ----------
+        t_max : float
+            End of the time window (>= 0).
+        method, time_tolerance, samples, max_iterations, threads
+            As for :func:`polycontact.first_impacts`.
+
+        Returns
+        -------
+        list of PairImpact
+            ``(id_a, id_b, impact)`` with ``id_a < id_b`` the bodies' ids and ``impact``
+            what :func:`polycontact.time_of_impact` answers for the two bodies as placed
+            now.
 
         Examples
         --------
@@ -1493,31 +1738,58 @@ class World:
         >>> w = pc.World()
         >>> a = w.add(sq, (0.5, 0.5), motion=pc.Motion(velocity=(1, 0)))
         >>> b = w.add(sq, (3.5, 0.5))
-        >>> [(i, j, round(imp.time, 3)) for i, j, imp in w.first_impacts(5)]
+        >>> [(e.i, e.j, round(e.impact.time, 3)) for e in w.first_impacts(t_max=5)]
         [(0, 1, 2.0)]
         """
-        from .impacts import first_impacts
-
         ids, shapes, motions = self._moving()
-        return [(ids[e.i], ids[e.j], e.impact)
-                for e in first_impacts(shapes, motions, t_max, **options)]
+        return [PairImpact(ids[e.i], ids[e.j], e.impact)
+                for e in first_impacts(shapes, motions, t_max=t_max, method=method,
+                                       time_tolerance=time_tolerance, samples=samples,
+                                       max_iterations=max_iterations, threads=threads)]
 
-    def first_impact(self, t_max: float, **options: Any) -> tuple[int, int, Any] | None:
-        """The first event among the moving bodies, ``(id_a, id_b, impact)``: the
-        earliest collision, else the earliest touch; None when no pair meets (the order
-        of :func:`polycontact.first_impact`, whose ``options`` these are)."""
-        from .impacts import first_impact
+    def first_impact(self, *, t_max: float, method: str = "exact",
+                     time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
+                     max_iterations: int = MAX_ITERATIONS,
+                     threads: int | None = None) -> PairImpact | None:
+        """The first event among the moving bodies: the earliest collision, else the
+        earliest touch (the order of :func:`polycontact.first_impact`).
 
+        Parameters
+        ----------
+        t_max, method, time_tolerance, samples, max_iterations, threads
+            As for :meth:`first_impacts`.
+
+        Returns
+        -------
+        PairImpact or None
+            ``(id_a, id_b, impact)``, or None when no pair meets.
+
+        Examples
+        --------
+        >>> import polycontact as pc
+        >>> sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> w = pc.World()
+        >>> ids = [w.add(sq, (0.5, 0.5), motion=pc.Motion(velocity=(1, 0))),
+        ...        w.add(sq, (3.5, 0.5)), w.add(sq, (0.5, 3.0))]
+        >>> e = w.first_impact(t_max=5)
+        >>> e.i, e.j, e.impact.status.value
+        (0, 1, 'hit')
+        >>> w.remove(ids[1])
+        >>> w.first_impact(t_max=5) is None
+        True
+        """
         ids, shapes, motions = self._moving()
-        e = first_impact(shapes, motions, t_max, **options)
-        return None if e is None else (ids[e.i], ids[e.j], e.impact)
+        e = first_impact(shapes, motions, t_max=t_max, method=method,
+                         time_tolerance=time_tolerance, samples=samples,
+                         max_iterations=max_iterations, threads=threads)
+        return None if e is None else PairImpact(ids[e.i], ids[e.j], e.impact)
 
     def _moving(self) -> tuple[list[int], list[Shape], list[Motion]]:
         ids = sorted(self._records)
         bodies = [self.body(k) for k in ids]
         return ids, [b.shape for b in bodies], [b.motion or Motion() for b in bodies]
 
-    def plot(self, ax: Any = None, *, labels: bool | None = None) -> Any:
+    def plot(self, ax: Axes | None = None, *, labels: bool | None = None) -> Axes:
         """Draw the bodies where they stand, with their ids, and the container; returns
         the matplotlib Axes. ``world.contacts().plot()`` draws the contacts too.
 
@@ -1545,10 +1817,19 @@ class World:
 
         return plot_world(self, ax, labels=labels)
 
-    def feasible_region(self, shape: BodyLike, angle: float = 0.0) -> Any:
-        """Positions of ``shape``'s area centroid (turned by ``angle``) where it lies in
-        the container and penetrates no body: the container's inner-fit polygon minus
-        the union of the bodies' no-fit polygons, with exact fits and slides kept.
+    def feasible_region(self, shape: ShapeLike, angle: float = 0.0) -> BaseGeometry:
+        """Where a shape can go: the positions of its area centroid (turned by
+        ``angle``) where it lies in the container and penetrates no body.
+
+        The container's inner-fit polygon minus the union of the bodies' no-fit
+        polygons, with exact fits and slides kept.
+
+        Parameters
+        ----------
+        shape : ShapeLike
+            The shape to place.
+        angle : float, default 0
+            Its turn about its centroid, radians, counter-clockwise.
 
         Returns
         -------
@@ -1560,6 +1841,14 @@ class World:
         ------
         ValueError
             Without a container (the free region would be unbounded).
+
+        Examples
+        --------
+        >>> w = World(container=[(0, 0), (3, 0), (3, 1), (0, 1)])
+        >>> i = w.add([(0, 0), (1, 0), (1, 1), (0, 1)], (0.5, 0.5))
+        >>> region = w.feasible_region([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> region.geom_type, [round(v, 6) for v in region.bounds]
+        ('LineString', [1.5, 0.5, 2.5, 0.5])
         """
         import shapely
         from shapely import affinity

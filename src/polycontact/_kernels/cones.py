@@ -22,8 +22,7 @@ def pair_point(g, xa, xb, na):
 
 
 # Inlined into the state kernel: a call passes seven arrays, and in the batch pass (no
-# reference counting) that call cost about as much as the test; measured 50 -> 45 ms per
-# 100 000 pairs of 12-gons (one thread), single pairs within noise (+0.1 us).
+# reference counting) that call costs about as much as the test.
 @njit(cache=True, nogil=True, inline="always")
 def cones_overlap(px, py, xa, fa, xb, fb, na, edges, eps, ray_scratch):
     """Whether the open interior cones of A and B at the touch point p overlap.

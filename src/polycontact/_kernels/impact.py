@@ -681,8 +681,7 @@ def unpack_body(f, i):
 
 
 # The one kernel that takes its settings as plain numbers rather than as a record: it is
-# the call from Python, where unboxing a nested tuple and building it cost about 50 ns
-# (1 % of a small query) more than seven numbers.
+# the call from Python, where unboxing a nested tuple costs more than seven numbers.
 @njit(cache=True, nogil=True)
 def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter,
                work):

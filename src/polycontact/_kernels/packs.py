@@ -3,10 +3,10 @@ the stack, the state kernel's scratch, and a shape's kernel pack, with no alloca
 no call into Numba's helpers.
 
 A Numba ``reshape`` calls a helper of Numba's C library and ``view`` checks its
-arguments at run time: the dozen views that the state kernel of two 12-gons takes of
-the shapes' kernel packs and of its scratch cost about 0.1 µs of its 0.4-0.6 µs
-(measured warm, one process). Here a view is a pointer and a shape written straight
-into the array's structure. With ``NUMBA_DISABLE_JIT=1`` the same functions are plain
+arguments at run time: for the dozen views that the state kernel of two small shapes
+takes of the shapes' kernel packs and of its scratch, that is a sizeable part of the
+kernel's time. Here a view is a pointer and a shape written straight into the array's
+structure. With ``NUMBA_DISABLE_JIT=1`` the same functions are plain
 NumPy slicing, so the kernels' bodies run (and are tested) as Python.
 
 The caller guarantees the bounds: ``view(buf, start, n, k, dtype)`` must lie inside
@@ -181,8 +181,8 @@ def state_scratch_views(buf, size):
 #: shapes', so the caller reads no float object), the loop starts (int64 bit patterns,
 #: L + 1 of them) and then the packed coordinates row by row. A
 #: ``bytes`` object holds its data in itself: unboxing it reads one object, where an
-#: ndarray's header, shape and data are three allocations (0.26 against 0.43-0.52 us per
-#: call of two packs when other code has evicted the caches; the same when warm).
+#: ndarray's header, shape and data are three (which counts when other code has evicted
+#: the caches).
 PACK_HEAD = 6
 
 

@@ -137,7 +137,7 @@ def oriented_state(xa, sa, fa, xb, sb, fb, eps):
     return _overlap_state(xa, sa, fa, xb, sb, fb, eps, ba, bb, state_scratch(na + nb))
 
 
-# Inlined: as a call (a tuple of tuples returned) it made the World's pairs ~25 ns slower.
+# Inlined: as a call (a tuple of tuples returned) it slows the World's pairs down.
 @njit(cache=True, nogil=True, inline="always")
 def _early_exit(xa, na, xb, nb, eps):
     """``(apart, box of A, box of B)``: apart when the boxes are more than eps apart or
@@ -160,8 +160,8 @@ def _window(ba, bb, eps):
             min(ba[3], bb[3]) + eps)
 
 
-# Inlined into its callers: a call that passes a dozen arrays cost about 50 ns (more
-# than the early exits it makes), measured on the World's candidate pairs.
+# Inlined into its callers: a call that passes a dozen arrays costs more than the early
+# exits it makes, on the World's candidate pairs.
 @njit(cache=True, nogil=True, inline="always")
 def state_in(xa, sa, fa, xb, sb, fb, eps, scratch):
     """:func:`oriented_state` with the state kernel's ``scratch`` (the buffers of
@@ -304,9 +304,8 @@ _overlap_state = njit(cache=True, nogil=True, _nrt=False)(_overlap_test)
 
 
 # The same test inlined, for the state kernel of one pair of Shapes
-# (:func:`relate_shapes_into`): a call with its arguments cost 0.03-0.1 us
-# of the 0.3-0.7 us a pair of 12-gons takes (contact and penetrating pairs; one process,
-# three classes of 200 pairs). The kernels that loop over many pairs call it: inlined
+# (:func:`relate_shapes_into`): a call with its arguments is a sizeable part of the time
+# a pair of small shapes takes. The kernels that loop over many pairs call it: inlined
 # into each of them it would multiply their compile time.
 _overlap_state_inlined = njit(nogil=True, _nrt=False, inline="always")(_overlap_test)
 
@@ -334,11 +333,11 @@ def relate_state(xa, sa, xb, sb, eps):
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): the counts of the
-# arrays it is called with and passes on cost ~0.1 us per call, as much as the test of a
-# small separate pair. Nothing in it allocates: the scratch is on its stack (a buffer
-# passed in cost a thread-local look-up and one more array to unbox per call, about
-# 0.05 us). It takes one bytes object per shape (see PACK_HEAD) and reads the bounding
-# boxes and tolerance terms cached in them.
+# arrays it is called with and passes on cost as much as the test of a small separate
+# pair. Nothing in it allocates: the scratch is on its stack (a buffer passed in would
+# cost a thread-local look-up and one more array to unbox per call). It takes one bytes
+# object per shape (see PACK_HEAD) and reads the bounding boxes and tolerance terms
+# cached in them.
 @njit(cache=True, nogil=True, _nrt=False)
 def relate_shapes_into(pa, pb, eps):
     """:func:`relate_state` of two shapes given by their kernel packs (``Shape._kernel``),

@@ -6,9 +6,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..bodies import as_shape
 from ..errors import InvalidShapeError
-from ..shape import Shape
+from ..shape import Shape, as_shape
 from ._errors import CommandError
 from ._progress import announced
 
@@ -21,8 +20,8 @@ BODY_FILE_FORMS = ('JSON {"vertices": [[x, y], ...], "holes": [...]}, a JSON lis
 def read_shape(path: str, *, repair: bool = False) -> Shape:
     """Read one shape from ``path``.
 
-    Accepted: every text or binary form of a body (:mod:`polycontact.bodies`): a JSON
-    body ``{"vertices": [[x, y], ...], "holes": [...]}``, a bare JSON list of vertices
+    Accepted: every text or binary form of a shape (:func:`polycontact.shape.as_shape`):
+    a JSON mapping ``{"vertices": [[x, y], ...], "holes": [...]}``, a bare JSON list of vertices
     ``[[x, y], ...]``, a GeoJSON Polygon/Feature, WKT text (``POLYGON ((...))``) or WKB
     (binary or hex). Any problem is raised as a :class:`CommandError` whose message
     starts with the file name.

@@ -131,10 +131,11 @@ def run(args: argparse.Namespace) -> int:
                "samples": args.samples}
     bodies = f"{len(scene.bodies)} bodies ({sum(b.shape.n_vertices for b in scene.bodies)} " \
         f"vertices) over [0, {scene.t_max:g}]"
+    names = [b.name for b in scene.bodies]
     if args.all:
         with announced(f"searching every impact of {bodies}"):
             events = scene.impacts(**options)
-        reps = [imp.to_dict((a.name, b.name)) for a, b, imp in events]
+        reps = [imp.to_dict((names[i], names[j])) for i, j, imp in events]
         if args.json:
             print(json.dumps({"events": reps}))
         else:
@@ -144,14 +145,14 @@ def run(args: argparse.Namespace) -> int:
             if args.plot:
                 raise CommandError("--plot: no pair meets, nothing to draw")
             return 0
-        body_a, body_b, impact = events[0]
+        i, j, impact = events[0]
     else:
         with announced(f"searching the first impact of {bodies}"):
-            body_a, body_b, impact = scene.first_impact(**options)
-        rep = impact.to_dict((body_a.name, body_b.name))
+            i, j, impact = scene.first_impact(**options)
+        rep = impact.to_dict((names[i], names[j]))
         print(json.dumps(rep) if args.json else _text(rep))
     if args.plot:
-        save_figure(impact.plot(names=(body_a.name, body_b.name)).figure, args.plot)
+        save_figure(impact.plot(names=(names[i], names[j])).figure, args.plot)
     return 0
 
 

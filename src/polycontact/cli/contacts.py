@@ -41,9 +41,9 @@ def add_parser(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-#: Layouts with at least this many bodies show a progress bar while they are read
-#: (reading and validating takes about 30 µs per 12-gon; the contacts themselves
-#: take a few µs per body).
+#: Layouts with at least this many bodies show a progress bar while they are read:
+#: reading and validating the bodies takes longer than finding their contacts, long
+#: enough at this size to be worth showing.
 PROGRESS_MIN_BODIES = 10_000
 
 
@@ -61,7 +61,7 @@ def _progress(entries: list[Any], progress: bool) -> Any:
 def read_layout(path: str, progress: bool = False) -> tuple[Any, list[Any], list[str]]:
     """(container Shape or None, bodies, names) of a layout file; errors name the file
     and the entry. ``progress``: a bar on stderr while a long layout is read."""
-    from ..bodies import as_shape
+    from ..shape import as_shape
 
     try:
         data = load_json(Path(path).read_bytes())
@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     with announced(f"finding the contacts of {len(bodies)} bodies"):
         world.add_many(bodies, names=names)
         try:
-            contacts = world.contacts(args.tolerance)
+            contacts = world.contacts(tolerance=args.tolerance)
         except ValueError as exc:
             raise CommandError(str(exc)) from None
         rep = contacts.to_dict(names)

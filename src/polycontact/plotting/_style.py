@@ -11,6 +11,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
     from ..shape import Shape
 
 #: Coordinates are in whatever length unit the caller used (consistent throughout).
@@ -32,11 +34,11 @@ def pyplot() -> Any:
     return plt
 
 
-def new_axes(figsize: tuple[float, float]) -> Any:
+def new_axes(figsize: tuple[float, float]) -> Axes:
     """Axes of a new figure of ``figsize`` inches whose layout makes room for the titles,
     the axis labels and a legend outside the axes (``layout="constrained"``), so that
     ``ax.figure.savefig(...)`` clips none of them."""
-    _, ax = pyplot().subplots(figsize=figsize, layout="constrained")
+    ax: Axes = pyplot().subplots(figsize=figsize, layout="constrained")[1]
     return ax
 
 
@@ -52,6 +54,12 @@ def shape_patch(shape: Any, **style: Any) -> Any:
         verts += [*loop.tolist(), loop[0].tolist()]
         codes += [Path.MOVETO] + [Path.LINETO] * (len(loop) - 1) + [Path.CLOSEPOLY]
     return PathPatch(Path(verts, codes), **style)
+
+
+def xy(p: Any) -> tuple[float, float]:
+    """A point (an array of two numbers) as the ``(x, y)`` tuple matplotlib's
+    ``annotate`` takes."""
+    return float(p[0]), float(p[1])
 
 
 def plural(n: int, noun: str) -> str:

@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._style import LENGTH_LABEL, label_axes, legend_outside, plural, pyplot
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..entrance import EntranceBlock
 
 __all__ = ["plot_entrance_block", "plot_union"]
 
@@ -18,7 +24,7 @@ FAMILY_STYLE = {
 }
 
 
-def plot_entrance_block(block: Any, figure: Any = None) -> Any:
+def plot_entrance_block(block: EntranceBlock, figure: Figure | None = None) -> Figure:
     """Draw an entrance block like the paper's Fig. 5, in four panels.
 
     One panel per family of components (each in its colour, translucent so overlaps
@@ -78,7 +84,7 @@ def plot_entrance_block(block: Any, figure: Any = None) -> Any:
     return figure
 
 
-def plot_union(block: Any, ax: Any) -> Any:
+def plot_union(block: EntranceBlock, ax: Axes) -> Axes:
     """Draw the union panel alone into ``ax``: B, A, E(A, B) with its outline, a0.
 
     Returns ``ax`` (with axis labels and a legend outside).

@@ -7,10 +7,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..motion import Motion
-from ..bodies import BodyLike, as_shape
-from ._style import draw_shape, label_axes, legend_outside, new_axes
+from ..shape import ShapeLike, as_shape
+from ._style import draw_shape, label_axes, legend_outside, new_axes, xy
 
 if TYPE_CHECKING:  # (impact.py imports this module to plot: no cycle at run time)
+    from matplotlib.axes import Axes
+
     from ..impact import Impact
 
 __all__ = ["plot_impact"]
@@ -24,19 +26,36 @@ def _event_time(impact: Impact) -> float:
 
 
 def plot_impact(
-    a: BodyLike,
+    a: ShapeLike,
     motion_a: Motion,
-    b: BodyLike,
+    b: ShapeLike,
     motion_b: Motion,
     impact: Impact,
     *,
     names: tuple[str, str] = ("A", "B"),
-    ax: Any = None,
-) -> Any:
+    ax: Axes | None = None,
+) -> Axes:
     """Draw both bodies at t = 0 (faint) and at the event, the centroid paths, the contact.
 
     The event is ``impact.time`` (collision), else ``impact.first_contact``, else the end
-    of the search. Returns the matplotlib Axes.
+    of the search.
+
+    Parameters
+    ----------
+    a, b : ShapeLike
+        The bodies at t = 0, as given to :func:`polycontact.time_of_impact`.
+    motion_a, motion_b : Motion
+        Their motions.
+    impact : Impact
+        What :func:`polycontact.time_of_impact` answered for them.
+    names : (str, str), default ("A", "B")
+        The bodies' names in the legend.
+    ax : matplotlib Axes, optional
+        Drawn into a new figure when omitted.
+
+    Returns
+    -------
+    matplotlib Axes
 
     Examples
     --------
@@ -71,7 +90,7 @@ def plot_impact(
         if impact.normal is not None:
             # Long enough to clear the marker, drawn above it.
             size = 0.3 * max(a.bounding_radius, b.bounding_radius)
-            ax.annotate("", xy=impact.point + size * impact.normal, xytext=impact.point,
+            ax.annotate("", xy=xy(impact.point + size * impact.normal), xytext=xy(impact.point),
                         arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8},
                         zorder=6)
             ax.add_line(Line2D([], [], color="black", lw=1.8, marker=">", markevery=[1],

@@ -4,11 +4,19 @@ positions where A fits)."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._style import label_axes, legend_outside, new_axes, plural
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    from matplotlib.axes import Axes
+    from shapely.geometry.base import BaseGeometry
+
+    from ..nfp import NoFitPolygon
+    from ..shape import Shape
 
 __all__ = ["fit_parts", "plot_inner_fit", "plot_nfp"]
 
@@ -30,7 +38,8 @@ def _patch(geom: Any, **style: Any) -> Any:
     return PathPatch(Path(np.asarray(verts), codes), **style)
 
 
-def plot_nfp(nfp: Any, placement: Any = None, ax: Any = None) -> Any:
+def plot_nfp(nfp: NoFitPolygon, placement: npt.ArrayLike | None = None,
+             ax: Axes | None = None) -> Axes:
     """Draw a no-fit polygon like the paper's Fig. 18.
 
     B in grey; the region E(A, B) in red, its outline (the NFP) in black, its holes
@@ -101,8 +110,9 @@ def fit_parts(geometry: Any) -> tuple[Any, np.ndarray, np.ndarray]:
             np.array(slides, dtype=np.float64).reshape(-1, 2, 2))
 
 
-def plot_inner_fit(a: Any, container: Any, geometry: Any, reference: Any,
-                   placement: Any = None, ax: Any = None) -> Any:
+def plot_inner_fit(a: Shape, container: Shape, geometry: BaseGeometry,
+                   reference: npt.ArrayLike, placement: npt.ArrayLike | None = None,
+                   ax: Axes | None = None) -> Axes:
     """Draw an inner-fit polygon: the container in grey, the positions of A's reference
     point where A lies inside it in green (with its outline), exact fits as black stars
     and slides as thick black segments, and A (purple) with its reference point (red

@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
-from ._style import draw_shape, label_axes, legend_outside, new_axes
+from ._style import draw_shape, label_axes, legend_outside, new_axes, xy
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..relation import Relation
 
 __all__ = ["plot_relation"]
 
 
-def plot_relation(relation: Any, ax: Any = None) -> Any:
+def plot_relation(relation: Relation, ax: Axes | None = None) -> Axes:
     """Draw A (red) and B (blue) where they stand, the witness point and the normal.
 
     Parameters
@@ -44,7 +49,7 @@ def plot_relation(relation: Any, ax: Any = None) -> Any:
                 label="witness point")
         if normal is not None:
             size = 0.3 * max(a.bounding_radius, b.bounding_radius)
-            ax.annotate("", xy=point + size * normal, xytext=point, zorder=6,
+            ax.annotate("", xy=xy(point + size * normal), xytext=xy(point), zorder=6,
                         arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8})
             ax.add_line(Line2D([], [], color="black", lw=1.8, marker=">", markevery=[1],
                                label="normal, A towards B"))

@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ._style import label_axes, legend_outside, new_axes, plural, shape_patch
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..shape import Shape
 
 __all__ = ["plot_shape"]
 
 
-def plot_shape(shape: Any, ax: Any = None, *, numbers: bool = False, **style: Any) -> Any:
+def plot_shape(shape: Shape, ax: Axes | None = None, *, numbers: bool = False,
+               **style: Any) -> Axes:
     """Draw a shape: its solid filled, holes left open, every loop outlined.
 
     Parameters

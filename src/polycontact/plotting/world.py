@@ -3,9 +3,14 @@ and penetrations (:func:`plot_contacts`)."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ._style import label_axes, legend_outside, new_axes, plural, shape_patch
+from ._style import label_axes, legend_outside, new_axes, plural, shape_patch, xy
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..world import Contacts, World
 
 __all__ = ["plot_contacts", "plot_world"]
 
@@ -15,7 +20,7 @@ LABELLED_BODIES = 100
 _COLOURS = {"penetrating": "#d62728", "outside the container": "#ff7f0e", "body": "#9ecae1"}
 
 
-def plot_contacts(contacts: Any, ax: Any = None) -> Any:
+def plot_contacts(contacts: Contacts, ax: Axes | None = None) -> Axes:
     """Draw the bodies (penetrating ones red, those leaving the container orange), the
     container, contact points (green circles) and penetrations (black crosses).
 
@@ -42,7 +47,7 @@ def plot_contacts(contacts: Any, ax: Any = None) -> Any:
     """
     if ax is None:
         ax = new_axes((11, 7))
-    pen = set(contacts.penetrating.ravel().tolist())
+    pen = set(contacts.penetrating_pairs.ravel().tolist())
     out = set(contacts.container_ids[contacts.container_states == 2].tolist())
     if contacts.container is not None:
         ax.add_patch(shape_patch(contacts.container, facecolor="none", edgecolor="0.2", lw=1.5,
@@ -81,7 +86,7 @@ def _bodies(n: int) -> str:
     return "1 body" if n == 1 else f"{n} bodies"
 
 
-def plot_world(world: Any, ax: Any = None, *, labels: bool | None = None) -> Any:
+def plot_world(world: World, ax: Axes | None = None, *, labels: bool | None = None) -> Axes:
     """Draw the bodies of a World where they stand and its container (no contacts are
     computed: :meth:`World.contacts` and its ``plot`` draw those).
 
@@ -120,7 +125,7 @@ def plot_world(world: Any, ax: Any = None, *, labels: bool | None = None) -> Any
     if labels or (labels is None and len(bodies) <= LABELLED_BODIES):
         for body in bodies:
             text = str(body.id) if body.name is None else f"{body.id} ({body.name})"
-            ax.annotate(text, body.shape.centroid, ha="center", va="center",
+            ax.annotate(text, xy(body.shape.centroid), ha="center", va="center",
                         fontsize="small")
     ax.autoscale_view()
     label_axes(ax)
