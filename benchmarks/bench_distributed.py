@@ -20,7 +20,7 @@ square, an L and a U, each pair one of them at a random place and turn against a
 axis), spins (up to 1 rad/s), accelerations for a quarter, over [0, 3]; each pair has
 its own shape objects except one side of every other pair, which shares one of the
 three. ``local 1`` is the local call on one thread, ``local N`` on every CPU, ``dask
-1`` / ``dask 2`` :func:`polycontact.distributed.time_of_impact_many` on the clusters
+1`` / ``dask 2`` the same call with ``client=`` on the clusters
 above (default chunk size), whose first run is checked equal to ``local 1``. Each run
 gets new shape objects (the search keeps its tables with a shape). Printed with the
 fastest and slowest run.
@@ -116,7 +116,6 @@ def main() -> None:
     args = parser.parse_args()
     from distributed import Client, LocalCluster
 
-    from polycontact import distributed as pd
 
     pc.warmup(["no-fit polygon", "many moving bodies"])
     instances = {} if args.no_nfp else {
@@ -159,10 +158,10 @@ def main() -> None:
                     lambda: pc.nfp_table(inst, progress=False, client=client),
                     args.repeat, client)
             if args.impacts:
-                got = pd.time_of_impact_many(*impact_pairs(args.impacts), 3, client=client)
+                got = pc.time_of_impact_many(*impact_pairs(args.impacts), t_max=3, client=client)
                 assert same(got, want)
                 toi[f"dask {n}"] = spread(
-                    lambda p: pd.time_of_impact_many(*p, 3, client=client), args.impacts,
+                    lambda p: pc.time_of_impact_many(*p, t_max=3, client=client), args.impacts,
                     args.repeat)
     print(f"{os.cpu_count()} CPUs; medians of {args.repeat} runs, seconds\n")
     if toi:

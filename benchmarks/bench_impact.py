@@ -118,7 +118,8 @@ def kernel_query(a, ma, b, mb, t_max, method="exact", samples=10, compiled=False
     else:
         kernel = ki.sampled_query
         args = ((ra, a.packed[1], a.centroid, la), va, (rb, b.packed[1], b.centroid, lb), vb,
-                (t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR, 0.0, 0, samples),
+                (t_max, BROAD_PHASE_INFLATION, TOL, eps_rel, ROUNDING_FACTOR, 0.0, 1_000_000,
+                 samples),
                 work)
     if compiled:
         kernel = entry_point(kernel, args)

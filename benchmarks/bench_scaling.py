@@ -106,6 +106,20 @@ def one_row(case: str, n: int, repeat: int) -> dict:
     return row
 
 
+def row_in_fresh_process(cmd: list[str], timeout: float) -> dict | str:
+    """Run ``cmd`` (a script's ``--row`` mode, which prints its row as JSON on its last
+    line) in a fresh process: the row, or why there is none: ``"> N"`` past ``timeout``
+    seconds, ``"killed (memory?)"`` or ``"failed (code)"``."""
+    try:
+        run = subprocess.run(cmd, capture_output=True, text=True, check=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return f"> {int(timeout)}"
+    except subprocess.CalledProcessError as err:
+        return "killed (memory?)" if err.returncode < 0 else f"failed ({err.returncode})"
+    row: dict = json.loads(run.stdout.strip().splitlines()[-1])
+    return row
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
@@ -126,17 +140,10 @@ def main() -> None:
             if n > args.max or (case == "depth, stars deep" and n > 1000):
                 continue
             cmd = [sys.executable, __file__, "--repeat", str(args.repeat), "--row", case, str(n)]
-            try:
-                run = subprocess.run(cmd, capture_output=True, text=True, check=True,
-                                     timeout=args.timeout)
-            except subprocess.TimeoutExpired:
-                print(f"{case:24} {n:9d} {'> ' + str(int(args.timeout)):>10}", flush=True)
+            row = row_in_fresh_process(cmd, args.timeout)
+            if isinstance(row, str):
+                print(f"{case:24} {n:9d} {row:>10}", flush=True)
                 continue
-            except subprocess.CalledProcessError as err:
-                why = "killed (memory?)" if err.returncode < 0 else f"failed ({err.returncode})"
-                print(f"{case:24} {n:9d} {why:>28}", flush=True)
-                continue
-            row = json.loads(run.stdout.strip().splitlines()[-1])
             spread = f"{row['min']:.3f}..{row['max']:.3f}"
             peer = f"{row['shapely']:10.3f}" if "shapely" in row else f"{'':>10}"
             print(f"{case:24} {n:9d} {row['seconds']:10.3f} {spread:>17} {row['peak_mb']:8.0f}"

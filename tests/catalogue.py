@@ -33,6 +33,22 @@ from polycontact import Shape
 from polycontact.errors import InvalidShapeError
 
 
+def interlocking_combs(teeth: int) -> tuple[np.ndarray, np.ndarray]:
+    """Two regular combs of ``4 teeth + 4`` vertices: one with its unit teeth down, one
+    with its teeth up, each tooth exactly as wide as the other's gaps (the first fits
+    into the second at every shift, sliding: ``2 teeth - 1`` slides in their no-fit
+    polygon)."""
+    w = 2 * teeth + 1
+    up = [(0, 0), (w, 0), (w, 2), (w - 1, 2)]
+    for i in range(teeth - 1, -1, -1):
+        up += [(2 * i + 2, 1), (2 * i + 1, 1), (2 * i + 1, 2), (2 * i, 2)]
+    down = [(0, 0), (w, 0), (w, 1)]
+    for i in range(teeth - 1, -1, -1):
+        down += [(2 * i + 2, 1), (2 * i + 2, 2), (2 * i + 1, 2), (2 * i + 1, 1)]
+    down += [(0, 1)]
+    return np.array(down, float) * [1.0, -1.0], np.array(up, float)
+
+
 @dataclass(frozen=True)
 class Case:
     """Two bodies and the state they are in (``"separate"``, ``"contact"``,

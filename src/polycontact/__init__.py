@@ -18,8 +18,8 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from .errors import (DepthTooLargeError, InvalidSceneError, InvalidShapeError, NfpTooLargeError,
-                     PolycontactError)
+from .errors import (DepthTooLargeError, EntranceBlockTooLargeError, InvalidSceneError,
+                     InvalidShapeError, NfpTooLargeError, PolycontactError, WorkLimitError)
 from .shape import Shape, ShapeLike
 
 __version__ = "0.1.0"
@@ -76,8 +76,10 @@ _LAZY = {
 __all__ = [
     "PolycontactError",
     "InvalidShapeError",
+    "WorkLimitError",
     "NfpTooLargeError",
     "DepthTooLargeError",
+    "EntranceBlockTooLargeError",
     "InvalidSceneError",
     "Shape",
     "ShapeLike",

@@ -3,36 +3,32 @@
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Iterable
+from collections.abc import Callable
 from typing import Any
 
 from distributed import WorkerPlugin
-
-from .compiling import FAMILIES, warmup
 
 __all__ = ["WarmupPlugin"]
 
 
 class WarmupPlugin(WorkerPlugin):
-    """Loads (or compiles) polycontact's kernels once per worker, when it starts or joins.
+    """Runs ``warm()`` once per worker, when it starts or joins: a call that loads (or
+    compiles) the kernels a batch uses, so that no task does.
 
-    Registered by :func:`polycontact.distributed.ensure_warm`. The warm-up runs in a
+    Registered by :func:`polycontact.distributed.ensure_warm` (``warm``: the warm-up of a
+    kernel family) and by the batches (a first task of theirs). The call runs in a
     thread, so the worker keeps answering the scheduler while Numba compiles.
 
     Parameters
     ----------
-    families : iterable of str, optional
-        Kernel families (keys of :data:`polycontact.compiling.FAMILIES`); default all.
+    warm : callable
+        Called without arguments; picklable (it is sent to the workers).
     """
 
     name = "polycontact-warmup"
 
-    def __init__(self, families: Iterable[str] | None = None) -> None:
-        self.families = tuple(FAMILIES if families is None else families)
-        unknown = [f for f in self.families if f not in FAMILIES]
-        if unknown:
-            raise ValueError(f"families: expected names from {', '.join(FAMILIES)}, "
-                             f"got {unknown[0]!r}")
+    def __init__(self, warm: Callable[[], Any]) -> None:
+        self.warm = warm
 
     async def setup(self, worker: Any) -> None:
-        await asyncio.to_thread(warmup, self.families)
+        await asyncio.to_thread(self.warm)

@@ -26,7 +26,8 @@ import numpy as np
 
 from ._pieces import pieces_packed
 from .errors import DepthTooLargeError
-from .limits import EAR_CLIPPING_MAX, MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS
+from . import limits
+from .limits import EAR_CLIPPING_MAX, RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = ["penetration", "penetrations"]
 
@@ -59,7 +60,10 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     ------
     DepthTooLargeError
         When the convex sums near the overlap would hold more than
-        :data:`~polycontact.limits.MAX_SUM_VERTICES` vertices.
+        :data:`~polycontact.limits.MAX_SUM_VERTICES` vertices (read at each call):
+        before the bodies are decomposed when the vertex-edge contacts within the first
+        escape already prove it (:func:`polycontact._kernels.depth.contacts_near`, a
+        lower bound), else once the pieces near the overlap are counted.
 
     Examples
     --------
@@ -70,18 +74,26 @@ def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
     [0.5, -0.5, 0.0]
     """
     from ._kernels.convolution import FEW_VERTICES, contact_depth
-    from ._kernels.depth import box_escape, depth_from_pieces, first_escape
+    from ._kernels.depth import box_escape, contacts_near, depth_from_pieces, first_escape
 
     if len(xa) + len(xb) <= FEW_VERTICES:
         fast = contact_depth(xa, sa, xb, sb, *box_escape(xa, xb), eps)
         if fast[3]:
             return fast[0], fast[1], fast[2]
+    escape = first_escape(xa, xb)
+    limit = limits.MAX_SUM_VERTICES
+    # refused before decomposing (GEOS's triangulation of 10^5 vertices takes seconds)
+    # when the contacts near the overlap already prove the sums too large
+    lower = contacts_near(xa, sa, xb, sb, escape[0], float(limit))
+    if lower > limit:
+        raise _too_large(len(xa), len(xb),
+                         f"at least {lower:.0f} (counted from the vertex-edge contacts "
+                         f"within the first escape, {escape[0]:.3g} length units)")
     bxy, bst = pieces_packed(xb, sb)
     axy, ast = pieces_packed(xa, sa)
-    got = depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), first_escape(xa, xb),
-                            eps, MAX_SUM_VERTICES)
+    got = depth_from_pieces((xa, sa), (xb, sb), (bxy, bst), (-axy, ast), escape, eps, limit)
     if np.isnan(got[0]):
-        raise _too_large(len(xa), len(xb))
+        raise _too_large(len(xa), len(xb), "more")
     return cast("tuple[float, float, float]", got)
 
 
@@ -132,15 +144,19 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     if bad.size:
         p = pairs[one[bad[0]]]
         raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
-                         int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]))
+                         int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]), "more")
     return cast("np.ndarray", out[group])
 
 
-def _too_large(m: int, n: int) -> DepthTooLargeError:
+def _too_large(m: int, n: int, estimate: str) -> DepthTooLargeError:
+    """The error of a depth whose convex sums would hold ``estimate`` vertices, more
+    than the limit."""
     return DepthTooLargeError(
         f"penetration depth: the convex sums of the pieces near the overlap would hold "
-        f"more than {MAX_SUM_VERTICES:.0e} vertices (memory); the bodies ({m} and "
-        f"{n} vertices) are too large and interlocked for this depth"
+        f"{estimate} vertices, more than limits.MAX_SUM_VERTICES = "
+        f"{limits.MAX_SUM_VERTICES:.3g} (memory); the bodies ({m} and {n} vertices) are "
+        f"too large and interlocked for this depth (set "
+        f"polycontact.limits.MAX_SUM_VERTICES to allow more)"
     )
 
 
@@ -183,4 +199,4 @@ def _depths_by_pieces(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
     ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
     rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    return depths_of_pairs(batch, pairs, eps, slot_a, ra, slot_b, rb, MAX_SUM_VERTICES)
+    return depths_of_pairs(batch, pairs, eps, slot_a, ra, slot_b, rb, limits.MAX_SUM_VERTICES)

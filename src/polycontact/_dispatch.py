@@ -37,11 +37,15 @@ def entry_point(dispatcher: Any, args: tuple[Any, ...]) -> Callable[..., Any]:
     try:
         from numba import typeof
 
+        from ._kernels.jit import accepts
+
         key = tuple(typeof(x) for x in args)  # type: ignore[no-untyped-call]
         found = dispatcher.overloads.get(key)
         if found is None:
             dispatcher(*args)
-            found = dispatcher.overloads.get(key)
+            # (a kernel compiles for the relaxed types of its arguments: see _kernels.jit)
+            found = next((cres for have, cres in dispatcher.overloads.items()
+                          if accepts(have, key)), None)
         fast = getattr(found, "entry_point", None)
     except Exception:  # noqa: BLE001 - any change in Numba's internals: the safe way
         fast = None

@@ -1,18 +1,27 @@
 """Compiling the kernels: whether the cache is warm, and warm-up.
 
-polycontact's kernels are compiled by Numba on first use and cached on disk. The first
-run on a new machine (or after an upgrade) therefore takes about a minute; every run
-after it loads the compiled code in well under a second.
+polycontact's kernels are compiled by Numba on first use and cached on disk. A call
+compiles only the kernels it runs, the first time they run on a machine (or after an
+upgrade): a first call takes seconds to tens of seconds (about 40 s for the first time
+of impact on a 2-core machine), and every run after it loads the compiled code in well
+under a second.
+
+**The notice.** The first compile of a process says so once, as a warning on the
+``polycontact`` logger (:data:`polycontact._kernels.jit.LOGGER`), shown on stderr when
+logging is not configured: ``polycontact is compiling the kernels this call needs (...)``.
+``logging.getLogger("polycontact").setLevel(logging.ERROR)`` silences it. Kernels
+loaded from the cache say nothing.
 
 **Where the cache goes.** In the per-user cache directory (:func:`cache_directory`,
 e.g. ``~/.cache/polycontact/numba`` on Linux; ``NUMBA_CACHE_DIR`` overrides it for
 every Numba library), in a subdirectory named after a hash of all the kernels' sources
-(:func:`kernel_sources_fingerprint`); see :mod:`polycontact._kernels.cache`.
+(:func:`kernel_sources_fingerprint`), shared by every install of the same sources
+(editable or not); see :mod:`polycontact._kernels.cache`.
 
-**First run.** :func:`warmup` compiles (or loads) every kernel family and reports each
-stage to a callback; the command line says "compiling kernels, first run only, about a
-minute" on stderr before a command whose kernels are not cached yet, with one line per
-stage (``polycontact warmup`` does it on purpose), so stdout stays parseable.
+**Ahead of time.** :func:`warmup` compiles (or loads) every kernel family and reports
+each stage to a callback, in this process or in several at once; ``polycontact
+warmup`` does it from the command line, in one process per CPU, one line per family on
+stderr.
 
 This module is the top of the package: :func:`warmup` calls every public function.
 
@@ -28,6 +37,8 @@ True
 from __future__ import annotations
 
 import importlib
+import itertools
+import logging
 import time
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -42,9 +53,10 @@ FAMILIES: dict[str, tuple[str, ...]] = {
                        "rings.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
     "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
-                       "fits.select_contacts"),
+                       "fits.select_contacts", "nfp_batch.nfp_pairs"),
     "entrance block": ("validate.first_defect",),
-    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk"),
+    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk",
+                           "impact_batch.body_tables", "impact_batch.suspect_bodies"),
 }
 
 
@@ -113,6 +125,9 @@ def _run(family: str) -> None:
         no_fit_polygon(Shape(sq), slot).region  # noqa: B018
         inner_fit_polygon(Shape(sq), Shape(sq * 4.0))
         inner_fit_polygon(Shape(sq), Shape(sq))  # an exact fit
+        from .nfp_tables import nfp_table
+
+        nfp_table([ell, slot], progress=False, threads=1)  # the table's batch kernel
     elif family == "entrance block":
         from .entrance import entrance_block
 
@@ -132,6 +147,7 @@ def warmup(
     families: Iterable[str] = FAMILIES,
     *,
     progress: Callable[[str, int, int, float | None], None] | None = None,
+    processes: int = 1,
 ) -> None:
     """Compile (or load from the cache) the kernels now.
 
@@ -146,7 +162,16 @@ def warmup(
         Which kernel families (keys of :data:`FAMILIES`); all by default.
     progress : callable, optional
         Called as ``progress(family, k, n, seconds)`` before stage ``k`` of ``n``
-        (``seconds`` None) and after it (``seconds`` it took).
+        (``seconds`` None) and after it (``seconds`` it took). With several processes,
+        both calls come when the stage ends, and stages end in any order.
+    processes : int, optional
+        Compile in this many processes at once (up to one per family; each writes what
+        it compiles to the cache, where this process and later ones load it): about
+        half the wall time on two idle cores, for somewhat more CPU time (kernels that
+        several families run are compiled in each process that needs them). Each
+        process numbers the functions it compiles apart from every other process's, so
+        that no two give one name to different code in the cache. 1 (the default): in
+        this process.
 
     Examples
     --------
@@ -156,6 +181,11 @@ def warmup(
     for family in chosen:
         if family not in FAMILIES:
             raise ValueError(f"families: expected names from {', '.join(FAMILIES)}, got {family!r}")
+    if not (isinstance(processes, int) and processes >= 1):
+        raise ValueError(f"processes: expected an int >= 1, got {processes!r}")
+    if processes > 1 and len(chosen) > 1:
+        _warmup_in_processes(chosen, progress, min(processes, len(chosen)))
+        return
     for k, family in enumerate(chosen, 1):
         if progress is not None:
             progress(family, k, len(chosen), None)
@@ -163,3 +193,50 @@ def warmup(
         _run(family)
         if progress is not None:
             progress(family, k, len(chosen), time.perf_counter() - t0)
+
+
+def _warmup_in_processes(
+    chosen: list[str],
+    progress: Callable[[str, int, int, float | None], None] | None,
+    processes: int,
+) -> None:
+    """:func:`warmup` of ``chosen`` in ``processes`` worker processes, each family in
+    one of them, in order (the longest, classification, first)."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(processes, mp_context=context, initializer=_worker_start) as pool:
+        stages = {pool.submit(_timed_run, family): (k, family)
+                  for k, family in enumerate(chosen, 1)}
+        for done in as_completed(stages):
+            k, family = stages[done]
+            seconds = done.result()
+            if progress is not None:
+                progress(family, k, len(chosen), None)
+                progress(family, k, len(chosen), seconds)
+
+
+def _worker_start() -> None:
+    """A worker of :func:`warmup`: no compile notice (the caller reports), and the
+    functions it compiles numbered from its process id times 2**20 on.
+
+    Numba names compiled code after the function's name, argument types and a number
+    that counts up from 1 in each process; two processes can give one name to two
+    different functions (helpers that Numba generates share names), and a process that
+    later loads code of both from the cache can link the wrong one
+    (`numba/numba#10486 <https://github.com/numba/numba/issues/10486>`_). The workers'
+    numbers are apart from each other's and from those of every ordinary process.
+    """
+    import os
+
+    from numba.core.bytecode import FunctionIdentity
+
+    logging.getLogger("polycontact").setLevel(logging.ERROR)
+    FunctionIdentity._unique_ids = itertools.count(os.getpid() << 20)
+
+
+def _timed_run(family: str) -> float:
+    t0 = time.perf_counter()
+    _run(family)
+    return time.perf_counter() - t0

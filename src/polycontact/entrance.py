@@ -37,7 +37,9 @@ from typing import TYPE_CHECKING, Any, NamedTuple, cast
 import numpy as np
 import numpy.typing as npt
 
+from . import limits
 from ._checks import point as point_arg
+from .errors import EntranceBlockTooLargeError
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, default_tolerance, snap_grid
 
@@ -411,7 +413,8 @@ def entrance_block(
     reference : array_like of shape (2,), optional
         The reference point a0 of A; default A's area centroid (paper Eq. 3–4).
     method : {"swept", "pairs"}
-        ``"pairs"``: one parallelogram per edge of A and edge of B (m·n components).
+        ``"pairs"``: one parallelogram per edge of A and edge of B (m·n components;
+        more than :data:`~polycontact.limits.MAX_EDGE_PAIRS` are refused).
         ``"swept"``: one region per edge of B, the reflected boundary of A swept along
         it (n components); the paper's splice (§2.4, Fig. 6f) is used for every loop it
         is exact for (loops monotone across the edge), the union of the edge
@@ -435,6 +438,16 @@ def entrance_block(
     b = as_shape(b, "b")
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    if method == "pairs":
+        pairs = len(a.packed[0]) * len(b.packed[0])
+        if pairs > limits.MAX_EDGE_PAIRS:
+            # refused before any is built: each is a geometry and an object
+            raise EntranceBlockTooLargeError(
+                f"entrance_block: method='pairs' would build {pairs} edge-pair "
+                f"components ({len(a.packed[0])} x {len(b.packed[0])} edges), more than "
+                f"limits.MAX_EDGE_PAIRS = {limits.MAX_EDGE_PAIRS}; use method='swept' "
+                f"(one component per edge of b) or set "
+                f"polycontact.limits.MAX_EDGE_PAIRS to allow more")
     a0 = a.centroid.copy() if reference is None else point_arg(reference, "reference")
     check_range(a0.reshape(1, 2), "reference")
     a0.flags.writeable = False

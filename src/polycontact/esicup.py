@@ -40,7 +40,7 @@ from ._json import load_json
 from .errors import InvalidShapeError, PolycontactError
 from .shape import Shape
 
-__all__ = ["Instance", "InvalidInstanceError", "read_esicup", "turned"]
+__all__ = ["Instance", "InvalidInstanceError", "read_esicup", "turned", "turned_loops"]
 
 
 class InvalidInstanceError(PolycontactError, ValueError):
@@ -95,6 +95,19 @@ def turned(shape: Shape, degrees: float) -> Shape:
     >>> turned(sq, 180).exterior.tolist()
     [[-1.0, 0.0], [-2.0, 0.0], [-2.0, -1.0], [-1.0, -1.0]]
     """
+    loops = turned_loops(shape, degrees)
+    if loops is None:
+        return shape
+    return Shape(loops[0], loops[1:])
+
+
+def turned_loops(shape: Shape, degrees: float) -> list[np.ndarray] | None:
+    """The loops of :func:`turned` (``shape.loops`` turned, not yet checked as a Shape),
+    or None when the turn is none (a multiple of 360 degrees).
+
+    >>> turned_loops(Shape([(1, 0), (2, 0), (2, 1), (1, 1)]), 90)[0].tolist()
+    [[0.0, 1.0], [0.0, 2.0], [-1.0, 2.0], [-1.0, 1.0]]
+    """
     deg = finite_number(degrees, "degrees", error=InvalidShapeError)
     quarter = deg / 90.0
     if quarter == round(quarter):
@@ -102,10 +115,9 @@ def turned(shape: Shape, degrees: float) -> Shape:
     else:
         c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
     if (c, s) == (1.0, 0.0):
-        return shape
+        return None
     rot = np.array([[c, s], [-s, c]])  # row-vector form of R(degrees)
-    loops = [loop @ rot for loop in shape.loops]
-    return Shape(loops[0], loops[1:])
+    return [loop @ rot for loop in shape.loops]
 
 
 def read_esicup(path: str | PathLike[str]) -> Instance:

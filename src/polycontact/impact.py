@@ -385,10 +385,12 @@ def time_of_impact(
         resolves at the time examined (4 · 2⁻⁵² · abs(t)) it is clamped there, and the
         result's ``time_tolerance`` says so.
     samples : int, default :data:`~polycontact.limits.SAMPLES`
-        Points per round of the sampled method (>= 2); ignored by "exact".
+        Points per round of the sampled method (>= 2, at most ``max_iterations``: a
+        round may classify every one); ignored by "exact".
     max_iterations : int, default :data:`~polycontact.limits.MAX_ITERATIONS`
-        Budget of the exact method; when spent, the status is OUT_OF_ITERATIONS (no
-        verdict), never a hang.
+        Budget of the search: iterations of the exact method, classifications of the
+        sampled one; when spent, the status is OUT_OF_ITERATIONS (no verdict), never a
+        hang.
 
     Returns
     -------
@@ -439,7 +441,8 @@ def time_of_impact(
     if (type(t_max) is float and type(time_tolerance) is float and type(samples) is int
             and type(max_iterations) is int and 0.0 <= t_max < _INF
             and 0.0 < time_tolerance < _INF and 2 <= samples <= _INT64_MAX
-            and 1 <= max_iterations <= _INT64_MAX and method in _METHODS):
+            and 1 <= max_iterations <= _INT64_MAX and method in _METHODS
+            and (samples <= max_iterations or method == "exact")):
         tol = time_tolerance  # the common case, checked in one expression
     else:
         t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
@@ -479,8 +482,8 @@ def time_of_impact(
                 work)
     else:  # (the query's record, see _kernels.impact.exact_query: the exact method's at 0)
         args = ((ra, a._starts, a._centroid, la), ma._array, (rb, b._starts, b._centroid, lb),
-                mb._array, (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR, 0.0, 0,
-                            int(samples)), work)
+                mb._array, (t_max, BROAD_PHASE_INFLATION, tol, eps_rel, ROUNDING_FACTOR, 0.0,
+                            int(max_iterations), int(samples)), work)
     # the compiled code called directly when every argument has the type it always has
     # (Shapes and Motions), else through the dispatcher
     run = _ENTRY.get(method) if fixed else None
@@ -538,6 +541,12 @@ def check_options(t_max: float, method: str, time_tolerance: float, samples: int
         if not least <= value <= _INT64_MAX:
             raise ValueError(f"{name}: expected an integer from {least} to 2**63 - 1, got "
                              f"{value!r}")
+    if method == "sampled" and samples > max_iterations:
+        # refused before the search: its first round alone may classify every sample
+        raise ValueError(
+            f"samples: a round of the sampled search classifies up to {samples} time "
+            f"points, more than max_iterations = {max_iterations} (its budget of "
+            f"classifications); ask for fewer samples or a larger max_iterations")
     return t_max, tol
 
 

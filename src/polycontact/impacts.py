@@ -21,22 +21,26 @@ Examples
 from __future__ import annotations
 
 import math
-import os
+import operator
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from contextlib import closing
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from .broad_phase import check_motion, check_reach, check_t_max, reach_excess
+from .broad_phase import base_reach, check_motion, check_reach, check_t_max, reach_excess
 from .errors import InvalidShapeError
-from .impact import Impact, ImpactStatus, body_frame, check_options, impact_from_kernel
-from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, MAX_ITERATIONS, MAX_SLICES,
-                     RELATIVE_TOLERANCE, SAMPLES, SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
+from .impact import Impact, ImpactStatus, check_options, impact_from_kernel
+from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, EXTENT_FLOOR,
+                     MAX_ITERATIONS, MAX_SLICES, RELATIVE_TOLERANCE, SAMPLES,
+                     SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
+from .relation import shapes_packed
 from .shape import Shape, ShapeLike, as_shape
-from .tolerances import ROUNDING_FACTOR
+from .tolerances import ROUNDING_FACTOR, check_range
+from ._checks import real_array
+from ._threads import as_done, numba_threads, requested, useful
 
 __all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
@@ -159,8 +163,11 @@ def _sequence(items: Any, what: str) -> list[Any]:
 
 def check_shapes(items: Any, what: str) -> list[Shape]:
     """The bodies of the sequence ``items`` as Shapes (an error naming ``what[k]``)."""
+    given = _sequence(items, what)
+    if set(map(type, given)) <= {Shape}:
+        return given
     out = []
-    for k, obj in enumerate(_sequence(items, what)):
+    for k, obj in enumerate(given):
         if type(obj) is Shape:
             out.append(obj)
             continue
@@ -175,15 +182,62 @@ def check_shapes(items: Any, what: str) -> list[Shape]:
     return out
 
 
-def check_motions(items: Any, what: str, count: int, shapes_what: str) -> list[Motion]:
-    """The ``count`` Motions of the sequence ``items``, one per shape of ``shapes_what``
-    (an error naming ``what``)."""
+class MotionRows:
+    """Motions given as the rows of an (N, 6) float64 array of kernel vectors ``[vx, vy,
+    ax, ay, ω, α]`` (:attr:`polycontact.Motion.array`): the batch reads the rows as
+    they are, and makes the :class:`~polycontact.Motion` of a row only when asked for
+    (``motions[k]``).
+
+    >>> MotionRows(np.array([[1.0, 0, 0, 0, 0.5, 0]]))[0].angular_velocity
+    0.5
+    """
+
+    def __init__(self, rows: np.ndarray) -> None:
+        self.rows = rows
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __getitem__(self, k: int) -> Motion:
+        vx, vy, ax, ay, w, alpha = self.rows[k].tolist()
+        return Motion(velocity=(vx, vy), acceleration=(ax, ay), angular_velocity=w,
+                      angular_acceleration=alpha)
+
+
+#: Motions as a batch takes them: Motion objects, or the rows of an array.
+Motions = list[Motion] | MotionRows
+
+
+def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motions:
+    """The ``count`` motions of ``items``, one per shape of ``shapes_what`` (an error
+    naming ``what``): a sequence of Motions, or an array of shape (count, 6) of their
+    kernel vectors (:class:`MotionRows`, finite numbers)."""
+    if isinstance(items, np.ndarray) and items.ndim == 2:
+        rows = real_array(items, what)
+        if rows.shape != (count, 6):
+            raise ValueError(f"{what}: expected {count} motions (one per shape of "
+                             f"{shapes_what}) as an array of shape ({count}, 6), got shape "
+                             f"{rows.shape}")
+        bad = ~np.isfinite(rows).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise ValueError(f"{what}[{k}]: expected finite numbers, got {rows[k].tolist()}")
+        return MotionRows(rows)
     motions = _sequence(items, what)
     if len(motions) != count:
         raise ValueError(f"{what}: expected {count} motions (one per shape of {shapes_what}), "
                          f"got {len(motions)}")
+    if set(map(type, motions)) <= {Motion}:
+        return motions
     return [m if type(m) is Motion else check_motion(m, f"{what}[{k}]")
             for k, m in enumerate(motions)]
+
+
+def _rows(motions: Motions) -> np.ndarray:
+    """The kernel vectors of ``motions``, (N, 6)."""
+    if isinstance(motions, MotionRows):
+        return motions.rows
+    return np.frombuffer(b"".join(map(_ARRAY, motions)), np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -192,51 +246,55 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
     """:func:`polycontact.impact.check_options` and ``threads``:
     ``(t_max, time_tolerance, samples, max_iterations, threads)``."""
     t_max, tol = check_options(t_max, method, time_tolerance, samples, max_iterations)
-    if threads is None:
-        threads = os.cpu_count() or 1
-    elif isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"threads: expected an integer >= 1 or None, got {threads!r}")
-    return t_max, tol, int(samples), int(max_iterations), int(threads)
+    return t_max, tol, int(samples), int(max_iterations), requested(threads)
 
 
 # -- the batched search ----------------------------------------------------------------
-def _pack(shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The shapes' packed body frames (``_kernels.impact.pack_body``, built once per
-    shape) one after another, with their offsets: ``(floats, f_off, ints, i_off)``
-    (see ``impacts_chunk``)."""
-    packs = [body_frame(s)[3] for s in shapes]
-    f_off = np.zeros(len(packs) + 1, np.int64)
-    i_off = np.zeros(len(packs) + 1, np.int64)
-    np.cumsum([len(f) for f, _ in packs], out=f_off[1:])
-    np.cumsum([len(i) for _, i in packs], out=i_off[1:])
-    if not packs:
-        return np.empty(0), f_off, np.empty(0, np.int64), i_off
-    return (np.concatenate([f for f, _ in packs]), f_off,
-            np.concatenate([i for _, i in packs]), i_off)
+def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
+    """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
+    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, and
+    each shape's stored centroid and bounding radius)."""
+    n = len(shapes)
+    return (*shapes_packed(shapes),
+            np.frombuffer(b"".join(map(_CENTROID, shapes)), np.float64).reshape(n, 2),
+            np.fromiter(map(_RADIUS, shapes), np.float64, n))
 
 
-def search_pairs(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.ndarray,
-                 mb: np.ndarray, eps_rel: np.ndarray, t_max: float, method: str, tol: float,
-                 samples: int, max_iterations: int, threads: int) -> tuple[Any, ...]:
-    """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` through the
-    search of ``time_of_impact`` on ``threads`` threads (``eps_rel[p]``: the size term
-    of pair p's distance tolerance, see :func:`_extents`); the raw result arrays."""
+_KERNEL = operator.attrgetter("_kernel")
+_CENTROID = operator.attrgetter("_centroid")
+_RADIUS = operator.attrgetter("_radius")
+
+
+def empty_result(count: int) -> tuple[np.ndarray, ...]:
+    """The raw result arrays of :func:`search_pairs` for ``count`` pairs, unwritten:
+    ``(code, t_hi, t_lo, contact, iters, reached, n_iv, iv)``."""
     from ._kernels.broad_phase import MAX_INTERVALS
+
+    return (np.zeros(count, np.int8), np.empty(count), np.empty(count), np.empty(count),
+            np.empty(count, np.int64), np.empty(count), np.empty(count, np.int64),
+            np.empty((count, MAX_INTERVALS, 2)))
+
+
+def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
+                 ma: np.ndarray, mb: np.ndarray, eps_rel: np.ndarray, t_max: float,
+                 method: str, tol: float, samples: int, max_iterations: int,
+                 threads: int) -> tuple[Any, ...]:
+    """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` of the shapes
+    ``packed`` by :func:`pack_shapes` through the
+    search of ``time_of_impact`` on at most ``threads`` threads (``eps_rel[p]``: the size
+    term of pair p's distance tolerance, see :func:`prepare_pairs`); the raw result
+    arrays. The bodies' tables are built in parallel first
+    (:func:`polycontact._kernels.impact_batch.body_tables`)."""
+    from ._kernels.impact_batch import body_tables
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
-    tables = _pack(shapes)
+    xy, rows, starts, st_off, centroids, radii = packed
+    with numba_threads(useful(threads, len(radii) * _TABLE_SECONDS)) as n:
+        tables = body_tables(xy, rows, starts, st_off, centroids, radii,
+                             1 if n == 1 else 4 * n)
     p_count = len(sa)
-    code = np.zeros(p_count, np.int8)
-    t_hi = np.empty(p_count)
-    t_lo = np.empty(p_count)
-    contact = np.empty(p_count)
-    iters = np.empty(p_count, np.int64)
-    reached = np.empty(p_count)
-    n_iv = np.empty(p_count, np.int64)
-    iv = np.empty((p_count, MAX_INTERVALS, 2))
-    out = (code, t_hi, t_lo, contact, iters, reached, n_iv, iv)
-
+    out = empty_result(p_count)
     pairs = (sa, sb, ma, mb, eps_rel)
     settings = (t_max, BROAD_PHASE_INFLATION, tol, ROUNDING_FACTOR, CONTACT_RESOLUTION,
                 max_iterations, exact, samples)
@@ -247,13 +305,17 @@ def search_pairs(shapes: list[Shape], sa: np.ndarray, sb: np.ndarray, ma: np.nda
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
     order = np.arange(p_count, dtype=np.int64)
-    if threads == 1 or p_count < 64:
-        run(order)
-    else:
-        n_chunks = min(p_count // 16, 16 * threads)
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(run, [order[c::n_chunks].copy() for c in range(n_chunks)]))
+    n = useful(threads, p_count * _PAIR_SECONDS)
+    n_chunks = 1 if n == 1 else min(p_count // 16, 16 * n)
+    for _ in as_done(run, [order[c::n_chunks].copy() for c in range(n_chunks)], n):
+        pass
     return out
+
+
+#: Seconds of one body's tables, and of one pair's search at the least (both about a
+#: 12-gon's), for the threads the work can use (see :mod:`polycontact._threads`).
+_TABLE_SECONDS = 2e-6
+_PAIR_SECONDS = 2e-6
 
 
 def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
@@ -274,45 +336,59 @@ def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int]
     return make
 
 
-def _unique(shapes: list[Shape]) -> tuple[list[Shape], np.ndarray]:
-    """Distinct shape objects (a shape used by many pairs is packed once) and each
-    input's index among them."""
-    seen: dict[int, int] = {}
-    uniq: list[Shape] = []
-    index = np.empty(len(shapes), np.int64)
-    for k, s in enumerate(shapes):
-        u = seen.get(id(s))
-        if u is None:
-            u = seen[id(s)] = len(uniq)
-            uniq.append(s)
-        index[k] = u
-    return uniq, index
-
-
-def _motion_array(motions: list[Motion]) -> np.ndarray:
-    """The rows ``Motion.array`` of every motion, in one NumPy call."""
-    return np.array([m._array for m in motions], dtype=np.float64).reshape(len(motions), 6)
-
-
 def _names(k: int) -> tuple[str, str]:
     """The names of body k's arguments in ``first_impacts`` and ``candidate_pairs``."""
     return f"shapes[{k}]", f"motions[{k}]"
 
 
-def _extents(shapes: list[Shape], motions: list[Motion],
-             name_of: Callable[[int], tuple[str, str]], t_max: float) -> np.ndarray:
-    """Each body's extent (the larger side of its bounding box: its pairs' distance
-    tolerance has the size term ``RELATIVE_TOLERANCE * max(extent_a, extent_b)``, as in
-    ``time_of_impact``), after the checks ``time_of_impact`` makes: the coordinates
-    (once per shape, with its body frame), then motions that would carry coordinates,
-    speeds or accelerations beyond float64's safe range within [0, t_max]. Errors name
-    the body's arguments, ``name_of(k) = (shape's, motion's)`` (made only for an error)."""
-    bases = [(s._frame or body_frame(s, tables=False, what=name_of(k)[0]))[2]
-             for k, s in enumerate(shapes)]
-    for k, (s, m, base) in enumerate(zip(shapes, motions, bases)):
-        if reach_excess(base, s.bounding_radius, m._norms, t_max) is not None:
-            check_reach(s, m, t_max, name_of(k)[1])  # raises, naming the motion
-    return np.array([float(s._extent) for s in shapes], dtype=np.float64)
+class _Bodies(NamedTuple):
+    """Checked moving bodies (see :func:`_bodies`)."""
+
+    shapes: list[Shape]     # the distinct shape objects
+    packed: tuple[np.ndarray, ...]  # their pack_shapes
+    owner: np.ndarray       # each body's index among them
+    motions: np.ndarray     # each body's motion as the kernel vector, (N, 6)
+    centroids: np.ndarray   # of the distinct shapes, (U, 2)
+    radii: np.ndarray       # their bounding radii
+    extents: np.ndarray     # the larger sides of their boxes
+
+
+def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Motion],
+            name_of: Callable[[int], tuple[str, str]], t_max: float,
+            threads: int) -> _Bodies:
+    """The bodies ``(shapes[k], motion_of(k))`` (``rows``: the motions' kernel vectors)
+    after the checks ``time_of_impact`` makes:
+    coordinates within the range the kernels take, and motions that do not carry them,
+    the points' speeds or accelerations beyond it within [0, t_max]. A shape object in
+    many bodies is kept once. The checks run in compiled code on at most ``threads``
+    threads; the bodies it marks are checked again here, exactly, and the first that
+    fails is refused, named by ``name_of(k) = (shape's, motion's)``."""
+    from ._kernels.impact_batch import suspect_bodies
+
+    count = len(shapes)
+    ids = np.fromiter(map(id, shapes), np.int64, count)
+    _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
+    uniq = [shapes[k] for k in first.tolist()]
+    owner = owner.reshape(-1).astype(np.int64)
+    packed = pack_shapes(uniq)
+    xy, vrows, _, _, centroids, radii = packed
+    with numba_threads(useful(threads, count * _TABLE_SECONDS)) as n:
+        suspect = suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
+                                 COORDINATE_LIMIT, EXTENT_FLOOR, 1 if n == 1 else 4 * n)
+    if suspect.any():
+        marked = np.flatnonzero(suspect).tolist()
+        for k in marked:
+            check_range(shapes[k].packed[0], name_of(k)[0])
+        for k in marked:
+            sh, m = shapes[k], motion_of(k)
+            if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
+                check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
+    extents = np.fromiter(map(_EXTENT, uniq), np.float64, len(uniq))
+    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
+
+
+_ARRAY = operator.attrgetter("_array")
+_EXTENT = operator.attrgetter("_extent")
 
 
 def time_of_impact_many(
@@ -327,6 +403,8 @@ def time_of_impact_many(
     samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
 ) -> ImpactBatch:
     """Time of impact of many pairs ``(shapes_a[k], motions_a[k])`` against
     ``(shapes_b[k], motions_b[k])``, in parallel.
@@ -347,12 +425,24 @@ def time_of_impact_many(
     ----------
     shapes_a, shapes_b : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
         The bodies at t = 0, P of each.
-    motions_a, motions_b : sequence of Motion
-        Their motions, one per shape.
+    motions_a, motions_b : sequence of Motion, or ndarray of shape (P, 6)
+        Their motions, one per shape: Motions, or their kernel vectors ``[vx, vy, ax,
+        ay, ω, α]`` (:attr:`polycontact.Motion.array`) as the rows of an array, read as
+        they are (no Motion is made unless ``impact(k)`` asks for it: the quick form
+        for many pairs).
     t_max, method, time_tolerance, samples, max_iterations
         As for :func:`polycontact.time_of_impact`, for every pair.
     threads : int, optional
-        Threads to use (default: one per CPU).
+        At most this many threads (default ``numba.get_num_threads()``; see the
+        threading policy of :doc:`conventions`).
+    client : dask.distributed.Client, optional
+        Run the searches on this Dask cluster (default: the current Dask client if
+        there is one, see :func:`polycontact.distributed.current_client`), after the same
+        checks here; shapes that several tasks use go to every worker once, the others
+        with their task; the result is the local call's.
+    chunk_size : int, optional
+        Pairs per Dask task (default: sized from a first task, see
+        :func:`polycontact.distributed.run_spans`).
 
     Returns
     -------
@@ -380,6 +470,9 @@ def time_of_impact_many(
     >>> batch.impact(0).status.value
     'hit'
     """
+    from ._cluster import check_chunk_size, current_client
+
+    check_chunk_size(chunk_size)
     a = check_shapes(shapes_a, "shapes_a")
     b = check_shapes(shapes_b, "shapes_b")
     if len(a) != len(b):
@@ -388,48 +481,42 @@ def time_of_impact_many(
     mb = check_motions(motions_b, "motions_b", len(b), "shapes_b")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
-    uniq, sa, sb, rows_a, rows_b, eps_rel = prepare_pairs(a, b, ma, mb, t_max)
-    raw = search_pairs(uniq, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol, samples,
-                       max_iterations, threads)
-    return impact_batch(a, b, ma, mb, raw, eps_rel, t_max, method, tol)
+    remote = current_client(client)
+    prepared = prepare_pairs(a, b, ma, mb, t_max, threads)
+    if remote is None:
+        _, packed, sa, sb, rows_a, rows_b, eps_rel = prepared
+        raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol,
+                           samples, max_iterations, threads)
+    else:
+        raw = _remote_search(remote, prepared, (t_max, method, tol, samples, max_iterations),
+                            chunk_size)
+    return impact_batch(a, b, ma, mb, raw, prepared[6], t_max, method, tol)
 
 
-def prepare_pairs(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
-                  t_max: float) -> tuple[Any, ...]:
+def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
+                  t_max: float, threads: int = 1) -> tuple[Any, ...]:
     """Check every body of the pairs as ``time_of_impact`` does (errors naming where it
-    first appears: ``shapes_a[k]``, ``motions_b[k]``, ...), then the inputs of
-    :func:`search_pairs`: the distinct shapes, each pair's two indices among them, its two
-    motion rows and its ``eps_rel``. (:func:`polycontact.distributed.time_of_impact_many`
-    runs this in the caller's process and :func:`search_pairs` on slices.)"""
-    # a body (the same shape and motion objects) in many pairs is prepared once
+    first appears: ``shapes_a[k]``, ``motions_b[k]``, ...; see :func:`_bodies`), then
+    the distinct shapes and the inputs of :func:`search_pairs`: the shapes packed, each
+    pair's two indices among them, its two motion rows and its ``eps_rel``, the size term of its distance
+    tolerance (``RELATIVE_TOLERANCE`` times the larger of the two shapes' extents).
+    (:func:`_remote_search` runs :func:`search_pairs` on slices of them in tasks.)"""
     p_count = len(a)
-    seen: dict[tuple[int, int], int] = {}
-    body = np.empty(2 * p_count, np.int64)
-    b_shapes: list[Shape] = []
-    b_motions: list[Motion] = []
-    first: list[int] = []                      # where each body first appears
-    for k, (s, m) in enumerate(zip(a + b, ma + mb)):
-        u = seen.setdefault((id(s), id(m)), len(b_shapes))
-        if u == len(b_shapes):
-            b_shapes.append(s)
-            b_motions.append(m)
-            first.append(k)
-        body[k] = u
 
-    def name_of(u: int) -> tuple[str, str]:
-        k = first[u]
+    def name_of(k: int) -> tuple[str, str]:
         side, q = ("a", k) if k < p_count else ("b", k - p_count)
         return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
-    extent = _extents(b_shapes, b_motions, name_of, t_max)
-    uniq, index = _unique(b_shapes)
-    rows = _motion_array(b_motions)
-    ba, bb = body[:p_count], body[p_count:]
-    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[ba], extent[bb])
-    return uniq, index[ba], index[bb], rows[ba], rows[bb], eps_rel
+    bodies = _bodies(a + b, np.concatenate([_rows(ma), _rows(mb)]),
+                     lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
+                     threads)
+    ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[ia], bodies.extents[ib])
+    return (bodies.shapes, bodies.packed, ia, ib, bodies.motions[:p_count],
+            bodies.motions[p_count:], eps_rel)
 
 
-def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Motion],
+def impact_batch(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
                  raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
                  tol: float) -> ImpactBatch:
     """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
@@ -449,8 +536,119 @@ def impact_batch(a: list[Shape], b: list[Shape], ma: list[Motion], mb: list[Moti
     )
 
 
+# -- on a Dask cluster ------------------------------------------------------------------
+def _remote_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, ...],
+                   chunk_size: int | None) -> tuple[Any, ...]:
+    """The raw result arrays of :func:`search_pairs` for the prepared pairs
+    (:func:`prepare_pairs`'s answer), in tasks on the cluster of ``client``; ``options`` = ``(t_max,
+    method, tol, samples, max_iterations)``."""
+    from ._cluster import run_spans
+
+    uniq, _, sa, sb, rows_a, rows_b, eps_rel = prepared
+    count = len(sa)
+    raw = empty_result(count)
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return _impact_tasks(uniq, sa, sb, rows_a, rows_b, eps_rel, spans)
+
+    with closing(run_spans(client, _impact_slice, count, tasks_of, *options,
+                           chunk_size=chunk_size, family="many moving bodies")) as results:
+        for p0, p1, part in results:
+            for whole, got in zip(raw, part):
+                whole[p0:p1] = got
+    return raw
+
+
+def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
+                  rows_b: np.ndarray, eps_rel: np.ndarray,
+                  spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple[Any, ...]]]:
+    """The shapes several tasks use (sent once to every worker) and the tasks: each its
+    slice of pairs, with its own shapes, the pairs' shape indices numbering the shared
+    shapes first, then the task's own."""
+    task = np.empty(len(sa), np.int64)
+    for k, (p0, p1) in enumerate(spans):
+        task[p0:p1] = k
+    first = np.full(len(uniq), len(spans), np.int64)
+    last = np.full(len(uniq), -1, np.int64)
+    for s in (sa, sb):
+        np.minimum.at(first, s, task)
+        np.maximum.at(last, s, task)
+    shared_ids = np.flatnonzero(first < last)
+    number = np.full(len(uniq), -1, np.int64)
+    number[shared_ids] = np.arange(len(shared_ids))
+    tasks = []
+    for p0, p1 in spans:
+        ta, tb = sa[p0:p1], sb[p0:p1]
+        own = np.unique(np.concatenate([ta, tb]))
+        own = own[number[own] < 0]
+        number[own] = len(shared_ids) + np.arange(len(own))
+        tasks.append((number[ta], number[tb], _ShapePack([uniq[u] for u in own]),
+                      rows_a[p0:p1], rows_b[p0:p1], eps_rel[p0:p1]))
+        number[own] = -1
+    return _ShapePack([uniq[u] for u in shared_ids]), tasks
+
+
+def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, method: str,
+                  tol: float, samples: int, max_iterations: int) -> tuple[Any, ...]:
+    """One task of :func:`time_of_impact_many`: the local search on a slice of pairs
+    (only the shapes it uses are packed for the kernel); the raw result arrays."""
+    sa, sb, own, rows_a, rows_b, eps_rel = task
+    used, inverse = np.unique(np.concatenate([sa, sb]), return_inverse=True)
+    n = len(sa)
+    inverse = inverse.reshape(-1)
+    return search_pairs(_ShapePack.packed([shared, own], used.tolist()), inverse[:n],
+                        inverse[n:], rows_a, rows_b, eps_rel, t_max, method, tol, samples,
+                        max_iterations, 1)
+
+
+class _ShapePack:
+    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates
+    and loop starts, see :func:`polycontact.relation.shapes_packed`), centroids and
+    bounding radii.
+
+    A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
+    shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
+    send against 1 s of work); bytes objects and two arrays travel as one message. The
+    receiving task packs the shapes it needs for the search with :meth:`packed`.
+
+    Examples
+    --------
+    >>> import pickle
+    >>> from polycontact import Shape
+    >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
+    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))])))
+    >>> xy, rows, starts, st_off, centroids, radii = _ShapePack.packed([back], [1])
+    >>> centroids.tolist(), float(radii[0]) == frame.bounding_radius, starts.tolist()
+    ([[4.0, 3.0]], True, [0, 4, 8])
+    """
+
+    def __init__(self, shapes: Sequence[Any]) -> None:
+        n = len(shapes)
+        self.kernels = list(map(_KERNEL, shapes))
+        self.centroids = np.frombuffer(b"".join(map(_CENTROID, shapes)),
+                                       np.float64).reshape(n, 2)
+        self.radii = np.fromiter(map(_RADIUS, shapes), np.float64, n)
+
+    def __len__(self) -> int:
+        return len(self.kernels)
+
+    @staticmethod
+    def packed(packs: Sequence[_ShapePack], chosen: Sequence[int]) -> tuple[np.ndarray, ...]:
+        """The shapes ``chosen`` (numbered through ``packs`` one after another) packed as
+        :func:`pack_shapes` packs them."""
+        from ._kernels.packs import unpack_shapes
+
+        kernels = [k for p in packs for k in p.kernels]
+        centroids = np.concatenate([p.centroids for p in packs])
+        radii = np.concatenate([p.radii for p in packs])
+        picked = np.asarray(chosen, np.int64)
+        return (*unpack_shapes(np.frombuffer(b"".join(kernels[k] for k in picked.tolist()),
+                                             np.float64), len(picked)),
+                centroids[picked], radii[picked])
+
+
 # -- many moving bodies ----------------------------------------------------------------
-def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
+def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.ndarray, *,
                     t_max: float) -> np.ndarray:
     """Pairs of moving bodies whose swept bounds over ``[0, t_max]`` meet: the pairs
     :func:`first_impacts` searches.
@@ -486,23 +684,24 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion], *,
     >>> candidate_pairs(shapes, motions, t_max=5).tolist()
     [[0, 1]]
     """
-    shapes = check_shapes(shapes, "shapes")
-    motions = check_motions(motions, "motions", len(shapes), "shapes")
+    bodies = check_shapes(shapes, "shapes")
+    moves = check_motions(motions, "motions", len(bodies), "shapes")
     t_max = check_t_max(t_max)
-    _extents(shapes, motions, _names, t_max)
-    return _candidates(shapes, motions, t_max)
+    return _candidates(_bodies(bodies, _rows(moves), moves.__getitem__, _names, t_max,
+                               requested(None)), t_max)
 
 
-def _candidates(shapes: list[Shape], motions: list[Motion], t_max: float) -> np.ndarray:
+def _candidates(bodies: _Bodies, t_max: float) -> np.ndarray:
+    """:func:`candidate_pairs` of checked bodies."""
     from ._kernels.swept import box_pairs, swept_boxes
 
-    n = len(shapes)
+    n = len(bodies.owner)
     if n < 2:
         return np.empty((0, 2), np.int64)
-    cent = np.array([s.centroid for s in shapes], dtype=np.float64).reshape(n, 2)
-    rad = np.array([s.bounding_radius for s in shapes], dtype=np.float64)
-    boxes, owner = swept_boxes(cent, _motion_array(motions), rad, t_max, MAX_SLICES,
-                               BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
+    cent = np.ascontiguousarray(bodies.centroids[bodies.owner])
+    boxes, owner = swept_boxes(cent, bodies.motions, bodies.radii[bodies.owner], t_max,
+                               MAX_SLICES, BROAD_PHASE_INFLATION,
+                               SWEPT_ROUNDING_ULPS * 2.0**-52)
     pairs: np.ndarray = box_pairs(boxes, owner, n)
     return pairs
 
@@ -541,7 +740,7 @@ def event_time(impact: Impact) -> float:
 
 def first_impacts(
     shapes: Sequence[ShapeLike],
-    motions: Sequence[Motion],
+    motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",
@@ -571,8 +770,9 @@ def first_impacts(
     ----------
     shapes : sequence of ShapeLike
         The bodies at t = 0.
-    motions : sequence of Motion
-        One per body.
+    motions : sequence of Motion, or ndarray of shape (N, 6)
+        One per body: Motions, or their kernel vectors as rows (as for
+        :func:`time_of_impact_many`).
     t_max : float
         End of the time window (>= 0).
     method : {"exact", "sampled"}, default "exact"
@@ -584,7 +784,8 @@ def first_impacts(
     max_iterations : int, default :data:`~polycontact.limits.MAX_ITERATIONS`
         As for :func:`polycontact.time_of_impact`, per pair.
     threads : int, optional
-        Threads for the searches (default: one per CPU).
+        At most this many threads (default ``numba.get_num_threads()``; see the
+        threading policy of :doc:`conventions`).
 
     Returns
     -------
@@ -609,29 +810,26 @@ def first_impacts(
     0 1 hit penetrating 2.0
     """
     shapes = check_shapes(shapes, "shapes")
-    motions = check_motions(motions, "motions", len(shapes), "shapes")
+    moves = check_motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
-    extent = _extents(shapes, motions, _names, t_max)
-    pairs = _candidates(shapes, motions, t_max)
+    bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
+    pairs = _candidates(bodies, t_max)
     if len(pairs) == 0:
         return []
-    # only the bodies of candidate pairs are packed and searched
-    used = np.unique(pairs)
-    local = np.empty(len(shapes), np.int64)
-    local[used] = np.arange(len(used))
-    sub_shapes = [shapes[k] for k in used]
-    sub_motions = [motions[k] for k in used]
-    uniq, index = _unique(sub_shapes)
-    m = _motion_array(sub_motions)
-    eps_rel = RELATIVE_TOLERANCE * np.maximum(extent[pairs[:, 0]], extent[pairs[:, 1]])
-    i, j = local[pairs[:, 0]], local[pairs[:, 1]]
-    raw = search_pairs(uniq, index[i], index[j], m[i], m[j], eps_rel, t_max, method, tol,
-                       samples, max_iterations, threads)
+    # only the shapes of candidate pairs are packed and searched
     i, j = pairs[:, 0], pairs[:, 1]
+    oi, oj = bodies.owner[i], bodies.owner[j]
+    used, inverse = np.unique(np.concatenate([oi, oj]), return_inverse=True)
+    inverse = inverse.reshape(-1).astype(np.int64)
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[oi], bodies.extents[oj])
+    raw = search_pairs(pack_shapes([bodies.shapes[u] for u in used.tolist()]),
+                       inverse[: len(i)], inverse[len(i):], bodies.motions[i],
+                       bodies.motions[j], eps_rel, t_max, method, tol, samples,
+                       max_iterations, threads)
     code, _, _, contact, *_ = raw
-    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: motions[pairs[p, s]], raw,
+    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
     events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
               for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
@@ -650,7 +848,7 @@ def _first_order(event: PairImpact) -> tuple[Any, ...]:
 
 def first_impact(
     shapes: Sequence[ShapeLike],
-    motions: Sequence[Motion],
+    motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",

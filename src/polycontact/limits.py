@@ -2,7 +2,12 @@
 
 The public functions read these and pass them to the compiled kernels as arguments
 (Numba freezes a module global into the compiled code, so a kernel never reads one of
-these). Constants that belong to one algorithm's proof or to the layout of its
+these). The limits on work (``MAX_SUM_VERTICES``, ``MAX_CLIP_TESTS``,
+``MAX_EDGE_PAIRS``) are read at each call, so a program that means to wait longer or to
+use more memory may raise them: ``polycontact.limits.MAX_CLIP_TESTS = 10**9``. A call
+that would exceed one estimates its work before starting and raises a
+:class:`~polycontact.WorkLimitError` that names the estimate and the limit; the time of
+impact's budget is its ``max_iterations`` argument. Constants that belong to one algorithm's proof or to the layout of its
 buffers (a grid's size, a threshold between two ways of getting the same answer, a
 rounding allowance derived in a kernel's docstring) stay beside that kernel in
 ``polycontact._kernels``.
@@ -36,10 +41,12 @@ __all__ = [
     "HOLE_WIDTH_FACTOR",
     "SNAP_FACTOR",
     "MAX_SUM_VERTICES",
+    "MAX_CLIP_TESTS",
+    "MAX_EDGE_PAIRS",
     "EAR_CLIPPING_MAX",
     "PIECES_CACHE_SIZE",
-    "DEFAULT_BATCH",
-    "DEFAULT_IMPACT_BATCH",
+    "THREAD_WORK",
+    "TASK_SECONDS",
     "JSON_MAX_DEPTH",
     "NOTICE_AFTER",
 ]
@@ -131,10 +138,27 @@ SNAP_FACTOR = 64.0
 #: Most vertices of convex sums built for one no-fit polygon or one penetration depth
 #: (vertices). Beyond, the call is refused with an error (``NfpTooLargeError``,
 #: ``DepthTooLargeError``) instead of being killed by the system for want of memory:
-#: a no-fit polygon costs about 350 bytes per vertex of sums with the outline's work
-#: arrays (3.5 GB here), a depth about 80 with its frames and sort keys, so this one
-#: limit keeps both within a few GB.
+#: a no-fit polygon costs about 100 bytes per vertex of sums with the outline's work
+#: arrays (1 GB here), a depth about 80 with its frames and sort keys, so this one
+#: limit keeps both within a few GB. The depth's count is estimated before its bodies
+#: are decomposed (a lower bound: the vertex-edge contacts nearer than a known escape).
+#: Read at each call.
 MAX_SUM_VERTICES = 10_000_000
+
+#: Most tests of an edge against a convex sum that the outline of one no-fit polygon
+#: may take (tests): the sums listed near each sum edge that can lie on the outline,
+#: counted once the sums are built and before any is clipped. A test costs 20 ns to a
+#: few microseconds (a long sum that the edge enters is read whole), so this is about
+#: 5 to 10 s of clipping; beyond, ``NfpTooLargeError``. Two interlocking regular combs
+#: of 400 vertices need 5e7, of 800 vertices 4e8. Read at each call.
+MAX_CLIP_TESTS = 100_000_000
+
+#: Most components one entrance block built with ``method="pairs"`` may have
+#: (parallelograms, one per pair of edges: m n for bodies of m and n edges). Each costs
+#: a Shapely geometry and a Python object, about 1 kB and 25 µs, so this is about
+#: 0.25 GB and 6 s; beyond, ``EntranceBlockTooLargeError`` (``method="swept"`` makes
+#: one component per edge of B). Read at each call.
+MAX_EDGE_PAIRS = 250_000
 
 #: Rings of up to this many vertices are cut into convex pieces by ear clipping
 #: (vertices): quadratic, but cheaper than a GEOS triangulation up to this size.
@@ -145,18 +169,17 @@ EAR_CLIPPING_MAX = 64
 #: asks about many pairs of the same pieces decomposes each piece once.
 PIECES_CACHE_SIZE = 4096
 
-# -- distributed batches -------------------------------------------------------------
+# -- threads and distributed batches -----------------------------------------------
 
-#: Default pairs per task of ``polycontact.distributed.map_batches`` (pairs):
-#: classification of this many is about 10 ms of work, well above a Dask task's
-#: overhead of about 1 ms (fewer if that would leave fewer than four tasks per worker
-#: thread).
-DEFAULT_BATCH = 20_000
+#: Work per thread (seconds) below which a parallel call starts no further thread:
+#: starting a thread and handing it its share costs tens of microseconds, under 2 % of
+#: this (see :mod:`polycontact._threads`).
+THREAD_WORK = 2e-3
 
-#: Default pairs per task of ``polycontact.distributed.time_of_impact_many`` (pairs): a
-#: pair's search costs ten to a thousand times a classification, so a task of this
-#: many is still well above Dask's overhead.
-DEFAULT_IMPACT_BATCH = 2_000
+#: Least work of one Dask task (seconds): a task costs the scheduler and the transfers
+#: about a millisecond, and the results a round trip, so a task of this much work loses
+#: under 1 % to them; tasks are made larger only to keep several per worker thread.
+TASK_SECONDS = 0.2
 
 # -- files and the command line ------------------------------------------------------
 

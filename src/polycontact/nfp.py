@@ -52,7 +52,8 @@ from ._checks import finite_number
 from ._checks import point as point_arg
 from ._pieces import pieces_of_geometry, pieces_packed
 from .errors import InvalidShapeError, NfpTooLargeError
-from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR, MAX_SUM_VERTICES,
+from . import limits
+from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
                      RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import check_range, snap_grid, tolerance_for
@@ -76,6 +77,9 @@ _NO_CANDIDATES.flags.writeable = False
 #: The reference "origin" of every result that asks for it, shared: read-only.
 _ORIGIN = np.zeros(2)
 _ORIGIN.flags.writeable = False
+
+#: The outline kernel's status when the clipping would take more tests than allowed.
+_TOO_MANY_TESTS = -2.0
 
 #: How many regions GEOS has built since import because the outline parts did not link
 #: into rings (see :func:`fallback_count`).
@@ -360,16 +364,25 @@ def no_fit_polygon(
     -----
     Cost, for A of m and B of n vertices cut into k_A and k_B convex pieces: the
     decomposition (ear clipping up to 64 vertices, redone on each call; GEOS's
-    constrained triangulation beyond and with holes, cached by coordinates), then k_A k_B convex sums of O(k_A n + k_B m)
-    vertices in all, each sum in linear time, then every sum edge clipped by other
-    sums until covered: first those containing whole cells of a 32 x 32 grid along the
-    edge, then the one that covered the previous edge, then a scan of the boxes sorted
-    by their smallest x (O(k) per edge at worst, for edges of the outline). When A is
-    convex or small (k_A = O(1)) and each sum meets few others, that is near
-    O((m + n) log(m + n)); two large concave bodies make k_A k_B sums, and the time
-    follows that product (figures: ``benchmarks/bench_scaling.py``). Past
-    :data:`~polycontact.limits.MAX_SUM_VERTICES` vertices of sums, :class:`NfpTooLargeError`
-    is raised.
+    constrained triangulation beyond and with holes, cached by coordinates), then
+    k_A k_B convex sums of O(k_A n + k_B m) vertices in all, each sum in linear time.
+    Only the sum edges on the reduced convolution (a convex vertex of one body with an
+    edge of the other whose direction fits its turning cone: the only places where the
+    bodies can touch without overlapping) can hold the outline, exact fits and slides;
+    each is clipped by the sums listed in the cells of a grid along it (those within
+    the tolerance of the cell), starting from the sum that covered the previous edge,
+    each long sum from its edge facing the segment. The time thus follows the size of
+    the reduced convolution times the sums met near it, not the product of all edges
+    with all sums (figures: ``benchmarks/bench_bounds.py`` and
+    ``benchmarks/bench_scaling.py``).
+
+    Refused before the work, with :class:`~polycontact.NfpTooLargeError` naming the
+    estimate and the limit: sums of more than
+    :data:`~polycontact.limits.MAX_SUM_VERTICES` vertices (memory), or a clipping of
+    more than :data:`~polycontact.limits.MAX_CLIP_TESTS` edge–sum tests (time; the
+    sums listed near each edge, counted once the sums are built). Both are read at
+    each call: set ``polycontact.limits.MAX_CLIP_TESTS`` (or ``MAX_SUM_VERTICES``) to
+    allow more.
     """
     a = as_shape(a, "a")
     b = as_shape(b, "b")
@@ -389,7 +402,7 @@ def no_fit_polygon(
         out = _kernels().nfp.ring_entrance(
             xb, xa, ax, ay, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
             ANGLE_TOLERANCE, SNAP_FACTOR, HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX,
-            MAX_SUM_VERTICES)
+            limits.MAX_SUM_VERTICES, limits.MAX_CLIP_TESTS)
     if out is None or not out[0][0]:
         out = _entrance_kernel(*pieces(), tolerance)
     region, pts, segs, eps = _entrance_result(out, pieces)
@@ -537,15 +550,16 @@ def _entrance_kernel(
     """The outline kernel's answer for E = B ⊕ R from convex pieces (see
     :func:`_entrance_result`); too many sums' vertices are refused first."""
     total = len(bxy) * (len(rst) - 1) + len(rxy) * (len(bst) - 1)
-    if total > MAX_SUM_VERTICES:
+    if total > limits.MAX_SUM_VERTICES:
         raise NfpTooLargeError(
             f"no-fit polygon: the {len(bst) - 1} x {len(rst) - 1} convex sums of the "
             f"shapes' pieces would hold {total:.3g} vertices, more than "
-            f"{MAX_SUM_VERTICES:.0e} (memory): too large for this machine's budget"
+            f"limits.MAX_SUM_VERTICES = {limits.MAX_SUM_VERTICES:.3g} (memory); set "
+            f"polycontact.limits.MAX_SUM_VERTICES to allow more"
         )
     out: tuple[Any, ...] = _kernels().nfp.entrance_packed(
         bxy, bst, rxy, rst, _tolerance(tolerance), RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        ANGLE_TOLERANCE, SNAP_FACTOR, HOLE_WIDTH_FACTOR
+        ANGLE_TOLERANCE, SNAP_FACTOR, HOLE_WIDTH_FACTOR, limits.MAX_CLIP_TESTS
     )
     return out
 
@@ -564,7 +578,15 @@ def _entrance_result(
     ``pieces()`` (B's, then R's) instead, and the region is that geometry. Rings
     thinner than the tolerance (rounding seams and pinholes) are dropped.
     """
-    (_, eps, status, n_pts, n_rings, n_vertices, n_cand), buf = out
+    (_, eps, status, n_pts, n_rings, n_vertices, n_cand, tests), buf = out
+    if status == _TOO_MANY_TESTS:
+        raise NfpTooLargeError(
+            f"no-fit polygon: clipping the edges of its convex sums would take about "
+            f"{tests:.3g} edge–sum tests (the sums near each edge that can lie on the "
+            f"outline, counted before clipping), more than limits.MAX_CLIP_TESTS = "
+            f"{limits.MAX_CLIP_TESTS:.3g} (time); set polycontact.limits.MAX_CLIP_TESTS "
+            f"to allow more"
+        )
     if status < 0.0:
         raise InvalidShapeError(
             "no-fit polygon: the Minkowski sums of the shapes overflow float64 "
@@ -576,7 +598,7 @@ def _entrance_result(
     else:
         global _FALLBACKS
         _FALLBACKS += 1
-        sums, starts = _kernels().minkowski.convex_sums(*pieces())
+        sums, starts, _ = _kernels().minkowski.convex_sums(*pieces())
         ids = np.repeat(np.arange(len(starts) - 1), np.diff(starts))
         region = _union_of_sums(shapely.polygons(shapely.linearrings(sums, indices=ids)), eps)
     if not n_cand:
@@ -729,5 +751,9 @@ def _clean_degenerate(
     """
     if len(pts) == 0 and len(segs) == 0:
         return _NO_FITS, _NO_SLIDES
+    if len(pts) > 1:
+        # the same exact fit, found on every edge through it, is verified once (the
+        # first of equal points is the one the selection would keep)
+        pts = pts[np.sort(np.unique(pts, axis=0, return_index=True)[1])]
     fits, slides = make_select()(pts, segs, HOLE_WIDTH_FACTOR * eps)
     return (fits if len(fits) else _NO_FITS), (slides if len(slides) else _NO_SLIDES)

@@ -29,16 +29,24 @@ shards, and the next build computes only the entries the cache lacks. A shard th
 cannot be read or does not match its checksum is ignored with a warning and its entries
 are recomputed.
 
-**Parallel runs.** With ``client=`` (a ``dask.distributed.Client``), or when called where
-a Dask client is the default, the missing entries are split into tasks of
-``chunk_size`` pairs run on the cluster (:mod:`polycontact.distributed`); the client
-writes the shards as results arrive. Without Dask, large builds run on a pool of
-``workers`` processes (default: one per CPU): the NFP build spends most of its time in
-Python and GEOS calls that hold the GIL, so threads do not help (measured: two threads
-are twice as slow as one on jakobs1). Processes start in about a second each, so builds
-under :data:`PROCESS_POOL_MIN_ENTRIES` missing entries run in the calling process.
-Scripts that build large tables locally must guard their entry point with
-``if __name__ == "__main__":`` (processes are spawned, as on macOS and Windows).
+**Parallel runs.** The no-fit polygon of two pieces without holes is computed, with its
+region's WKB, exact fits and slides, in compiled code that releases the GIL
+(:mod:`polycontact._kernels.nfp_batch`): a local build shares the missing entries among
+threads (``threads=``, by the threading policy of :doc:`conventions`), in chunks of
+``chunk_size`` entries. The entries it leaves to :func:`polycontact.no_fit_polygon`
+(pieces with holes, rings too large for ear clipping) hold the GIL; when they are most
+of a large build, the build uses a pool of ``workers`` processes instead, but only
+where the work measured on a first chunk outweighs the processes' start
+(:data:`PROCESS_START`), so that processes never make a build slower; the pool is
+started once, after the kernels are compiled here, so the processes load them and never
+compile. Scripts that may build large tables with processes must guard their entry
+point with ``if __name__ == "__main__":`` (processes are spawned, as on macOS and
+Windows). With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
+client is the default, the missing entries run as tasks on the cluster
+(:mod:`polycontact.distributed`), each of at least
+:data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task and
+several per worker thread, the pieces sent to every worker once; the client writes the
+shards as results arrive.
 
 Examples
 --------
@@ -51,6 +59,7 @@ Examples
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import json
 import math
@@ -78,11 +87,12 @@ import shapely
 
 from . import __version__
 from ._json import load_json
-from .esicup import Instance, turned
+from .esicup import Instance, turned, turned_loops
 from .nfp import NoFitPolygon, no_fit_polygon
 from .shape import Shape, as_shape
+from ._threads import requested
 
-__all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_POOL_MIN_ENTRIES"]
+__all__ = ["NfpTable", "nfp_table", "CacheWarning", "PROCESS_START"]
 
 #: Name and version of the on-disk format.
 FORMAT = "polycontact-nfp-table"
@@ -90,10 +100,14 @@ FORMAT_VERSION = 2
 MANIFEST = "table.json"
 SHARDS = "shards"
 
-#: Below this many missing entries a local build runs in the calling process: starting
-#: a process (import, load the compiled kernels) costs about a second, the time of some
-#: 30 000 NFPs of the ESICUP instances.
-PROCESS_POOL_MIN_ENTRIES = 50_000
+#: What starting one local worker process costs (seconds: the interpreter, the imports
+#: and loading the compiled kernels from the cache, measured at about a second): a
+#: build uses processes only where each has more work than this.
+PROCESS_START = 1.0
+
+#: Entries of the first chunk, computed in the calling process (or as the first Dask
+#: task) to measure the work per entry before the others are sized.
+PROBE_ENTRIES = 256
 
 #: Angles closer than this (degrees) name the same orientation in ``table[i, a, j, b]``.
 ANGLE_MATCH = 1e-9
@@ -152,17 +166,35 @@ class NfpTable:
         pieces: tuple[Shape, ...],
         orientations: tuple[tuple[float, ...], ...],
         reference: str,
+        packed: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]],
         shapes: dict[tuple[int, int], Shape],
-        keys: dict[tuple[int, int], bytes],
-        records: dict[str, _Record],
+        digests: dict[tuple[int, int], bytes],
     ) -> None:
         self.pieces = pieces
         self.orientations = orientations
         self.reference = reference
-        self._shapes = shapes
-        self._digests = keys
-        self._records = records
-        self._regions: dict[str, Any] = {}
+        self._packed = packed  # each slot's turned piece, as Shape.packed
+        self._shapes = shapes  # the turned pieces made Shapes so far
+        self._digests = digests
+        # An entry is a pair of distinct turned pieces (digests): its code is
+        # ``ia * D + ib``, ia and ib the digests' numbers, D how many there are.
+        numbers: dict[bytes, int] = {}
+        self._number: dict[tuple[int, int], int] = {}
+        self._first: list[tuple[int, int]] = []  # a slot of each digest
+        for slot, d in digests.items():
+            if d not in numbers:
+                numbers[d] = len(numbers)
+                self._first.append(slot)
+            self._number[slot] = numbers[d]
+        self._distinct = list(numbers)  # each digest once, in the order of their numbers
+        n = len(self._distinct)
+        self._records: dict[int, _Record] = {}
+        # entries of this build, unpacked on first use: their number in the build (-1:
+        # none), and the computed chunks with the number of their first entry
+        self._where = np.full(n * n, -1, np.int64)
+        self._chunks: list[_Stored] = []
+        self._chunk_starts: list[int] = []
+        self._regions: dict[int, Any] = {}
         self.computed = 0
         self.loaded = 0
         self.seconds = 0.0
@@ -186,16 +218,51 @@ class NfpTable:
         i, ai, j, aj = index
         sa = self._slot(i, ai, "i")
         sb = self._slot(j, aj, "j")
-        key = _pair_key(self._digests[sa], self._digests[sb])
-        rec = self._records.get(key)
+        code = self._number[sa] * len(self._distinct) + self._number[sb]
+        rec = self._record(code)
         if rec is None:
             raise KeyError(f"entry {index!r} is not in the table (a load of an incomplete "
                            "cache); build it with nfp_table(..., cache=DIR)")
-        region = self._regions.get(key)
+        region = self._regions.get(code)
         if region is None:
-            region = self._regions[key] = shapely.from_wkb(rec.wkb)
+            region = self._regions[code] = shapely.from_wkb(rec.wkb)
         return NoFitPolygon(region, rec.exact_fits, rec.slides, rec.reference,
-                            self._shapes[sa], self._shapes[sb], rec.tolerance)
+                            self._shape(sa), self._shape(sb), rec.tolerance)
+
+    def _shape(self, slot: tuple[int, int]) -> Shape:
+        """The turned piece of ``slot`` (piece, orientation number), made on first use."""
+        shape = self._shapes.get(slot)
+        if shape is None:
+            i, k = slot
+            shape = self._shapes[slot] = turned(self.pieces[i], self.orientations[i][k])
+        return shape
+
+    def _key(self, code: int) -> str:
+        """The cache key of entry ``code``."""
+        n = len(self._distinct)
+        return _pair_key(self._distinct[code // n], self._distinct[code % n])
+
+    def _record(self, code: int) -> _Record | None:
+        """The stored entry ``code`` (None if the table lacks it); an entry computed by
+        this build is unpacked from its chunk's arrays on first use."""
+        rec = self._records.get(code)
+        if rec is None and self._where[code] >= 0:
+            k = int(self._where[code])
+            c = bisect.bisect_right(self._chunk_starts, k) - 1
+            rec = self._records[code] = self._chunks[c].record(k - self._chunk_starts[c])
+        return rec
+
+    def _store(self, codes: np.ndarray, chunk: _Stored) -> None:
+        """Take the computed entries ``codes``, in the order of ``chunk``."""
+        start = self._chunk_starts[-1] + len(self._chunks[-1]) if self._chunks else 0
+        self._chunks.append(chunk)
+        self._chunk_starts.append(start)
+        self._where[codes] = np.arange(start, start + len(codes))
+        self.computed += len(codes)
+
+    def _known(self) -> list[int]:
+        """The codes of the entries the table holds."""
+        return sorted({*self._records, *np.flatnonzero(self._where >= 0).tolist()})
 
     def _slot(self, piece: Any, angle: Any, what: str) -> tuple[int, int]:
         try:
@@ -231,28 +298,25 @@ class NfpTable:
         (1, 0, 0)
         """
         holes = fits = slides = 0
-        counted: dict[str, tuple[int, int, int]] = {}
-        for key in self._entry_keys():
-            c = counted.get(key)
+        counted: dict[int, tuple[int, int, int]] = {}
+        n = len(self._distinct)
+        numbers = list(self._number.values())
+        for code in (a * n + b for a in numbers for b in numbers):
+            c = counted.get(code)
             if c is None:
-                rec = self._records[key]
-                region = self._regions.get(key)
+                rec = self._record(code)
+                assert rec is not None
+                region = self._regions.get(code)
                 if region is None:
-                    region = self._regions[key] = shapely.from_wkb(rec.wkb)
+                    region = self._regions[code] = shapely.from_wkb(rec.wkb)
                 n_holes = sum(len(p.interiors) for p in shapely.get_parts(region))
-                c = counted[key] = (n_holes, len(rec.exact_fits), len(rec.slides))
+                c = counted[code] = (n_holes, len(rec.exact_fits), len(rec.slides))
             holes += c[0]
             fits += c[1]
             slides += c[2]
         return {"entries": len(self), "distinct": len(counted), "holes": holes,
                 "exact_fits": fits, "slides": slides, "computed": self.computed,
                 "loaded": self.loaded, "seconds": self.seconds}
-
-    def _entry_keys(self) -> Iterator[str]:
-        slots = list(self._digests)
-        for sa in slots:
-            for sb in slots:
-                yield _pair_key(self._digests[sa], self._digests[sb])
 
     # -- files ----------------------------------------------------------------------
     def save(self, directory: str | PathLike[str]) -> None:
@@ -261,7 +325,8 @@ class NfpTable:
         cache = Path(directory)
         have = _read_cache(cache)
         _write_manifest(cache, self.pieces, self.orientations, self.reference)
-        todo = [(k, r) for k, r in self._records.items() if k not in have]
+        todo = [(key, r) for code in self._known() for key in [self._key(code)]
+                if key not in have for r in [self._record(code)] if r is not None]
         if todo:
             _write_shard(cache, todo)
 
@@ -283,11 +348,21 @@ class NfpTable:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise ValueError(f"directory: {cache} holds no readable {MANIFEST}: {exc}") from None
         table = _prepare(pieces, orientations, reference)
-        records = _read_cache(cache)
-        wanted = set(table._entry_keys())
-        table._records.update({k: r for k, r in records.items() if k in wanted})
-        table.loaded = len(table._records)
+        table._take_cached(_read_cache(cache))
         return table
+
+    def _take_cached(self, records: dict[str, _Record]) -> np.ndarray:
+        """Take this table's entries among ``records`` (cache keys to records); the
+        codes of the entries they lack."""
+        missing = []
+        for code in range(len(self._where)):
+            rec = records.get(self._key(code))
+            if rec is None:
+                missing.append(code)
+            else:
+                self._records[code] = rec
+        self.loaded = len(self._records)
+        return np.array(missing, np.int64)
 
 
 def nfp_table(
@@ -299,6 +374,7 @@ def nfp_table(
     client: Any = None,
     progress: Progress = True,
     workers: int | None = None,
+    threads: int | None = None,
     chunk_size: int | None = None,
 ) -> NfpTable:
     """The no-fit polygon of every ordered pair of pieces at every orientation.
@@ -322,12 +398,17 @@ def nfp_table(
         Show a progress bar (tqdm on stderr), or call ``progress(done, total)`` after
         each batch of entries.
     workers : int, optional
-        Local processes when there is no Dask client (default: one per CPU, used only
-        for at least :data:`PROCESS_POOL_MIN_ENTRIES` missing entries; 1: in this
-        process).
+        Local processes when there is no Dask client. By default none, unless most of
+        the work holds the GIL (pieces with holes, large rings) and each process has
+        more of it than its start costs (:data:`PROCESS_START`); 1: in this process.
+    threads : int, optional
+        Threads of a local build (default and meaning: the threading policy of
+        :doc:`conventions`: at most ``numba.get_num_threads()``, and no more than the
+        work can use).
     chunk_size : int, optional
         Entries per task (and per cache shard); default about a quarter of each
-        worker's share, between 64 and 1024.
+        thread's or process's share, between 64 and 1024, and on a cluster at least
+        :data:`~polycontact.limits.TASK_SECONDS` of work.
 
     Returns
     -------
@@ -345,28 +426,21 @@ def nfp_table(
     if reference not in ("origin", "centroid"):
         raise ValueError(f"reference: expected 'origin' or 'centroid', got {reference!r}")
     shapes, angles = _pieces_and_orientations(pieces, orientations)
+    n_threads = requested(threads)
     for name, value in (("workers", workers), ("chunk_size", chunk_size)):
         if value is not None and (isinstance(value, bool) or not isinstance(value, int)
                                   or value < 1):
             raise ValueError(f"{name}: expected a positive integer, got {value!r}")
     table = _prepare(shapes, angles, reference)
-    have: dict[str, _Record] = {}
     cache_dir = None if cache is None else Path(cache)
     if cache_dir is not None:
-        have = _read_cache(cache_dir)
+        todo = table._take_cached(_read_cache(cache_dir))
         _write_manifest(cache_dir, shapes, angles, reference)
-    # the distinct missing entries, as pairs of slots
-    todo: dict[str, tuple[tuple[int, int], tuple[int, int]]] = {}
-    for sa in table._digests:
-        for sb in table._digests:
-            key = _pair_key(table._digests[sa], table._digests[sb])
-            if key in have:
-                table._records[key] = have[key]
-            elif key not in todo:
-                todo[key] = (sa, sb)
-    table.loaded = len(table._records)
-    if todo:
-        _compute_missing(table, todo, cache_dir, client, progress, workers, chunk_size)
+    else:
+        todo = np.arange(len(table._where), dtype=np.int64)
+    if len(todo):
+        _compute_missing(table, todo, cache_dir, client, progress, workers, n_threads,
+                         chunk_size)
     table.seconds = time.perf_counter() - start
     return table
 
@@ -424,117 +498,267 @@ def _is_number(a: Any) -> bool:
 
 def _prepare(pieces: tuple[Shape, ...], orientations: tuple[tuple[float, ...], ...],
              reference: str) -> NfpTable:
-    """A table without entries: the turned pieces and their digests."""
+    """A table without entries: the turned pieces, packed, and their digests.
+
+    The turned pieces of one loop are checked together in one compiled call
+    (:func:`polycontact._kernels.relation_many.check_rings`); one it takes as given
+    (counter-clockwise, no vertex dropped) is what :func:`~polycontact.esicup.turned`
+    would store, and its Shape is made only when asked for. Any other turned piece is
+    made a Shape here, checked (or refused) as ``turned`` does."""
+    from ._kernels.relation_many import check_rings
+    from .limits import COORDINATE_LIMIT, EXTENT_FLOOR, RELATIVE_TOLERANCE, ROUNDING_ULPS
+
+    packed: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
     shapes: dict[tuple[int, int], Shape] = {}
-    digests: dict[tuple[int, int], bytes] = {}
-    prefix = f"{FORMAT}/{FORMAT_VERSION}/{__version__}/{reference}/".encode()
+    rings: dict[tuple[int, int], np.ndarray] = {}
     for i, (piece, angles) in enumerate(zip(pieces, orientations)):
         for k, a in enumerate(angles):
-            s = turned(piece, a)
-            xy, starts = s.packed
+            loops = turned_loops(piece, a)
+            if loops is not None and len(loops) == 1:
+                rings[i, k] = loops[0]
+            else:
+                shapes[i, k] = piece if loops is None else Shape(loops[0], loops[1:])
+    if rings:
+        n = np.array([len(r) for r in rings.values()], np.int64)
+        used, sign = check_rings(np.concatenate(list(rings.values())),
+                                 np.cumsum(n) - n, n, RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                                 COORDINATE_LIMIT, EXTENT_FLOOR)
+        for (slot, ring), u, m, sg in zip(rings.items(), used.tolist(), n.tolist(),
+                                          sign.tolist()):
+            if u == m and sg > 0.0:
+                starts = np.array([0, m], np.int64)
+                packed[slot] = (ring, starts)
+            else:
+                i, k = slot
+                shapes[slot] = turned(pieces[i], orientations[i][k])
+    packed.update({slot: shape.packed for slot, shape in shapes.items()})
+    digests: dict[tuple[int, int], bytes] = {}
+    prefix = f"{FORMAT}/{FORMAT_VERSION}/{__version__}/{reference}/".encode()
+    for i, angles in enumerate(orientations):
+        for k in range(len(angles)):
+            xy, starts = packed[i, k]
             h = hashlib.blake2b(prefix, digest_size=16)
             h.update(np.ascontiguousarray(xy, dtype="<f8").tobytes())
             h.update(np.ascontiguousarray(starts, dtype="<i8").tobytes())
-            shapes[i, k] = s
             digests[i, k] = h.digest()
-    return NfpTable(pieces, orientations, reference, shapes, digests, {})
+    return NfpTable(pieces, orientations, reference, packed, shapes, digests)
 
 
 def _pair_key(da: bytes, db: bytes) -> str:
     return hashlib.blake2b(da + db, digest_size=16).hexdigest()
 
 
-def _compute_chunk(shapes: Sequence[Shape], pairs: np.ndarray, reference: str) -> Packed:
-    """Compute the NFPs of ``pairs`` (rows of indices into ``shapes``), packed in a few
+class _Pieces:
+    """The distinct turned pieces of a build, packed as
+    :func:`polycontact._kernels.nfp_batch.nfp_pairs` reads them (made once per build,
+    sent once to every worker), with what the kernel needs of each: its largest
+    |coordinate| and the larger side of its box (computed as :class:`~polycontact.Shape`
+    computes them), and the reference points (``centroids``: the pieces' area
+    centroids, or None for the origin)."""
+
+    def __init__(self, packs: Sequence[tuple[np.ndarray, np.ndarray]],
+                 centroids: np.ndarray | None) -> None:
+        rows = np.array([0, *np.cumsum([len(xy) for xy, _ in packs])], np.int64)
+        self.xy = (np.ascontiguousarray(np.concatenate([xy for xy, _ in packs]))
+                   if packs else np.empty((0, 2)))
+        self.ls = np.concatenate([st + rows[k] for k, (_, st) in enumerate(packs)]
+                                 + [np.empty(0, np.int64)])
+        self.nl = np.array([len(st) - 1 for _, st in packs], np.int64)
+        self.lo = np.concatenate([[0], np.cumsum(self.nl + 1)]).astype(np.int64)
+        first = rows[:-1]
+        lo = np.minimum.reduceat(self.xy, first) if packs else np.empty((0, 2))
+        hi = np.maximum.reduceat(self.xy, first) if packs else np.empty((0, 2))
+        self.extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
+        self.magnitude = np.maximum(-lo.min(axis=1, initial=np.inf),
+                                    hi.max(axis=1, initial=-np.inf))
+        self.centroids = centroids
+
+    def shape(self, k: int) -> Shape:
+        """Piece ``k`` as a Shape (its loops as packed: checked already)."""
+        st = self.ls[self.lo[k]:self.lo[k + 1]]
+        return Shape._trusted([self.xy[st[q]:st[q + 1]] for q in range(len(st) - 1)])
+
+
+def _compute_chunk(pieces: _Pieces, pairs: np.ndarray, reference: str) -> Packed:
+    """:func:`_compute`'s entries."""
+    return _compute(pieces, pairs, reference)[0]
+
+
+def _compute(pieces: _Pieces, pairs: np.ndarray, reference: str) -> tuple[Packed, float]:
+    """Compute the NFPs of ``pairs`` (rows of indices into the pieces), packed in a few
     flat arrays (a task's result crosses the network quicker so than as many small
     objects): the regions' WKB one after the other, their ends, the exact fits and
-    slides with their ends per entry, the references and the tolerances."""
-    wkbs, fits, slides, refs, tols = [], [], [], [], []
-    for ia, ib in pairs.tolist():
-        nfp = no_fit_polygon(shapes[ia], shapes[ib], reference)
-        wkbs.append(shapely.to_wkb(nfp.region, byte_order=1, include_srid=False))
-        fits.append(nfp.exact_fits.reshape(-1, 2))
-        slides.append(nfp.slides.reshape(-1, 2, 2))
-        refs.append(nfp.reference)
-        tols.append(float(nfp.tolerance))
-    return (b"".join(wkbs), np.cumsum([len(w) for w in wkbs], dtype=np.int64),
-            np.concatenate(fits), np.cumsum([len(f) for f in fits], dtype=np.int64),
-            np.concatenate(slides), np.cumsum([len(x) for x in slides], dtype=np.int64),
-            np.array(refs, dtype=np.float64).reshape(-1, 2), np.array(tols, dtype=np.float64))
+    slides with their ends per entry, the references and the tolerances.
+
+    The compiled batch (:func:`polycontact._kernels.nfp_batch.nfp_pairs`, without the
+    GIL) computes what it can; the entries it leaves go through
+    :func:`polycontact.no_fit_polygon`, which gives the same answers. Returns the
+    packed entries and the seconds spent on those (holding the GIL)."""
+    from ._kernels.nfp_batch import nfp_pairs
+    from . import limits
+    from .limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
+                         RELATIVE_TOLERANCE, ROUNDING_ULPS, SNAP_FACTOR)
+
+    pairs = np.ascontiguousarray(pairs, dtype=np.int64)
+    if pieces.centroids is None:
+        refs = np.zeros((len(pairs), 2))
+    else:
+        refs = np.ascontiguousarray(pieces.centroids[pairs[:, 0]])
+    settings = (RELATIVE_TOLERANCE, ROUNDING_ULPS, ANGLE_TOLERANCE, SNAP_FACTOR,
+                HOLE_WIDTH_FACTOR, EAR_CLIPPING_MAX, limits.MAX_SUM_VERTICES, limits.MAX_CLIP_TESTS,
+                reference == "origin")
+    blob, wkb_ends, fits, fit_ends, slides, slide_ends, tols, flagged = nfp_pairs(
+        (pieces.xy, pieces.ls, pieces.lo, pieces.nl, pieces.magnitude, pieces.extent),
+        pairs, refs, settings)
+    data: list[np.ndarray] = [blob, fits, slides]
+    ends = [wkb_ends, fit_ends, slide_ends]
+    t0 = time.perf_counter()
+    if len(flagged):
+        made = [no_fit_polygon(pieces.shape(ia), pieces.shape(ib), reference)
+                for ia, ib in pairs[flagged].tolist()]
+        parts = ([np.frombuffer(shapely.to_wkb(n.region, byte_order=1, include_srid=False),
+                                np.uint8) for n in made],
+                 [n.exact_fits.reshape(-1, 2) for n in made],
+                 [n.slides.reshape(-1, 2, 2) for n in made])
+        for f, got in enumerate(parts):
+            data[f], ends[f] = _splice(data[f], ends[f], flagged, got)
+        tols[flagged] = [n.tolerance for n in made]
+        refs[flagged] = [n.reference for n in made]
+    return ((data[0].tobytes(), ends[0], data[1], ends[1], data[2], ends[2], refs, tols),
+            time.perf_counter() - t0 if len(flagged) else 0.0)
 
 
-def _unpack_chunk(packed: Packed) -> list[_Record]:
-    """The records of a result of :func:`_compute_chunk`."""
-    blob, wkb_ends, fits, fit_ends, slides, slide_ends, refs, tols = packed
-    out = []
-    w0 = f0 = s0 = 0
-    for k in range(len(tols)):
-        w1, f1, s1 = int(wkb_ends[k]), int(fit_ends[k]), int(slide_ends[k])
-        out.append(_Record(blob[w0:w1], fits[f0:f1].copy(), slides[s0:s1].copy(),
-                           refs[k].copy(), float(tols[k])))
-        w0, f0, s0 = w1, f1, s1
-    return out
+def _splice(data: np.ndarray, ends: np.ndarray, at: np.ndarray,
+            parts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Entries ``at`` (empty in ``data``, whose entry k ends at ``ends[k]``) replaced by
+    ``parts``; the new data and ends.
+
+    >>> d, e = _splice(np.array([1, 2, 3]), np.array([2, 2, 3]), np.array([1]),
+    ...                [np.array([7, 7])])
+    >>> d.tolist(), e.tolist()
+    ([1, 2, 7, 7, 3], [2, 4, 5])
+    """
+    lengths = np.diff(ends, prepend=0)
+    lengths[at] = [len(p) for p in parts]
+    ours = np.ones(len(ends), bool)
+    ours[at] = False
+    mask = np.repeat(ours, lengths)
+    out = np.empty((len(mask), *data.shape[1:]), data.dtype)
+    out[mask] = data
+    out[~mask] = np.concatenate(parts)
+    return out, np.cumsum(lengths)
 
 
-def _chunks(count: int, workers: int, chunk_size: int | None) -> list[tuple[int, int]]:
-    if chunk_size is None:
-        chunk_size = min(1024, max(64, math.ceil(count / (4 * workers))))
-    return [(p, min(count, p + chunk_size)) for p in range(0, count, chunk_size)]
+class _Stored:
+    """The entries of one computed chunk (a :data:`Packed`), unpacked into records one
+    by one on first use (a table of many entries never makes the records it is not
+    asked for)."""
+
+    def __init__(self, packed: Packed) -> None:
+        self.packed = packed
+
+    def __len__(self) -> int:
+        return len(self.packed[7])
+
+    def record(self, k: int) -> _Record:
+        """The record of entry ``k``."""
+        blob, wkb_ends, fits, fit_ends, slides, slide_ends, refs, tols = self.packed
+        w0, f0, s0 = ((0, 0, 0) if k == 0 else
+                      (int(wkb_ends[k - 1]), int(fit_ends[k - 1]), int(slide_ends[k - 1])))
+        return _Record(blob[w0:int(wkb_ends[k])], fits[f0:int(fit_ends[k])].copy(),
+                       slides[s0:int(slide_ends[k])].copy(), refs[k].copy(), float(tols[k]))
+
+
+def _spans(start: int, count: int, size: int) -> list[tuple[int, int]]:
+    return [(p, min(count, p + size)) for p in range(start, count, size)]
 
 
 def _compute_missing(
-    table: NfpTable, todo: dict[str, tuple[tuple[int, int], tuple[int, int]]],
-    cache_dir: Path | None, client: Any, progress: Progress,
-    workers: int | None, chunk_size: int | None,
+    table: NfpTable, todo: np.ndarray, cache_dir: Path | None, client: Any,
+    progress: Progress, workers: int | None, threads: int, chunk_size: int | None,
 ) -> None:
-    from .distributed import current_client
+    """Compute the entries ``todo`` (codes) of ``table``, writing the cache's shards as
+    they come."""
+    from ._cluster import current_client
 
     client = current_client(client)
-    # the distinct shapes the missing entries need, and the pairs as indices into them
-    index: dict[tuple[int, int], int] = {}
-    for sa, sb in todo.values():
-        index.setdefault(sa, len(index))
-        index.setdefault(sb, len(index))
-    shapes = [table._shapes[slot] for slot in index]  # numbered in insertion order
-    keys = list(todo)
-    pairs = np.array([(index[sa], index[sb]) for sa, sb in todo.values()], dtype=np.int64)
-    if client is not None:
-        n_workers = max(1, sum(client.nthreads().values()))  # every thread of every worker
-    else:
-        n_workers = workers or os.cpu_count() or 1
-        if workers is None and len(keys) < PROCESS_POOL_MIN_ENTRIES:
-            n_workers = 1
-    spans = _chunks(len(keys), n_workers, chunk_size)
-    tasks = [pairs[p0:p1] for p0, p1 in spans]
-    results: Generator[tuple[int, Packed], None, None]
-    if client is not None:
-        from .distributed import run_tasks
-
-        results = run_tasks(client, _compute_chunk, shapes, tasks, table.reference,
-                            families=["no-fit polygon"])
-    elif n_workers > 1:
-        results = _run_processes(n_workers, shapes, tasks, table.reference)
-    else:
-        results = ((k, _compute_chunk(shapes, t, table.reference)) for k, t in enumerate(tasks))
-    bar = _progress_bar(progress, len(keys))
+    # the distinct turned pieces the missing entries need, and the pairs of them
+    n = len(table._distinct)
+    ia, ib = todo // n, todo % n
+    used = np.unique(np.concatenate([ia, ib]))
+    local = np.full(n, -1, np.int64)
+    local[used] = np.arange(len(used))
+    slots = [table._first[d] for d in used.tolist()]
+    pieces = _Pieces([table._packed[slot] for slot in slots], None if table.reference ==
+                     "origin" else np.array([table._shape(slot).centroid for slot in slots]))
+    pairs = np.stack([local[ia], local[ib]], axis=1)
+    count = len(todo)
+    bar = _progress_bar(progress, count)
     done = 0
+
+    def take(p0: int, p1: int, packed: Packed) -> None:
+        nonlocal done
+        stored = _Stored(packed)
+        if cache_dir is not None:
+            _write_shard(cache_dir, [(table._key(code), stored.record(k))
+                                     for k, code in enumerate(todo[p0:p1].tolist())])
+        table._store(todo[p0:p1], stored)
+        done += p1 - p0
+        if callable(progress):
+            progress(done, count)
+        elif bar is not None:
+            bar.update(p1 - p0)
+
+    results: Generator[tuple[int, int, Packed], None, None]
     try:
+        if client is not None:
+            from ._cluster import run_spans
+
+            def tasks_of(spans: list[tuple[int, int]]) -> tuple[_Pieces, list[np.ndarray]]:
+                return pieces, [pairs[p0:p1] for p0, p1 in spans]
+
+            results = run_spans(client, _compute_chunk, count, tasks_of, table.reference,
+                                chunk_size=chunk_size, family="no-fit polygon")
+        else:
+            results = _local(pieces, pairs, table.reference, workers, threads, chunk_size)
         with closing(results):
-            for k, packed in results:
-                p0, p1 = spans[k]
-                recs = list(zip(keys[p0:p1], _unpack_chunk(packed)))
-                if cache_dir is not None:
-                    _write_shard(cache_dir, recs)
-                table._records.update(recs)
-                table.computed += len(recs)
-                done += p1 - p0
-                if callable(progress):
-                    progress(done, len(keys))
-                elif bar is not None:
-                    bar.update(p1 - p0)
+            for p0, p1, packed in results:
+                take(p0, p1, packed)
     finally:
         if bar is not None:
             bar.close()
+
+
+def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | None,
+           threads: int, chunk_size: int | None) -> Generator[tuple[int, int, Packed], None, None]:
+    """The entries of ``pairs`` computed here, as ``(p0, p1, packed)`` spans as they
+    finish: a first chunk here (which compiles the kernels before any process starts)
+    measures the work and how much of it holds the GIL, which decides between threads
+    and processes (see the module's docstring)."""
+    from ._threads import as_done, useful
+
+    count = len(pairs)
+    first = min(count, chunk_size or PROBE_ENTRIES)
+    t0 = time.perf_counter()
+    packed, gil_seconds = _compute(pieces, pairs[:first], reference)
+    seconds = time.perf_counter() - t0
+    yield 0, first, packed
+    rest = count - first
+    n_proc = workers or 1
+    if workers is None and gil_seconds > 0.5 * seconds:
+        n_proc = min(threads, int(gil_seconds / first * rest / PROCESS_START))
+    n_threads = 1 if n_proc > 1 or workers == 1 else useful(threads, seconds / first * rest)
+    size = chunk_size or min(1024, max(64, math.ceil(rest / (4 * max(n_proc, n_threads)))))
+    spans = _spans(first, count, size)
+    tasks = [pairs[p0:p1] for p0, p1 in spans]
+    results: Iterator[tuple[int, Packed]]
+    if n_proc > 1:
+        results = _run_processes(n_proc, pieces, tasks, reference)
+    else:
+        results = as_done(lambda t: _compute_chunk(pieces, t, reference), tasks, n_threads)
+    with closing(results):  # type: ignore[type-var]
+        for k, got in results:
+            yield *spans[k], got
 
 
 def _progress_bar(progress: Progress, total: int) -> Any:
@@ -545,21 +769,20 @@ def _progress_bar(progress: Progress, total: int) -> Any:
     return tqdm(total=total, unit="NFP", desc="NFP table", file=sys.stderr, smoothing=0.1)
 
 
-_WORKER_SHAPES: list[Shape] = []
+_WORKER_PIECES: list[_Pieces] = []
 
 
-def _init_process(shapes: list[Shape]) -> None:
+def _init_process(pieces: _Pieces, reference: str) -> None:
     """A local worker process: Ctrl-C is the parent's to handle; it ends when its parent
-    does (:func:`_exit_with_parent`); kernels loaded once."""
+    does (:func:`_exit_with_parent`); the kernels loaded once, by a first entry (from
+    the cache: the parent compiled them before starting the pool)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     parent = multiprocessing.parent_process()
     if parent is not None:
         threading.Thread(target=_exit_with_parent, args=(parent.sentinel,), daemon=True,
                          name="polycontact-parent-watch").start()
-    from .compiling import warmup
-
-    warmup(["no-fit polygon"])
-    _WORKER_SHAPES[:] = shapes
+    _compute_chunk(pieces, np.zeros((1, 2), np.int64), reference)
+    _WORKER_PIECES[:] = [pieces]
 
 
 def _exit_with_parent(sentinel: int) -> None:
@@ -575,15 +798,16 @@ def _exit_with_parent(sentinel: int) -> None:
 
 
 def _process_task(pairs: np.ndarray, reference: str) -> Packed:
-    return _compute_chunk(_WORKER_SHAPES, pairs, reference)
+    return _compute_chunk(_WORKER_PIECES[0], pairs, reference)
 
 
 def _run_processes(
-    n: int, shapes: list[Shape], tasks: list[np.ndarray], reference: str
+    n: int, pieces: _Pieces, tasks: list[np.ndarray], reference: str
 ) -> Generator[tuple[int, Packed], None, None]:
-    """Run the tasks on ``n`` spawned processes; yield (task index, result) as they end."""
+    """Run the tasks on ``n`` spawned processes (one pool for the build); yield (task
+    index, result) as they end."""
     pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_init_process, initargs=(shapes,))
+                               initializer=_init_process, initargs=(pieces, reference))
     try:
         futures = {pool.submit(_process_task, t, reference): k for k, t in enumerate(tasks)}
         pending = set(futures)

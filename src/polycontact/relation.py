@@ -20,11 +20,11 @@ Examples
 from __future__ import annotations
 
 import enum
-import os
+import operator
 import threading
 import weakref
+from contextlib import closing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast, overload
@@ -518,7 +518,9 @@ def _bind_state_into(pa: bytes, pb: bytes, eps: float) -> int:
     binding at once bind the same entry point).
     """
     global _state_into
-    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, 1.0))
+    # (bound by a call with the caller's own tolerance: a made-up one could make the
+    # binding call far costlier than the classification asked for)
+    _state_into = entry_point(_kr().relate_shapes_into, (pa, pb, eps))
     return int(_state_into(pa, pb, eps))
 
 
@@ -526,7 +528,9 @@ def _bind_state_full(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndar
                      eps: float) -> int:
     """:func:`_bind_state_into` for ``relate_state`` on the shapes' arrays (``_state_full``)."""
     global _state_full
-    _state_full = entry_point(_kr().relate_state, (xa, sa, xb, sb, 1.0))
+    # (a tolerance of 1.0 on a large unit ring made every vertex touch every edge near
+    # it: the binding call took minutes)
+    _state_full = entry_point(_kr().relate_state, (xa, sa, xb, sb, eps))
     return int(_state_full(xa, sa, xb, sb, eps))
 
 
@@ -653,6 +657,7 @@ class RelationBatch:
     states: np.ndarray
     tolerances: np.ndarray
     _pack: Callable[[], tuple[Any, ...]] = field(repr=False)  # the packed pairs, built on demand
+    _threads: int = field(default=1, repr=False)  # the most threads of the distances
 
     def __len__(self) -> int:
         return int(self.states.shape[0])
@@ -687,24 +692,25 @@ class RelationBatch:
         """Signed distance of every pair (gap, 0 at contact, minus the depth), read-only."""
         from ._depth import penetrations
         from ._kernels import relation_many as km
+        from ._threads import numba_threads
 
         pack = self._pack()
-        out = km.many_distances(*pack, self.states, self.tolerances)
-        pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
-        if pen.size:
-            out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
+        with numba_threads(self._threads):
+            out = km.many_distances(*pack, self.states, self.tolerances)
+            pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
+            if pen.size:
+                out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
         return _read_only(out)
 
 
-def _split(count: int, fn: Any) -> list[Any]:
-    """Run ``fn(p0, p1)`` over chunks of range(count) on threads (the kernels release
-    the GIL), one chunk per CPU; returns the results in order."""
-    workers = min(os.cpu_count() or 1, max(1, count // 2048))
-    if workers == 1:
-        return [fn(0, count)]
-    bounds = np.linspace(0, count, workers + 1).astype(int)
-    with ThreadPoolExecutor(workers) as pool:
-        return list(pool.map(fn, bounds[:-1], bounds[1:]))
+def _split(count: int, fn: Any, threads: int) -> list[Any]:
+    """Run ``fn(p0, p1)`` over chunks of range(count) on at most ``threads`` threads (the
+    kernels release the GIL), no more than the work can use (a pair costs about
+    :data:`polycontact._threads.PAIR_SECONDS`); returns the results in order."""
+    from ._threads import PAIR_SECONDS, map_chunks, useful
+
+    n = useful(threads, count * PAIR_SECONDS)
+    return map_chunks(fn, count, n, chunks=1 if n == 1 else None)
 
 
 def _raw_array(arr: Any) -> np.ndarray | None:
@@ -727,7 +733,7 @@ def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any
 
 
 def _classify_arrays(
-    arr_a: np.ndarray, arr_b: np.ndarray, tol: float
+    arr_a: np.ndarray, arr_b: np.ndarray, tol: float, threads: int
 ) -> RelationBatch | None:
     """:func:`classify_many` of two (P, N, 2) ring arrays in one kernel pass per thread;
     None if some ring is not certified valid as given (the caller then decides and
@@ -750,7 +756,7 @@ def _classify_arrays(
                       tuple(o[p0:p1] for o in out))
 
     try:
-        _split(arr_a.shape[0], chunk)
+        _split(arr_a.shape[0], chunk, threads)
     except BaseException:
         _BUFFERS.give(buf_a, buf_b)
         raise
@@ -761,6 +767,7 @@ def _classify_arrays(
     batch = RelationBatch(
         states, eps,
         lambda: (*_ring_pack(copy_a, used_a, sign_a), *_ring_pack(copy_b, used_b, sign_b)),
+        threads,
     )
     weakref.finalize(batch, _BUFFERS.give, buf_a, buf_b)  # reused once the batch is gone
     return batch
@@ -815,6 +822,11 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
     packed as it is, stored reversed where ``sign`` < 0)."""
     from ._kernels import relation_many as km
 
+    if set(map(type, items)) <= {Shape}:  # (every body a Shape: packed without a loop)
+        if made is not None:
+            made[:] = items
+        xy, rows, starts, st_off = shapes_packed(list(items))
+        return xy, starts + np.repeat(rows[:-1], np.diff(st_off)), st_off, np.ones(len(items))
     bodies: list[Any] = []
     raw: list[int] = []
     for i, it in enumerate(items):
@@ -861,6 +873,27 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
     return xy, np.array(ls, dtype=np.int64), np.array(bs, dtype=np.int64), sign
 
 
+def shapes_packed(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
+    """The stored coordinates of many shapes one after another, ``(xy, rows, starts,
+    st_off)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]`` and its loop starts
+    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]``. Each shape's kernel
+    pack (the bytes ``classify`` hands the kernels) is joined with the others and read
+    in compiled code: per shape, only the few tens of nanoseconds of the join.
+
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> [a.tolist() for a in shapes_packed([sq, sq])[1:]]
+    [[0, 4, 8], [0, 4, 0, 4], [0, 2, 4]]
+    """
+    from ._kernels.packs import unpack_shapes
+
+    out: tuple[np.ndarray, ...] = unpack_shapes(
+        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), len(shapes))
+    return out
+
+
+_KERNEL = operator.attrgetter("_kernel")
+
+
 def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[Any, ...]:
     if isinstance(items, np.ndarray) and items.ndim == 3:
         items = list(items)
@@ -872,14 +905,77 @@ def pack_bodies(items: Any, what: str, made: list[Any] | None = None) -> tuple[A
     return _pack_sequence(items, what, made)
 
 
+def pack_states(xa: np.ndarray, lsa: np.ndarray, bsa: np.ndarray, fa: np.ndarray,
+                xb: np.ndarray, lsb: np.ndarray, bsb: np.ndarray, fb: np.ndarray,
+                tol: float, threads: int) -> tuple[np.ndarray, np.ndarray]:
+    """States and tolerances of the pairs of two packed batches (``pack_bodies``), on at
+    most ``threads`` threads, each into its part of the results."""
+    from ._kernels import relation_many as km
+
+    p_count = len(fa)
+    states = np.empty(p_count, np.int8)
+    eps = np.empty(p_count)
+
+    def chunk(p0: int, p1: int) -> None:
+        states[p0:p1], eps[p0:p1] = km.many_states(
+            xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
+            RELATIVE_TOLERANCE, ROUNDING_ULPS,
+        )
+
+    _split(p_count, chunk, threads)
+    return states, eps
+
+
+def _remote_states(client: Any, packs: tuple[Any, ...], tol: float,
+                    chunk_size: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """The states and tolerances of the packed pairs ``packs`` (both sides'
+    ``pack_bodies``) as :func:`classify_many` computes them, in tasks on the cluster of
+    ``client`` (each with the slices of the packed arrays its pairs need)."""
+    from ._cluster import run_spans
+
+    count = len(packs[3])
+    states = np.empty(count, np.int8)
+    tols = np.empty(count)
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return None, [(_pack_slice(packs[:4], p0, p1), _pack_slice(packs[4:], p0, p1))
+                      for p0, p1 in spans]
+
+    with closing(run_spans(client, _states_task, count, tasks_of, tol,
+                           chunk_size=chunk_size, family="classification")) as results:
+        for p0, p1, (st, e) in results:
+            states[p0:p1] = st
+            tols[p0:p1] = e
+    return states, tols
+
+
+def _pack_slice(pack: tuple[Any, ...], p0: int, p1: int) -> tuple[Any, ...]:
+    """The bodies ``p0:p1`` of a ``pack_bodies`` result ``(xy, ls, bs, sign)``, packed
+    alone (their rows, loop starts and body starts renumbered from 0)."""
+    xy, ls, bs, sign = pack
+    b0, b1 = int(bs[p0]), int(bs[p1])
+    r0 = int(ls[b0]) if b1 > b0 else 0
+    r1 = int(ls[b1 - 1]) if b1 > b0 else 0
+    return (xy[r0:r1], ls[b0:b1] - r0, bs[p0:p1 + 1] - b0, sign[p0:p1])
+
+
+def _states_task(_: Any, task: tuple[Any, ...], tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """One task of :func:`_remote_states`."""
+    (xa, lsa, bsa, fa), (xb, lsb, bsb, fb) = task
+    return pack_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, 1)
+
+
 def classify_many(
     shapes_a: Sequence[ShapeLike] | np.ndarray, shapes_b: Sequence[ShapeLike] | np.ndarray, *,
-    tolerance: float | None = None
+    tolerance: float | None = None, threads: int | None = None, client: Any = None,
+    chunk_size: int | None = None,
 ) -> RelationBatch:
     """Classify many pairs ``(shapes_a[i], shapes_b[i])`` in one call.
 
-    The pairs are split over one thread per CPU (the compiled kernels release the GIL);
-    the signed distances, on first access, run in parallel too.
+    The pairs are shared among threads (the compiled kernels release the GIL), as many
+    as the threading policy of :doc:`conventions` gives; the signed distances, on first
+    access, run in parallel too. With a Dask client the pairs run as tasks on the
+    cluster instead, after the same checks here, with the same result.
 
     Parameters
     ----------
@@ -890,6 +986,14 @@ def classify_many(
         access, are those of the rings as they were at the call).
     tolerance : float, optional
         Absolute tolerance for every pair; default per pair as in :func:`classify`.
+    threads : int, optional
+        At most this many threads (default ``numba.get_num_threads()``).
+    client : dask.distributed.Client, optional
+        Run on this Dask cluster; by default the current Dask client if there is one
+        (see :func:`polycontact.distributed.current_client`).
+    chunk_size : int, optional
+        Pairs per Dask task (default: sized from a first task, see
+        :func:`polycontact.distributed.run_spans`).
 
     Returns
     -------
@@ -904,13 +1008,17 @@ def classify_many(
     >>> batch.states.tolist(), batch.distances.round(6).tolist()
     ([0, 1, 2], [1.414214, 0.0, -0.5])
     """
-    from ._kernels import relation_many as km
+    from ._cluster import check_chunk_size, current_client
+    from ._threads import requested
 
     tol = -1.0 if tolerance is None else _check_tolerance(tolerance)
+    n_threads = requested(threads)
+    check_chunk_size(chunk_size)
+    remote = current_client(client)
     arr_a = _raw_array(shapes_a)
     arr_b = _raw_array(shapes_b)
-    if arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
-        batch = _classify_arrays(arr_a, arr_b, tol)
+    if remote is None and arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
+        batch = _classify_arrays(arr_a, arr_b, tol, n_threads)
         if batch is not None:
             return batch
     pa = pack_bodies(shapes_a, "shapes_a")
@@ -919,18 +1027,10 @@ def classify_many(
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"
         )
-    xa, lsa, bsa, fa = pa
-    xb, lsb, bsb, fb = pb
-
-    def chunk(p0: int, p1: int) -> tuple[np.ndarray, np.ndarray]:
-        out: tuple[np.ndarray, np.ndarray] = km.many_states(
-            xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1], tol,
-            RELATIVE_TOLERANCE, ROUNDING_ULPS,
-        )
-        return out
-
-    parts = _split(len(fa), chunk)
-    states = np.concatenate([st for st, _ in parts])
-    eps = np.concatenate([e for _, e in parts])
-    return RelationBatch(states, eps, lambda: (*pa, *pb))
-
+    if remote is None:
+        xa, lsa, bsa, fa = pa
+        xb, lsb, bsb, fb = pb
+        states, eps = pack_states(xa, lsa, bsa, fa, xb, lsb, bsb, fb, tol, n_threads)
+    else:
+        states, eps = _remote_states(remote, (*pa, *pb), tol, chunk_size)
+    return RelationBatch(states, eps, lambda: (*pa, *pb), n_threads)

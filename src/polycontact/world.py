@@ -48,6 +48,7 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      TIME_TOLERANCE)
 from .shape import Shape, ShapeLike, as_shape, frozen_ints
 from .tolerances import ROUNDING_FACTOR, check_range, default_tolerance
+from ._threads import chunks as _chunks
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -85,20 +86,11 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 }
 
 
-#: Work, in units of one pair's classification (about half a microsecond), below which
-#: a compiled pass runs on the calling thread (starting threads would cost more).
-_SERIAL_WORK = 4096
-#: The work of one item of the passes that are not classifications, in those units.
+#: The work of one item of the passes that are not classifications, in units of one
+#: pair's classification (see :func:`polycontact._threads.chunks`).
 _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
-
-
-def _chunks(count: int, work: float = 1.0) -> int:
-    """Parallel chunks for ``count`` items of ``work`` each: 1 (serial, no thread start)
-    below :data:`_SERIAL_WORK` in all, else four per Numba thread."""
-    import numba
-
-    return 1 if count * work < _SERIAL_WORK else 4 * numba.get_num_threads()
+_BODY_WORK = 6.0  # a body's broad-phase query and the classification of its pairs
 
 
 @dataclass(frozen=True)
@@ -548,6 +540,28 @@ def _integer(value: Any, what: str) -> int:
     return int(value)
 
 
+def _id_array(ids: Any, what: str) -> np.ndarray:
+    """``ids`` as a 1-d int64 array (not checked against a World), else an error naming
+    ``what``."""
+    raw = np.asarray(ids)
+    if raw.ndim != 1:
+        raise ValueError(f"{what}: expected a 1-d sequence of body ids, got shape "
+                         f"{raw.shape}")
+    if raw.dtype.kind not in "iu" and not (raw.dtype.kind == "O" and all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
+            for v in raw.tolist())) and len(raw):
+        raise TypeError(f"{what}: expected integer body ids, got {raw.dtype}")
+    return np.ascontiguousarray(raw, dtype=np.int64)
+
+
+def _floats(value: Any, what: str) -> np.ndarray:
+    """``value`` itself if it is a C-contiguous float64 array (read during the call
+    only), else :func:`polycontact._checks.real_array` of it (a new array)."""
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.flags.c_contiguous:
+        return value
+    return real_array(value, what)
+
+
 def _values(value: Any, what: str, count: int) -> np.ndarray:
     """``value`` as a new float64 array of ``count`` finite real numbers, else an error
     naming ``what`` (and the index of a number that is not finite)."""
@@ -980,12 +994,13 @@ class World:
         self._rad[ids] = rad
         self._store(ids, rows, rows, vmap, ls, lmap, bs)
         if placed and count:
-            _, emax = pose_rows(ids, (p[:, 0].copy(), p[:, 1].copy(), a), self._bodies(),
+            _, emax = pose_rows(ids, (np.ascontiguousarray(p), a), self._bodies(),
                                 (self._bxy, self._cen), (RELATIVE_TOLERANCE, ROUNDING_ULPS),
-                                _chunks(count, _POSE_WORK))
-            self._emax = max(self._emax, float(emax))
-        self._pos[ids] = p
-        self._ang[ids] = a
+                                (self._pos, self._ang, self._ver), _chunks(count, _POSE_WORK))
+            self._emax = max(self._emax, float(emax))  # (the poses stored by pose_rows)
+        else:
+            self._pos[ids] = p
+            self._ang[ids] = a
         for k, b in enumerate(ids.tolist()):
             self._records[b] = [None if names is None else names[k], objects[k], None, None,
                                 -1]
@@ -1030,16 +1045,29 @@ class World:
         >>> w.contacts().pairs.tolist(), w.poses()[0].tolist()
         ([[0, 1]], [[0.5, 0.5], [1.5, 0.5]])
         """
-        idx = self._ids(ids, "ids", unique=True)
-        pos = points(positions, "positions", (len(idx), 2))
+        from ._kernels.poses import pose_checks
+
+        idx = _id_array(ids, "ids")
+        pos = _floats(positions, "positions")
+        if pos.shape != (len(idx), 2):
+            pos = points(positions, "positions", (len(idx), 2))  # (says what is wrong)
         if angles is None:
-            ang = self._ang[idx]
+            ang = np.empty(0)  # (each body keeps its angle)
         elif np.ndim(angles) == 0:
             ang = np.full(len(idx), finite_number(angles, "angles"))
         else:
-            ang = _values(angles, "angles", len(idx))
-        self._check_reach(pos, ang, self._rad[idx], idx, None, None, None, None,
-                          "body ids[{k}] placed at positions[{k}]")
+            ang = _floats(angles, "angles")
+            if ang.shape != (len(idx),):
+                ang = _values(angles, "angles", len(idx))
+        # every check in one parallel pass; only when it finds something, one by one
+        if not pose_checks(idx, (pos, ang), self._live[: self._next], self._rad,
+                           self._stamp, COORDINATE_LIMIT, _chunks(len(idx), _POSE_WORK)):
+            idx = self._ids(ids, "ids", unique=True)
+            pos = points(positions, "positions", (len(idx), 2))
+            if len(ang):
+                ang = _values(ang, "angles", len(idx))
+            self._check_reach(pos, ang if len(ang) else self._ang[idx], self._rad[idx], idx,
+                              None, None, None, None, "body ids[{k}] placed at positions[{k}]")
         self._write_poses(idx, pos, ang)
 
     def poses(self, ids: npt.ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -1139,15 +1167,7 @@ class World:
         error naming ``what`` and the index."""
         from ._kernels.poses import first_repeat
 
-        raw = np.asarray(ids)
-        if raw.ndim != 1:
-            raise ValueError(f"{what}: expected a 1-d sequence of body ids, got shape "
-                             f"{raw.shape}")
-        if raw.dtype.kind not in "iu" and not (raw.dtype.kind == "O" and all(
-                isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_))
-                for v in raw.tolist())) and len(raw):
-            raise TypeError(f"{what}: expected integer body ids, got {raw.dtype}")
-        idx = raw.astype(np.int64)
+        idx = _id_array(ids, what)
         bad = (idx < 0) | (idx >= self._next)
         bad[~bad] = ~self._live[idx[~bad]]
         if bad.any():
@@ -1186,7 +1206,8 @@ class World:
             check_range(out, what.format(k=k))
 
     def _write_poses(self, idx: np.ndarray, pos: np.ndarray, ang: np.ndarray) -> None:
-        """Set the checked poses: rows, boxes, tolerances, then the grid."""
+        """Set the checked poses (``ang`` empty: the bodies keep their angles): rows,
+        boxes, tolerances, then the grid (only the bodies that left their cell)."""
         from ._kernels.poses import pose_rows
 
         if not len(idx):
@@ -1195,20 +1216,18 @@ class World:
             every = len(idx) == len(self._records)
             self._xy = np.empty_like(self._xy) if every else self._xy.copy()
             self._shared = False
-        poses = (np.ascontiguousarray(pos[:, 0]), np.ascontiguousarray(pos[:, 1]),
-                 np.ascontiguousarray(ang))
-        _, emax = pose_rows(idx, poses, self._bodies(), (self._bxy, self._cen),
-                            (RELATIVE_TOLERANCE, ROUNDING_ULPS), _chunks(len(idx), _POSE_WORK))
+        chunks = _chunks(len(idx), _POSE_WORK)
+        _, emax = pose_rows(idx, (pos, ang), self._bodies(), (self._bxy, self._cen),
+                            (RELATIVE_TOLERANCE, ROUNDING_ULPS),
+                            (self._pos, self._ang, self._ver), chunks)
         self._emax = max(self._emax, float(emax))
-        self._pos[idx] = pos
-        self._ang[idx] = ang
-        self._ver[idx] += 1
-        made, done = _k().regrid(idx, self._keys, self._heads, self._nxt, self._prv,
+        left = _k().left_cells(idx, self._keys, self._slot, self._box, self._origin, chunks)
+        made, done = _k().regrid(left, self._keys, self._heads, self._nxt, self._prv,
                                  self._slot, self._level, self._lvl_count, self._box,
                                  self._origin, self._filled)
         self._filled += made
-        if done < len(idx):  # the table would be more than half full: a new one, with
-            self._rebuild(extra=int(idx[0]))  # every body in the cell of its new box
+        if done < len(left):  # the table would be more than half full: a new one, with
+            self._rebuild(extra=int(left[0]))  # every body in the cell of its new box
 
     # -- storage (private) -------------------------------------------------------------
     def _grow_bodies(self, n: int) -> None:
@@ -1401,25 +1420,19 @@ class World:
         tol = self._tol(tolerance)
         gap = finite_number(margin, "margin", minimum=0.0)
         alive = self._alive()
-        pi, pj = k.candidate_pairs(self._grid(), self._box, self._eps, tol, alive, self._next,
-                                   gap)
-        states, used = k.classify_pairs(self._bodies(), tol, pi, pj, self._vmax, self._lmax,
-                                        _chunks(len(pi)))
-        keep = states > 0
+        pairs, states, used = k.contact_pairs(
+            self._grid(), self._bodies(), tol, alive, self._next, gap,
+            k.CLASSIFIED if gap > 0.0 else k.TOUCHING, self._vmax, self._lmax,
+            _chunks(len(alive), _BODY_WORK))
         if gap > 0.0:
             from ._kernels.contact_geometry import boundary_gaps
 
+            keep = states > 0
             near = np.flatnonzero(~keep)
-            gaps = boundary_gaps(self._bodies()[:4], pi[near], pj[near], self._lmax,
-                                 _chunks(len(near)))
+            gaps = boundary_gaps(self._bodies()[:4], pairs[near, 0], pairs[near, 1],
+                                 self._lmax, _chunks(len(near)))
             keep[near[gaps <= gap]] = True
-        hit = np.flatnonzero(keep)
-        if self._next < 2**31:  # one key per pair, no overflow: one sort, not a lexsort
-            hit = hit[np.argsort(pi[hit] * self._next + pj[hit], kind="stable")]
-        else:
-            hit = hit[np.lexsort((pj[hit], pi[hit]))]
-        pairs = np.stack([pi[hit], pj[hit]], axis=1)
-        states, used = states[hit], used[hit]
+            pairs, states, used = pairs[keep], states[keep], used[keep]
         if self._container is not None and len(alive):
             cst = k.container_states(self._bodies(), tol, alive, self._hazards(), self._vmax,
                                      self._lmax, self._hmax, _chunks(len(alive)))
@@ -1594,7 +1607,7 @@ class World:
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]
         """
-        from ._kernels.world_sweep import sweep_search
+        from ._kernels.world_sweep import sweep_search, turned_frames
         from ._kernels.swept import box_pairs, swept_boxes
 
         step = finite_number(dt, "dt", minimum=0.0)
@@ -1622,16 +1635,19 @@ class World:
             cand = box_pairs(boxes, owner, n)
         else:
             cand = np.empty((0, 2), np.int64)
-        self._sweep_frames(ids[np.unique(cand)])
+        bodies = ids[np.unique(cand)]
+        self._sweep_frames(bodies)
         tint, tflt, tio, tfo = self._frames[:4]
         box = self._box
         extent = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2])
         pi = np.ascontiguousarray(cand[:, 0])
         pj = np.ascontiguousarray(cand[:, 1])
         base = (self._bxy, self._ls, self._lo, self._nl, self._cen)
+        tables = (tint, tflt, tio, tfo)
+        frames = turned_frames(base, tables, bodies, self._ang, _chunks(len(bodies), _POSE_WORK))
         code, t_hit, t_contact, state = sweep_search(
-            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base,
-            (tint, tflt, tio, tfo),
+            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base, tables,
+            frames, (self._xy, self._ls, self._lo, self._nl),
             (step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, ROUNDING_FACTOR,
              CONTACT_RESOLUTION, int(max_iterations)),
             self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
@@ -1644,7 +1660,8 @@ class World:
                    self._rad[a], self._rad[b],
                    RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j]),
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
-                  (tint, tflt, tio.copy(), tfo.copy()), self._vmax, self._lmax, ROUNDING_FACTOR)
+                  (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
+                  ROUNDING_FACTOR)
         hit = np.where(code[order] == 2, 0.0, np.where(code[order] == 1, t_hit[order], np.nan))
         return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
                      events)

@@ -26,8 +26,8 @@ direction by the same second-order bound).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import closest_on_segment, outward_normal
 
 

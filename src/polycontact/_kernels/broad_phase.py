@@ -23,7 +23,8 @@ t = 0 on). The roots are polished by bisection to adjacent floats.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 _ULP = 2.0**-52
 #: Breakpoints of f on [lo, hi]: both ends and at most one root per derivative of

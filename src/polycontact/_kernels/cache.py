@@ -8,7 +8,9 @@ cache goes in the per-user cache directory instead
 Linux). Setting ``NUMBA_CACHE_DIR`` overrides this for every Numba library, as Numba
 documents; other libraries' caches are never moved. Either way the kernels go in a
 subdirectory named after a hash of all the kernels' sources
-(:func:`kernel_sources_fingerprint`), since Numba tracks only each function's own file.
+(:func:`kernel_sources_fingerprint`), since Numba tracks only each function's own file,
+and not after where they are installed, so that every install of the same sources
+(editable or not, any virtual environment) shares one compiled copy.
 
 This module depends on the standard library and Numba alone (``platformdirs``, which
 finds the per-user directory, is imported when a path is asked for).
@@ -93,8 +95,9 @@ def install_cache_locator() -> None:
         def __init__(self, py_func: Any, py_file: str) -> None:
             self._py_file = py_file
             self._lineno = py_func.__code__.co_firstlineno
-            sub = self.get_suitable_cache_subpath(py_file)
-            self._cache_path = str(cache_directory() / f"{sub}-{fingerprint}")
+            # named after the sources, not where they are installed: an editable
+            # install and a regular one of the same sources share the compiled kernels
+            self._cache_path = str(cache_directory() / f"kernels-{fingerprint}")
 
         @classmethod
         def from_function(cls, py_func: Any, py_file: str) -> Any:

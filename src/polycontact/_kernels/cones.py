@@ -8,8 +8,8 @@ body's interior in a direction is decided by its nearest ray clockwise of it.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import norm, point_segment_distance
 
 

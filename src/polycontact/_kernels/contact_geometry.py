@@ -22,26 +22,38 @@ Vertices and edges come out as packed rows of each body; the caller maps them to
 numbering. The bodies come as ``rows`` = ``(xy, ls, lo, nl)``, the packed rows of a
 World's bodies (the first four fields of its ``bodies`` record). The pairs run in
 parallel chunks (one chunk: serial, no thread start); each chunk allocates its scratch
-once.
+once, and the pairs run without Numba's reference counting (the dozen arrays each pair
+passes on cost as much as a small pair's geometry), growing a buffer only where a pair
+needs it.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
-from .convolution import FEW_VERTICES, contact_depth_into, depth_buffers
+from .jit import njit
+from .convolution import DEPTH_MORE_ROWS, DEPTH_UNDECIDED, FEW_VERTICES, contact_depth_of, \
+    depth_buffers
 from .depth import box_escape
-from .overlap import overlap_moments, overlap_scratch, where
-from .primitives import bbox, closest_on_segment, loop_next, loop_prev
+from .overlap import overlap_moments, overlap_of_tables, overlap_scratch
+from .packs import scratch_floats
+from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next, loop_prev
+from .relation import moved_state
 from .world import body_view
 
 SEPARATE = 0
 CONTACT = 1
 PENETRATING = 2
 
+#: What :func:`pair_geometry_into` says: done, or undone for want of room for the
+#: boundaries' crossings, or for the depth's pieces (:func:`grown_buffers` makes it).
+GEOMETRY_DONE = 0
+GEOMETRY_MORE_CROSSINGS = 1
+GEOMETRY_MORE_PIECES = 2
 
-@njit(cache=True, nogil=True)
+
+@njit(cache=True, nogil=True, _nrt=False)
 def closest_features(xa, sa, xb, sb):
     """Closest points of the boundaries of two bodies that do not touch:
     ``(gap, ax, ay, bx, by, side, vertex, edge)``, A's point (ax, ay) and B's (bx, by);
@@ -90,7 +102,7 @@ def closest_features(xa, sa, xb, sb):
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def touch(xa, sa, xb, sb, eps):
     """The touch of two bodies in contact that :attr:`polycontact.Relation.normal`
     chooses: ``(nx, ny, side, vertex, edge)``, the unit normal from A towards B (B's
@@ -144,7 +156,7 @@ def touch(xa, sa, xb, sb, eps):
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def carrier(xa, sa, xb, sb, dx, dy):
     """The vertex-edge pair whose contact segment passes nearest the translation
     (dx, dy) of A: ``(side, vertex, edge)`` as :func:`contact_depth_into` gives them
@@ -170,61 +182,109 @@ def carrier(xa, sa, xb, sb, dx, dy):
     return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _penetrating(ya, sa, yb, sb, e, buffers):
-    """Geometry of a penetrating pair: ``(depth, nx, ny, px, py, area, cx, cy, side,
-    vertex, edge)``, NaN depth when undecided here (see the module docstring);
-    ``buffers`` = ``(depth, overlap)``: the scratch of
-    :func:`polycontact._kernels.convolution.contact_depth_into` and of
-    :func:`polycontact._kernels.overlap.overlap_moments`."""
+    """Geometry of a penetrating pair: ``(status, depth, nx, ny, px, py, area, cx, cy,
+    side, vertex, edge)``, NaN depth when undecided here (see the module docstring), a
+    status other than :data:`GEOMETRY_DONE` when a buffer is too short; ``buffers``: as
+    :func:`geometry_buffers` makes them.
+
+    The depth is at least that of the deepest vertex of either body inside the other
+    (less twice the tolerance: every shorter translation leaves it inside), and is that
+    depth when the translation that takes this vertex onto the nearest point of the
+    other body's boundary (two tolerances further) ends the overlap: one check of the
+    state kernel (:func:`polycontact._kernels.relation.moved_state`), the usual case of
+    a corner pressed into a side. Otherwise the contact segments
+    (:func:`polycontact._kernels.convolution.contact_depth_of`) search for it, from
+    that lower bound."""
     na = ya.shape[0]
     nb = yb.shape[0]
-    depth_buf, scratch = buffers
-    area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
-    if nc < 0:  # more crossings than the scratch holds: a buffer of the bodies' size
-        big = na * nb + 1
-        scratch = (scratch[0], scratch[1], np.empty((big, 6)), np.empty(big + na + nb + 2),
-                   scratch[4], scratch[5], scratch[6], scratch[7], scratch[8])
-        area, cx, cy, nc = overlap_moments(ya, sa, yb, sb, e, scratch)
-    if na + nb > FEW_VERTICES:
-        return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
+    depth_buf, scratch, (moved, state_buf) = buffers
+    ea, nxa, eb, nxb = scratch[9]
+    for side in range(2):
+        y, st, e_, nx_ = (ya, sa, ea, nxa) if side == 0 else (yb, sb, eb, nxb)
+        edge_rows(y, st, e_, nx_)
+    a = (ya, sa, ea[:na], nxa[:na], bbox(ya, na))
+    b = (yb, sb, eb[:nb], nxb[:nb], bbox(yb, nb))
+    nan = np.nan
+    area, cx, cy, nc = overlap_of_tables(a, b, e, scratch)
+    if nc < 0:
+        return GEOMETRY_MORE_CROSSINGS, nan, nan, nan, nan, nan, nan, nan, nan, -1, -1, -1
     cross, acc, where_a, where_b = scratch[2], scratch[4], scratch[7], scratch[8]
+    # the deepest vertex of either body inside the other, onto its nearest boundary
+    # point: A moved by (dx, dy)
+    deep = 0.0
+    side = v = f = -1
+    dx = dy = 0.0
+    for s in range(2):
+        xv, where_v, o = (ya, where_a, b) if s == 0 else (yb, where_b, a)
+        dv, vv, fv, qx, qy = _deepest(xv, where_v, o)
+        if dv > deep or (s == 0 and dv == deep):
+            deep, side, v, f = dv, s, vv, fv
+            dx = qx - xv[vv, 0] if s == 0 else xv[vv, 0] - qx
+            dy = qy - xv[vv, 1] if s == 0 else xv[vv, 1] - qy
+    if deep > 0.0:
+        g = 1.0 + 2.0 * e / deep
+        if not moved_state(a, b, dx * g, dy * g, e, moved[:na], state_buf)[0]:
+            xv = ya if side == 0 else yb
+            return GEOMETRY_DONE, deep, -dx / deep + 0.0, -dy / deep + 0.0, xv[v, 0], \
+                xv[v, 1], area, cx, cy, side, v, f
+    if na + nb > FEW_VERTICES:
+        return GEOMETRY_DONE, nan, nan, nan, nan, nan, area, cx, cy, -1, -1, -1
     bound, bdx, bdy = box_escape(ya, yb)
     # A vertex inside the other body by more than a length keeps the bodies penetrating
     # through any translation shorter than it (less the tolerance): no test there.
-    low = max(_deepest(ya, where_a, yb, sb), _deepest(yb, where_b, ya, sa)) - 2.0 * e
-    d, dx, dy, ok, side, v, f = contact_depth_into(ya, sa, yb, sb, bound, bdx, bdy, e, low,
-                                                   depth_buf)
-    if not ok:
-        return np.nan, np.nan, np.nan, np.nan, np.nan, area, cx, cy, -1, -1, -1
+    d, dx, dy, status, side, v, f = contact_depth_of(a, b, bound, bdx, bdy, e, deep - 2.0 * e,
+                                                     depth_buf)
+    if status == DEPTH_MORE_ROWS:
+        return GEOMETRY_MORE_PIECES, nan, nan, nan, nan, nan, nan, nan, nan, -1, -1, -1
+    if status == DEPTH_UNDECIDED:
+        return GEOMETRY_DONE, nan, nan, nan, nan, nan, area, cx, cy, -1, -1, -1
     if side < 0:
         side, v, f = carrier(ya, sa, yb, sb, dx, dy)
-    px, py = point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc)
+    inside = (where_a if side == 0 else where_b)[v] > 0
+    px, py = point_of(ya, yb, side, v, inside, cross, nc, acc)
     nx, ny = normal_of(ya, sa, yb, sb, d, dx, dy, side, f)
-    return d, nx, ny, px, py, area, cx, cy, side, v, f
+    return GEOMETRY_DONE, d, nx, ny, px, py, area, cx, cy, side, v, f
 
 
-@njit(cache=True, nogil=True)
-def _deepest(xv, where_v, xo, so):
-    """The largest distance from the other body's boundary ``(xo, so)`` of the vertices
-    of ``xv`` that ``where_v`` says lie inside it (0 when none does)."""
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _deepest(xv, where_v, o):
+    """The vertex of ``xv`` deepest inside the other body among those that ``where_v``
+    says lie inside it, and the nearest point of the other body's boundary:
+    ``(distance, vertex, edge, qx, qy)`` (distance 0 and vertex -1 when none does);
+    ``o`` = ``(xo, so, eo, nxo, box)``, the other body with its edge table (an edge
+    whose box is farther than the nearest edge so far is passed over)."""
+    xo, _, eo, nxo, _ = o
     best = 0.0
+    out = (0.0, -1, -1, 0.0, 0.0)
     for i in range(xv.shape[0]):
         if where_v[i] != 1:
             continue
         px = xv[i, 0]
         py = xv[i, 1]
         near = np.inf
-        for k in range(so.shape[0] - 1):
-            for f in range(so[k], so[k + 1]):
-                g = loop_next(f, so, k)
-                near = min(near, closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0],
-                                                    xo[g, 1])[2])
-        best = max(best, near)
-    return np.sqrt(best)
+        nf = -1
+        qx = qy = 0.0
+        for f in range(xo.shape[0]):
+            gx = max(0.0, px - eo[f, 4], eo[f, 3] - px)
+            gy = max(0.0, py - eo[f, 6], eo[f, 5] - py)
+            if gx * gx + gy * gy >= near:
+                continue
+            g = nxo[f]
+            cx, cy, d2 = closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0], xo[g, 1])
+            if d2 < near:
+                near = d2
+                nf = f
+                qx = cx
+                qy = cy
+        if near > best:
+            best = near
+            out = (np.sqrt(near), i, nf, qx, qy)
+    return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def normal_of(ya, sa, yb, sb, d, dx, dy, side, f):
     """The unit normal from A towards B of a penetration of depth ``d`` whose escape is
     (dx, dy): opposite the escape, or for a zero escape the normal of the carrying
@@ -243,17 +303,18 @@ def normal_of(ya, sa, yb, sb, d, dx, dy, side, f):
     return sign * -uy / ln + 0.0, sign * ux / ln + 0.0
 
 
-@njit(cache=True, nogil=True)
-def point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc):
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
+def point_of(ya, yb, side, v, inside, cross, nc, acc):
     """A point of the overlap's boundary for a penetrating pair: the carrying vertex
-    ``v`` (of A for side 0, of B for side 1) when it lies inside the other body, else
-    the boundaries' crossing nearest it (``cross[:nc]``, rows of
+    ``v`` (of A for side 0, of B for side 1) when it lies inside the other body by more
+    than the tolerance (``inside``, as the overlap's walk found it), else the
+    boundaries' crossing nearest it (``cross[:nc]``, rows of
     :func:`polycontact._kernels.overlap.overlap_moments`), else the point of the
     boundary that kernel left in ``acc``."""
-    xv, xo, so = (ya, yb, sb) if side == 0 else (yb, ya, sa)
+    xv = ya if side == 0 else yb
     px = xv[v, 0]
     py = xv[v, 1]
-    if where(px, py, xo, so, e) > 0:
+    if inside:
         return px, py
     if nc == 0:
         return (acc[4], acc[5]) if acc[3] == 1.0 else (px, py)
@@ -269,14 +330,18 @@ def point_of(ya, sa, yb, sb, e, side, v, cross, nc, acc):
     return qx, qy
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
 def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
     """Row k of the outputs ``out`` = (distance, normal, point, area, centroid, side,
     vertex, edge) for one pair in ``state`` (see the module docstring); ``buffers`` as
-    :func:`geometry_buffers` makes them."""
+    :func:`geometry_buffers` makes them. Returns :data:`GEOMETRY_DONE`, or what to grow
+    (:func:`grown_buffers`) before calling again (row k then unwritten)."""
     dist, normal, point, area, centroid, side, vert, edge = out
     if state == PENETRATING:
-        d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e, buffers)
+        status, d, nx, ny, px, py, a, cx, cy, s, v, f = _penetrating(ya, sa, yb, sb, e,
+                                                                     buffers)
+        if status != GEOMETRY_DONE:
+            return status
         dist[k] = -d
     elif state == CONTACT:
         nx, ny, s, v, f = touch(ya, sa, yb, sb, e)
@@ -317,27 +382,64 @@ def pair_geometry_into(ya, sa, yb, sb, state, e, buffers, out, k):
     side[k] = s
     vert[k] = v
     edge[k] = f
+    return GEOMETRY_DONE
 
 
 @njit(cache=True, nogil=True)
 def geometry_buffers(vmax):
-    """Scratch of :func:`pair_geometry_into` for bodies of up to ``vmax`` vertices."""
+    """Scratch of :func:`pair_geometry_into` for bodies of up to ``vmax`` vertices:
+    those of the depth's search (:func:`polycontact._kernels.convolution.depth_buffers`),
+    of the overlap (:func:`polycontact._kernels.overlap.overlap_scratch`), and of a
+    check of the state kernel (a body moved, the kernel's scratch)."""
     m = min(vmax, FEW_VERTICES)
-    return depth_buffers(m, m), overlap_scratch(vmax, vmax, 8 * vmax + 64)
+    return (depth_buffers(m, m), overlap_scratch(vmax, vmax, 8 * vmax + 64),
+            (np.empty((vmax, 2)), np.empty(scratch_floats(2 * vmax))))
+
+
+@njit(cache=True, nogil=True)
+def grown_buffers(buffers, status, vmax):
+    """``buffers`` (:func:`geometry_buffers`) with the one that ``status`` (of
+    :func:`pair_geometry_into`) names made longer: room for every crossing of two
+    bodies of ``vmax`` vertices, or twice the rows for the depth's pieces."""
+    depth_buf, scratch, check = buffers
+    if status == GEOMETRY_MORE_CROSSINGS:
+        big = vmax * vmax + 1
+        scratch = scratch[:2] + (np.empty((big, 6)), np.empty(big + 2 * vmax + 2)) + \
+            scratch[4:]
+    else:
+        depth_buf = (depth_buf[0], grow_rows(depth_buf[1])) + depth_buf[2:]
+    return depth_buf, scratch, check
 
 
 @njit(cache=True, nogil=True)
 def _geometry_range(rows, pairs, vmax, lmax, k0, k1, out):
     """:func:`pair_geometry` for the pairs ``k0:k1``, into ``out``."""
-    xy, ls, lo, nl = rows
-    pi, pj, states, tols = pairs
     buffers = geometry_buffers(vmax)
     ba = np.empty(lmax + 1, np.int64)
     bb = np.empty(lmax + 1, np.int64)
+    k = k0
+    while k < k1:
+        k, status = geometry_into(rows, pairs, k, k1, out, buffers, ba, bb)
+        if k < k1:
+            buffers = grown_buffers(buffers, status, vmax)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def geometry_into(rows, pairs, k0, k1, out, buffers, ba, bb):
+    """:func:`pair_geometry_into` for the pairs ``k0:k1`` of :func:`pair_geometry`
+    (``rows``, ``pairs`` as there), into ``out``, until one needs a buffer grown:
+    ``(that pair, the status saying which)``, or ``(k1, GEOMETRY_DONE)``; ``buffers``:
+    :func:`geometry_buffers`; ``ba``, ``bb``: room for the two bodies' loop starts. The
+    one compiled copy of the pairs' geometry (its parts are inlined into it)."""
+    xy, ls, lo, nl = rows
+    pi, pj, states, tols = pairs
     for k in range(k0, k1):
         ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
         yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
-        pair_geometry_into(ya, sa, yb, sb, states[k], tols[k], buffers, out, k)
+        status = pair_geometry_into(ya, sa, yb, sb, states[k], tols[k], buffers, out, k)
+        if status != GEOMETRY_DONE:
+            return k, status
+    return k1, GEOMETRY_DONE
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -393,7 +495,8 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
     side, v, f = carrier(xa, sa, xb, sb, dx, dy)
     scratch = overlap_scratch(xa.shape[0], xb.shape[0], xa.shape[0] * xb.shape[0] + 1)
     nc = overlap_moments(xa, sa, xb, sb, e, scratch)[3]
-    px, py = point_of(xa, sa, xb, sb, e, side, v, scratch[2], nc, scratch[4])
+    inside = (scratch[7] if side == 0 else scratch[8])[v] > 0
+    px, py = point_of(xa, xb, side, v, inside, scratch[2], nc, scratch[4])
     nx, ny = normal_of(xa, sa, xb, sb, d, dx, dy, side, f)
     return nx, ny, px, py, side, v, f
 

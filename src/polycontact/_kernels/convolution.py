@@ -37,12 +37,12 @@ takes :func:`polycontact._kernels.depth.depth_from_pieces`.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .packs import scratch_floats, state_scratch_views
-from .primitives import (bbox, grow_rows, loop_next, loop_prev, norm, origin_distance_sq,
+from .primitives import (bbox, edge_rows, grow_rows, loop_prev, norm, origin_distance_sq,
                          origin_foot)
-from .relation import PENETRATING, state_in
+from .relation import PENETRATING, moved_state, state_in, witness_holds
 
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
@@ -60,80 +60,74 @@ _SIN_PARALLEL = 1.0 / 64.0
 _SIN_SLACK = 1e-6
 
 
-@njit(cache=True, nogil=True)
-def _edges_into(x, st, e, nxt):
-    """Each edge's direction and length (rows ``(gx, gy, length)`` of ``e``, edge i from
-    vertex i to the next of its loop) and each vertex's successor (``nxt``)."""
-    for k in range(st.shape[0] - 1):
-        for i in range(st[k], st[k + 1]):
-            j = loop_next(i, st, k)
-            nxt[i] = j
-            e[i, 0] = x[j, 0] - x[i, 0]
-            e[i, 1] = x[j, 1] - x[i, 1]
-            e[i, 2] = np.sqrt(e[i, 0] * e[i, 0] + e[i, 1] * e[i, 1])
-
-
-@njit(cache=True, nogil=True)
-def _add_segments(xv, sv, ev, xe, ee, ne, sign, bound, slack, seg, n, near):
-    """Append the kept segments of the vertices of one body (``xv``, loop starts ``sv``,
-    edges ``ev`` of :func:`_edges_into`) against the edges of the other (``xe``, edges
-    ``ee``, successors ``ne``) nearer than ``bound``: rows ``(x0, y0, x1, y1, squared
-    distance, side, vertex, edge)`` of translations of A; ``sign`` +1 when the vertices
-    are B's (``v − e``, side 1), −1 when they are A's (``e − w``, side 0).
+@njit(cache=True, nogil=True, _nrt=False)
+def _add_segments(v, o, sign, bound, slack, seg, n, near):
+    """Append the kept segments of the vertices of one body against the edges of the
+    other nearer than ``bound``: rows ``(x0, y0, x1, y1, squared distance, side, vertex,
+    edge)`` of translations of A; ``v``, ``o`` the bodies as :func:`contact_depth_of`
+    takes them; ``sign`` +1 when the vertices are B's (``v − e``, side 1), −1 when they
+    are A's (``e − w``, side 0).
 
     Kept: a vertex that may touch the edge (the other body's interior on its left)
     without overlap: convex, and both of its edges on the outer (right) side of the
     edge, each up to :data:`_SIN_SLACK` and ``slack`` (an absolute allowance for the
-    rounding of the coordinates) in the cross products. ``near`` (one entry per vertex
-    of the other body) is scratch.
+    rounding of the coordinates) in the cross products. The segment of vertex p and
+    edge e is nearer than ``bound`` only if p is, so only the vertices within ``bound``
+    of the other body's box, and the edges within it of the vertices' box, are paired.
+    ``near`` (one entry per vertex of both bodies) is scratch. (The lists are made
+    without branches, a row written whether kept or not: the tests' outcomes follow no
+    pattern a branch predictor could learn.)
     """
+    xv, sv, ev, _, (vx0, vx1, vy0, vy1) = v
+    xe, _, ee, ne, (ex0, ex1, ey0, ey1) = o
     b2 = bound * bound
-    # (the segments of vertex i lie in the box of v_i - (the other body's box))
-    ex0, ex1, ey0, ey1 = bbox(xe, xe.shape[0])
-    # only the edges whose boxes come within bound of V's box can hold one: listed in
-    # ``near`` (the rest are farther than bound from every vertex of V)
-    vx0, vx1, vy0, vy1 = bbox(xv, xv.shape[0])
+    # only the edges whose boxes come within bound of V's box can hold one
     m = 0
     for j in range(xe.shape[0]):
-        jj = ne[j]
-        if (min(xe[j, 0], xe[jj, 0]) < vx1 + bound and max(xe[j, 0], xe[jj, 0]) > vx0 - bound
-                and min(xe[j, 1], xe[jj, 1]) < vy1 + bound
-                and max(xe[j, 1], xe[jj, 1]) > vy0 - bound):
-            near[m] = j
-            m += 1
+        near[m] = j
+        m += ((ee[j, 3] < vx1 + bound) & (ee[j, 4] > vx0 - bound) & (ee[j, 5] < vy1 + bound)
+              & (ee[j, 6] > vy0 - bound))
+    # the convex vertices within bound of the other body's box, after them
+    c = m
     for k in range(sv.shape[0] - 1):
         for i in range(sv[k], sv[k + 1]):
+            p = loop_prev(i, sv, k)
             gapx = max(0.0, xv[i, 0] - ex1, ex0 - xv[i, 0])
             gapy = max(0.0, xv[i, 1] - ey1, ey0 - xv[i, 1])
-            if gapx * gapx + gapy * gapy >= b2:
-                continue
-            p = loop_prev(i, sv, k)
             ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
-            vx, vy, lv = ev[i, 0], ev[i, 1], ev[i, 2]
-            if (ux * vy - uy * vx) < -(_SIN_SLACK * lu * lv + slack * (lu + lv)):
-                continue  # reflex: its wedge overlaps any edge it touches
-            for t in range(m):
-                j = near[t]
-                gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
-                if ((gx * vy - gy * vx) > _SIN_SLACK * lg * lv + slack * (lg + lv)
-                        or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
-                    continue
-                jj = ne[j]
-                x0 = sign * (xv[i, 0] - xe[j, 0])
-                y0 = sign * (xv[i, 1] - xe[j, 1])
-                x1 = sign * (xv[i, 0] - xe[jj, 0])
-                y1 = sign * (xv[i, 1] - xe[jj, 1])
-                d = origin_distance_sq(x0, y0, x1, y1)
-                if d < b2:
-                    seg[n, 0] = x0
-                    seg[n, 1] = y0
-                    seg[n, 2] = x1
-                    seg[n, 3] = y1
-                    seg[n, 4] = d
-                    seg[n, 5] = 0.5 + 0.5 * sign
-                    seg[n, 6] = i
-                    seg[n, 7] = j
-                    n += 1
+            wx, wy, lw = ev[i, 0], ev[i, 1], ev[i, 2]
+            near[c] = i
+            near[c + 1] = p
+            c += 2 * ((gapx * gapx + gapy * gapy < b2)
+                      & ((ux * wy - uy * wx) >= -(_SIN_SLACK * lu * lw + slack * (lu + lw))))
+    for r in range(m, c, 2):
+        i = near[r]
+        p = near[r + 1]
+        px = xv[i, 0]
+        py = xv[i, 1]
+        ux, uy, lu = ev[p, 0], ev[p, 1], ev[p, 2]
+        wx, wy, lw = ev[i, 0], ev[i, 1], ev[i, 2]
+        for t in range(m):
+            j = near[t]
+            gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
+            jj = ne[j]
+            x0 = sign * (px - xe[j, 0])
+            y0 = sign * (py - xe[j, 1])
+            x1 = sign * (px - xe[jj, 0])
+            y1 = sign * (py - xe[jj, 1])
+            seg[n, 0] = x0
+            seg[n, 1] = y0
+            seg[n, 2] = x1
+            seg[n, 3] = y1
+            seg[n, 5] = 0.5 + 0.5 * sign
+            seg[n, 6] = i
+            seg[n, 7] = j
+            if ((gx * wy - gy * wx) > _SIN_SLACK * lg * lw + slack * (lg + lw)
+                    or (gx * uy - gy * ux) < -(_SIN_SLACK * lg * lu + slack * (lg + lu))):
+                continue
+            d = origin_distance_sq(x0, y0, x1, y1)
+            seg[n, 4] = d
+            n += d < b2
     return n
 
 
@@ -144,7 +138,7 @@ def _project(px, py, ax, ay, dx, dy, ln2):
     return t, abs((px - ax) * dy - (py - ay) * dx) / np.sqrt(ln2)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _splits(seg, n, s, tol, ts):
     """Parameters in (0, 1) where the other segments meet segment ``s`` or come within
     ``tol`` of it (unsorted, in ``ts``): their count, or -1 when two of them run together
@@ -218,18 +212,27 @@ def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
     return state_in(moved, sa, 1.0, xb, sb, 1.0, eps, views) == PENETRATING
 
 
-@njit(cache=True, nogil=True)
-def _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+@njit(cache=True, nogil=True, _nrt=False)
+def _escapes(a, b, px, py, d, eps, moved, scratch):
     """Whether A moved by p = (px, py), a point at distance d of a contact segment, ends
     the overlap, up to the tolerance: first tried 2 ``eps`` further along p (the bodies
     apart there by about ``eps`` where p makes them touch: the state kernel's cheaper
     case, no touch to look into), then at p itself. Every translation nearer than p
-    having been found to penetrate, either makes p the depth within 2 ``eps``."""
+    having been found to penetrate, either makes p the depth within 2 ``eps``. ``a``,
+    ``b``: the bodies as :func:`contact_depth_of` takes them.
+
+    A penetration found 2 ``eps`` further whose witness (two edges crossing, a vertex
+    inside) holds at p too (:func:`polycontact._kernels.relation.witness_holds`) makes
+    p penetrate: the state kernel is not asked again there."""
     if d > 0.0:
         f = 1.0 + 2.0 * eps / d
-        if not penetrates(xa, sa, xb, sb, px * f, py * f, eps, moved, scratch):
+        got, witness, i, j = moved_state(a, b, px * f, py * f, eps, moved, scratch)
+        if not got:
             return True
-    return not penetrates(xa, sa, xb, sb, px, py, eps, moved, scratch)
+        touch = state_scratch_views(scratch, a[0].shape[0] + b[0].shape[0])[2]
+        if witness_holds(a, b, px, py, eps, witness, i, j, moved, touch):
+            return False
+    return not moved_state(a, b, px, py, eps, moved, scratch)[0]
 
 
 @njit(cache=True, nogil=True)
@@ -274,10 +277,17 @@ def depth_buffers(m, n):
     """Scratch of :func:`contact_depth_into` for bodies of up to ``m`` and ``n``
     vertices: ``(seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near)``."""
     k = 2 * m * n
-    return (np.empty((k, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
-            np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 3)),
-            np.empty(m, np.int64), np.empty((n, 3)), np.empty(n, np.int64),
-            np.empty(max(m, n), np.int64))
+    return (np.empty((k + 1, 8)), np.empty((8 * k + 8, 5)), np.empty(2 * k + 2),
+            np.empty((m, 2)), np.empty(scratch_floats(m + n)), np.empty((m, 7)),
+            np.empty(m, np.int64), np.empty((n, 7)), np.empty(n, np.int64),
+            np.empty(3 * (m + n), np.int64))
+
+
+#: What :func:`contact_depth_of` says of a depth: found, left undecided (the caller's
+#: search over convex sums), or not found for want of rows in its buffer of pieces.
+DEPTH_FOUND = 1
+DEPTH_UNDECIDED = 0
+DEPTH_MORE_ROWS = -1
 
 
 @njit(cache=True, nogil=True)
@@ -290,15 +300,35 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
     lies on, the vertex of one body brought onto the edge of the other (side 0: a vertex
     of A onto an edge of B; 1: a vertex of B onto an edge of A; packed rows of each
     body), or -1, -1, -1 when the escape is ``(bdx, bdy)`` itself."""
-    seg, pts, ts, moved, scratch, ea, nxa, eb, nxb, near = buffers
+    ea, nxa, eb, nxb = buffers[5], buffers[6], buffers[7], buffers[8]
     m = xa.shape[0]
     nb = xb.shape[0]
+    edge_rows(xa, sa, ea, nxa)
+    edge_rows(xb, sb, eb, nxb)
+    a = (xa, sa, ea[:m], nxa[:m], bbox(xa, m))
+    b = (xb, sb, eb[:nb], nxb[:nb], bbox(xb, nb))
+    while True:
+        got = contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers)
+        if got[3] != DEPTH_MORE_ROWS:
+            return got[0], got[1], got[2], got[3] == DEPTH_FOUND, got[4], got[5], got[6]
+        buffers = (buffers[0], grow_rows(buffers[1])) + buffers[2:]
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers):
+    """:func:`contact_depth_into` of the bodies ``a`` = ``(xa, sa, ea, nxa, box)``
+    (packed loops, :func:`polycontact._kernels.primitives.edge_rows` table and
+    successors, bounding box ``(xmin, xmax, ymin, ymax)``) and ``b`` likewise, their
+    tables already built: ``(depth, dx, dy, status, side, vertex, edge)``, ``status``
+    :data:`DEPTH_FOUND`, :data:`DEPTH_UNDECIDED` or :data:`DEPTH_MORE_ROWS` (the buffer
+    of pieces, ``buffers[1]``, too short: nothing found, to be called again with a
+    longer one). Allocates nothing."""
+    seg, pts, ts, moved, scratch, _, _, _, _, near = buffers
+    xa = a[0]
     tol = 4.0 * eps
-    _edges_into(xa, sa, ea[:m], nxa[:m])
-    _edges_into(xb, sb, eb[:nb], nxb[:nb])
-    n = _add_segments(xb, sb, eb[:nb], xa, ea[:m], nxa[:m], 1.0, bound, eps, seg, 0, near)
-    n = _add_segments(xa, sa, ea[:m], xb, eb[:nb], nxb[:nb], -1.0, bound, eps, seg, n, near)
-    moved = moved[:m]
+    n = _add_segments(b, a, 1.0, bound, eps, seg, 0, near)
+    n = _add_segments(a, b, -1.0, bound, eps, seg, n, near)
+    moved = moved[:xa.shape[0]]
     # Segments and pieces are taken in increasing distance (a linear scan each time:
     # a few of each): a segment is split when it is the nearest thing left, each piece
     # then waits for its turn, and the first piece point that escapes is the depth.
@@ -316,8 +346,8 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
             s = q
     if s >= 0 and low <= seg[s, 4] < bound:
         px, py, d = origin_foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
-            return d, px, py, True, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
+        if _escapes(a, b, px, py, d, eps, moved, scratch):
+            return d, px, py, DEPTH_FOUND, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
         pts[0, 0] = d
         pts[0, 1] = px
         pts[0, 2] = py
@@ -337,11 +367,10 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
             k = _splits(seg, n, s, tol, ts)
             seg[s, 4] = -1.0 - seg[s, 4]
             if k < 0:
-                return np.nan, np.nan, np.nan, False, -1, -1, -1
+                return np.nan, np.nan, np.nan, DEPTH_UNDECIDED, -1, -1, -1
             c = _pieces(seg, s, ts, k, bound, pts, c)
             if c < 0:  # (more rows needed)
-                pts = grow_rows(pts)
-                c = _pieces(seg, s, ts, k, bound, pts, -c - 1)
+                return np.nan, np.nan, np.nan, DEPTH_MORE_ROWS, -1, -1, -1
             continue
         if r < 0 or not pts[r, 0] < bound:
             break
@@ -349,15 +378,15 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
         pts[r, 3] = 1.0
         if d < low or _tried(pts, c, r):
             continue  # (known to penetrate; an end shared by several pieces is tried once)
-        if _escapes(xa, sa, xb, sb, px, py, d, eps, moved, scratch):
+        if _escapes(a, b, px, py, d, eps, moved, scratch):
             q = int(pts[r, 4])
-            return d, px, py, True, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
-    if penetrates(xa, sa, xb, sb, bdx, bdy, eps, moved, scratch):
-        return np.nan, np.nan, np.nan, False, -1, -1, -1
-    return bound, bdx, bdy, True, -1, -1, -1
+            return d, px, py, DEPTH_FOUND, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
+    if moved_state(a, b, bdx, bdy, eps, moved, scratch)[0]:
+        return np.nan, np.nan, np.nan, DEPTH_UNDECIDED, -1, -1, -1
+    return bound, bdx, bdy, DEPTH_FOUND, -1, -1, -1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _tried(pts, c, r):
     """Whether another row of ``pts`` holds the point of row r and was tried."""
     for q in range(c):
@@ -366,7 +395,7 @@ def _tried(pts, c, r):
     return False
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _pieces(seg, s, ts, k, bound, pts, c):
     """Append to ``pts`` (from row c) the point nearest the origin of each piece of
     segment ``s`` between the ``k`` split parameters ``ts`` (and 0 and 1), when nearer

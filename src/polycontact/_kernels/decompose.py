@@ -9,8 +9,8 @@ four times the minimum number of convex pieces, and in practice close to it.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import orient
 from .tolerance import tolerance_of
 

@@ -36,14 +36,16 @@ bodies to decompose once (see :func:`polycontact._depth.penetrations`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
+from .cells import segment_grid
 from .convolution import FEW_VERTICES, contact_depth, penetrates
 from .decompose import ring_pieces
 from .minkowski import (GRID, GRID_MIN_SUMS, boxes, clip_edge, frames, in_some_sum, lowest,
-                        sum_index, sum_into)
+                        no_flags, sum_index, sum_into)
 from .packs import scratch_floats
-from .primitives import bbox, origin_distance_sq_framed, origin_foot
+from .primitives import bbox, closest_on_segment, origin_distance_sq_framed, origin_foot
 from .relation_many import body, oriented
 
 
@@ -122,11 +124,12 @@ def _pair_sums(bxy, bstarts, rxy, rstarts, pairs):
     starts = np.empty(pairs.shape[0] + 1, np.int64)
     starts[0] = 0
     w = 0
+    flags = no_flags()
     for k in range(pairs.shape[0]):
         ps = bstarts[pairs[k, 0]]
         pe = bstarts[pairs[k, 0] + 1]
         w = sum_into(bxy, ps, pe, lowest(bxy, ps, pe), rxy, rstarts[pairs[k, 1]],
-                     rstarts[pairs[k, 1] + 1], out, w)
+                     rstarts[pairs[k, 1] + 1], out, w, flags)
         starts[k + 1] = w
     return out[:w].copy(), starts
 
@@ -238,7 +241,7 @@ def _nearest_escape(a, b, pieces_b, pieces_r, escape, eps, max_vertices, grid_fr
     by_dist = near[np.argsort(dist[near])]
     # (the grid, if any, over the disk of the first escape)
     sums = (xy, starts, bb, fr)
-    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, grid_from)
+    index = sum_index(sums, -bound, -bound, 2.0 * bound / GRID, eps, grid_from)
     lo1, hi1, lo0, hi0 = index[-4:]
     hint = deepest
     found = False
@@ -360,6 +363,125 @@ def first_escape(xa, xb):
             bdx = dx
             bdy = dy
     return best, bdx, bdy
+
+
+@njit(cache=True, nogil=True)
+def contacts_near(xa, sa, xb, sb, bound, limit):
+    """A lower bound, before any decomposition, of the vertices of the convex sums that
+    :func:`depth_from_pieces` builds for the escape distance ``bound``, from the
+    vertex–edge contacts that can hold without overlap within ``bound`` of the origin
+    (translations of A); counted until it passes ``limit``.
+
+    A contact of a strictly convex vertex v of one body with an edge e of the other
+    whose direction lies within v's turning cone (reversed: from −u to −w, for v's edges
+    u in and w out) is the segment ``v − e`` (``e − v`` for a vertex of A) of
+    translations. It lies on an edge of the sum of the pieces that hold v and e (a
+    piece's cone at v holds the body's), and comes within ``bound`` of the origin when v
+    comes within ``bound`` of e: that sum's box meets the disk, and the sum is built. A
+    sum edge holds one such segment with e strictly inside the cone, or up to four with
+    e parallel to an edge at v (two parallel edges of the pieces, each with either end
+    of the other), so the sums have at least (strict contacts) + (parallel ones) / 4
+    edges, hence vertices.
+
+    The edges of each body are listed in a grid of cells no narrower than ``bound`` / 2
+    (:func:`polycontact._kernels.cells.segment_grid`) and, in each cell, sorted by
+    direction: a vertex reads the cells within ``bound`` of it and, in each, the edges
+    of its cone only. Costs O((m + n) log(m + n)) plus the contacts counted.
+
+    Examples
+    --------
+    Two overlapping squares: their edges are parallel, a quarter each.
+
+    >>> import numpy as np
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> st = np.array([0, 4])
+    >>> float(contacts_near(sq, st, sq + 0.5, st, 0.6, 100.0))
+    1.0
+    """
+    if not bound > 0.0:
+        return 0.0  # (no disk: bodies that do not overlap have no depth)
+    got = _contacts_of(xb, sb, xa, sa, bound, limit, 0.0)
+    return _contacts_of(xa, sa, xb, sb, bound, limit, got)
+
+
+@njit(cache=True, nogil=True)
+def _contacts_of(xv, sv, xe, se, bound, limit, got):
+    """:func:`contacts_near`'s count for the vertices of one body (``xv``, loops ``sv``)
+    against the edges of the other (``xe``, ``se``), added to ``got``."""
+    ne = xe.shape[0]
+    if ne == 0 or xv.shape[0] == 0 or got > limit:
+        return got
+    # the edges (as the other body gives them) in a grid, each cell's sorted by direction
+    seg = np.empty((ne, 4))
+    ang = np.empty(ne)
+    for k in range(se.shape[0] - 1):
+        for i in range(se[k], se[k + 1]):
+            j = i + 1 if i + 1 < se[k + 1] else se[k]
+            seg[i, 0] = xe[i, 0]
+            seg[i, 1] = xe[i, 1]
+            seg[i, 2] = xe[j, 0]
+            seg[i, 3] = xe[j, 1]
+            ang[i] = np.arctan2(xe[j, 1] - xe[i, 1], xe[j, 0] - xe[i, 0])
+    x0, y0, h, gx, gy, first, items = segment_grid(seg, xe, 0.0, 0.5 * bound)
+    keys = np.empty(items.shape[0])
+    for c in range(gx * gy):
+        cell = items[first[c]:first[c + 1]]
+        cell[:] = cell[np.argsort(ang[cell])]
+        for u in range(first[c], first[c + 1]):
+            keys[u] = ang[items[u]]
+    seen = np.full(ne, -1, np.int64)
+    b2 = bound * bound
+    reach = int(np.ceil(bound / h))
+    for k in range(sv.shape[0] - 1):
+        for i in range(sv[k], sv[k + 1]):
+            p = i - 1 if i > sv[k] else sv[k + 1] - 1
+            q = i + 1 if i + 1 < sv[k + 1] else sv[k]
+            px, py = xv[i, 0], xv[i, 1]
+            ux, uy = px - xv[p, 0], py - xv[p, 1]
+            wx, wy = xv[q, 0] - px, xv[q, 1] - py
+            if not ux * wy - uy * wx > 0.0:
+                continue  # reflex or straight: none counted
+            lo = np.arctan2(-uy, -ux)  # the cone, from -u turning to -w
+            hi = lo + np.arctan2(ux * wy - uy * wx, ux * wx + uy * wy)
+            c0 = max(int(np.floor((px - x0) / h)) - reach, 0)
+            c1 = min(int(np.floor((px - x0) / h)) + reach, gx - 1)
+            r0 = max(int(np.floor((py - y0) / h)) - reach, 0)
+            r1 = min(int(np.floor((py - y0) / h)) + reach, gy - 1)
+            for c in range(c0, c1 + 1):
+                for r in range(r0, r1 + 1):
+                    f0 = first[c * gy + r]
+                    f1 = first[c * gy + r + 1]
+                    for turn in (0.0, 2.0 * np.pi):  # (a cone past pi wraps round)
+                        u = f0 + np.searchsorted(keys[f0:f1], lo - turn)
+                        while u < f1 and keys[u] <= hi - turn:
+                            e = items[u]
+                            u += 1
+                            if seen[e] == i or closest_on_segment(
+                                    px, py, seg[e, 0], seg[e, 1], seg[e, 2], seg[e, 3])[2] >= b2:
+                                continue
+                            seen[e] = i
+                            got += _weight(seg[e, 2] - seg[e, 0], seg[e, 3] - seg[e, 1], ux,
+                                           uy, wx, wy)
+                            if got > limit:
+                                return got
+    return got
+
+
+#: Edges whose directions make a sine below this count as parallel in
+#: :func:`contacts_near` (a quarter each: rounding of their angles must not count a
+#: parallel pair whole).
+_PARALLEL_SINE = 1e-9
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _weight(gx, gy, ux, uy, wx, wy):
+    """A contact's share of a sum edge in :func:`contacts_near`: 1, or 1/4 for an edge
+    (gx, gy) parallel to the vertex's edge in (u) or out (w)."""
+    lg = np.hypot(gx, gy)
+    if (abs(gx * uy - gy * ux) <= _PARALLEL_SINE * lg * np.hypot(ux, uy)
+            or abs(gx * wy - gy * wx) <= _PARALLEL_SINE * lg * np.hypot(wx, wy)):
+        return 0.25
+    return 1.0
 
 
 @njit(cache=True, nogil=True)

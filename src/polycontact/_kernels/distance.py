@@ -10,8 +10,8 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import bbox, closest_on_segment, loop_index, next_vertex, norm, proper_crossing
 
 

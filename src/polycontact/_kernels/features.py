@@ -5,8 +5,8 @@ crossing edges), in the numbering of the packed form.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import bbox, loop_index, next_vertex, orient, point_segment_distance
 from .relation import point_inside
 

@@ -12,9 +12,10 @@ overlapping.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from .minkowski import in_some_sum
+from .jit import njit
+from .cells import listed, polygon_grid, segment_cells, segment_grid
+from .minkowski import GRID_MIN_SUMS, in_some_listed
 from .primitives import append_part
 from .relation import relate_state
 
@@ -72,16 +73,15 @@ def surrounded(px, py, starts, bb, fr, eps, ang_tol):
     (:func:`polycontact._kernels.minkowski.frames`).
     """
     k = starts.shape[0] - 1
-    return _surrounded(px, py, starts, bb, fr, eps, ang_tol, np.empty((2, k)))
+    return _surrounded(px, py, np.arange(k), starts, bb, fr, eps, ang_tol, np.empty((2, k)))
 
 
 @njit(cache=True, nogil=True)
-def _surrounded(px, py, starts, bb, fr, eps, ang_tol, arcs):
-    """:func:`surrounded` with a work array ``arcs`` (2, number of sums), for callers
-    asking about many points."""
-    k = starts.shape[0] - 1
+def _surrounded(px, py, listed, starts, bb, fr, eps, ang_tol, arcs):
+    """:func:`surrounded` among the sums ``listed`` (every sum within eps of p), with a
+    work array ``arcs`` (2, number of sums), for callers asking about many points."""
     n = 0
-    for p in range(k):
+    for p in listed:
         if px < bb[p, 0] - eps or px > bb[p, 2] + eps or py < bb[p, 1] - eps or py > bb[p, 3] + eps:
             continue
         kind, st, ln = _arc_of(px, py, fr, starts[p], starts[p + 1], eps)
@@ -128,6 +128,13 @@ def may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang_tol):
     -sin(ang_tol) for each of them (unit u and v) and s passes here, where the same
     tests tell which sums are near and which edges within eps.
     """
+    return _may_be_surrounded(px, py, vx, vy, np.arange(starts.shape[0] - 1), starts, bb,
+                              fr, eps, ang_tol)
+
+
+@njit(cache=True, nogil=True)
+def _may_be_surrounded(px, py, vx, vy, listed, starts, bb, fr, eps, ang_tol):
+    """:func:`may_be_surrounded` among the sums ``listed`` (every sum within eps of p)."""
     ln = np.hypot(vx, vy)
     if ln > 0.0:
         vx /= ln
@@ -137,7 +144,7 @@ def may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang_tol):
         vy = 0.0
     # (the arcs' angles and these products are rounded: 1e-15 of a turn and a unit)
     slack = 2.0 * ang_tol + 1e-15
-    for q in range(starts.shape[0] - 1):
+    for q in listed:
         if px < bb[q, 0] - eps or px > bb[q, 2] + eps or py < bb[q, 1] - eps or py > bb[q, 3] + eps:
             continue
         enters = True
@@ -151,6 +158,30 @@ def may_be_surrounded(px, py, vx, vy, starts, bb, fr, eps, ang_tol):
         if enters:
             return True
     return False
+
+
+@njit(cache=True, nogil=True)
+def _sums_near(near, ax, ay, bx, by, eps, every, marks):
+    """The sums listed in the cells of the grid ``near``
+    (:func:`polycontact._kernels.cells.polygon_grid`) that the eps-neighbourhood of
+    segment ab meets, each once (``every`` sum when the cells do not fit the buffer);
+    ``marks`` = ``(cells, seen, out)``: buffers, ``seen[k]`` counting the calls."""
+    cells, seen, out = marks
+    nc = segment_cells(near, ax, ay, bx, by, eps, cells)
+    if nc < 0:
+        return every
+    k = seen.shape[0] - 1
+    stamp = seen[k] = seen[k] + 1
+    first, items = near[5], near[6]
+    n = 0
+    for ci in range(nc):
+        for u in range(first[cells[ci]], first[cells[ci] + 1]):
+            q = items[u]
+            if seen[q] != stamp:
+                seen[q] = stamp
+                out[n] = q
+                n += 1
+    return out[:n]
 
 
 @njit(cache=True, nogil=True)
@@ -171,7 +202,16 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
     slides = np.empty((loose.shape[0], 4))
     n_pts = 0
     n_slides = 0
-    arcs = np.empty((2, starts.shape[0] - 1))
+    k = starts.shape[0] - 1
+    arcs = np.empty((2, k))
+    # the sums that may hold a point or pass within eps of it: those listed in its cell
+    # (every sum, for few)
+    every = np.arange(k)
+    grid = k >= GRID_MIN_SUMS and loose.shape[0] > 0
+    near = polygon_grid(xy, starts, bb, eps, xy.shape[0] + 16 * k) if grid else (
+        polygon_grid(xy[:0], starts[:1], bb, eps, 1))
+    marks = (np.empty(3 * (near[3] + near[4]) + 8, np.int64), np.full(k + 1, -1, np.int64),
+             np.empty(k, np.int64))
     ts = np.empty(xy.shape[0] + 2)
     off = 64.0 * eps
     for r in range(loose.shape[0]):
@@ -180,8 +220,10 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
         if ln <= 8.0 * eps:
             mx = 0.5 * (ax + bx)
             my = 0.5 * (ay + by)
-            if may_be_surrounded(mx, my, by - ay, ax - bx, starts, bb, fr, eps, ang_tol) and (
-                    _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs)):
+            there = listed(near, mx, my) if grid else every
+            if _may_be_surrounded(mx, my, by - ay, ax - bx, there, starts, bb, fr, eps,
+                                  ang_tol) and (
+                    _surrounded(mx, my, there, starts, bb, fr, eps, ang_tol, arcs)):
                 pts[n_pts, 0] = mx
                 pts[n_pts, 1] = my
                 n_pts += 1
@@ -196,7 +238,7 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
         x1 = max(ax, bx) + eps
         y0 = min(ay, by) - eps
         y1 = max(ay, by) + eps
-        for q in range(starts.shape[0] - 1):
+        for q in _sums_near(near, ax, ay, bx, by, eps, every, marks) if grid else every:
             if bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
                 continue
             for v in range(starts[q], starts[q + 1]):
@@ -222,8 +264,12 @@ def degenerate_contacts(xy, starts, bb, fr, loose, eps, ang_tol):
             tm = 0.5 * (t0 + t1)
             mx = ax + tm * ux
             my = ay + tm * uy
-            inside = (in_some_sum(mx + off * uy, my - off * ux, starts, bb, fr, -1.0, -1)
-                      and _surrounded(mx, my, starts, bb, fr, eps, ang_tol, arcs))
+            qx = mx + off * uy
+            qy = my - off * ux
+            inside = (in_some_listed(qx, qy, listed(near, qx, qy) if grid else every, starts,
+                                     bb, fr, -1.0, -1)
+                      and _surrounded(mx, my, listed(near, mx, my) if grid else every, starts,
+                                      bb, fr, eps, ang_tol, arcs))
             if inside and open_at < 0.0:
                 open_at = t0
             if not inside and open_at >= 0.0:
@@ -243,24 +289,55 @@ def snap(points, along, xy, starts, tol):
     Each point goes to the nearest vertex of the sums within ``tol``; else to the
     nearest crossing within ``tol`` of a line through it with a sum edge passing within
     ``tol``: the line along ``along[k]`` (a slide's direction) or, where that is zero
-    (an exact fit), the line of the nearest such edge. Points with neither stay.
+    (an exact fit), the line of the nearest such edge. Points with neither stay. Ties
+    go to the last vertex or edge in the sums' order. The vertices and edges near each
+    point are read from a grid of cells (:mod:`polycontact._kernels.cells`), so the cost
+    follows the points and the sums' edges, not their product.
     """
     out = points.copy()
     nv = xy.shape[0]
+    if points.shape[0] == 0 or nv == 0:
+        return out
     nxt = np.empty(nv, np.int64)
     for k in range(starts.shape[0] - 1):
         for i in range(starts[k], starts[k + 1]):
             nxt[i] = i + 1 if i + 1 < starts[k + 1] else starts[k]
+    # the vertices (each a segment of length 0, numbered i), then the edges (nv + i),
+    # that reach the points' box; listed in the cells within twice tol (the rounding
+    # of the cells' bounds is far below it)
+    x0 = points[:, 0].min() - tol
+    x1 = points[:, 0].max() + tol
+    y0 = points[:, 1].min() - tol
+    y1 = points[:, 1].max() + tol
+    reach = np.empty(2 * nv, np.bool_)
+    for s in range(2 * nv):
+        i = s if s < nv else s - nv
+        j = i if s < nv else nxt[i]
+        reach[s] = not (max(xy[i, 0], xy[j, 0]) < x0 or min(xy[i, 0], xy[j, 0]) > x1
+                        or max(xy[i, 1], xy[j, 1]) < y0 or min(xy[i, 1], xy[j, 1]) > y1)
+    ids = np.flatnonzero(reach)
+    seg = np.empty((ids.shape[0], 4))
+    for n in range(ids.shape[0]):
+        i = ids[n] if ids[n] < nv else ids[n] - nv
+        j = i if ids[n] < nv else nxt[i]
+        seg[n, 0] = xy[i, 0]
+        seg[n, 1] = xy[i, 1]
+        seg[n, 2] = xy[j, 0]
+        seg[n, 3] = xy[j, 1]
+    grid = segment_grid(seg, points, 2.0 * tol)
     for k in range(points.shape[0]):
         px = points[k, 0]
         py = points[k, 1]
+        near = ids[listed(grid, px, py)]  # vertices (< nv), then edges (nv + i)
         best = tol
         bi = -1
-        for i in range(nv):
-            d = np.hypot(xy[i, 0] - px, xy[i, 1] - py)
+        for s in near:
+            if s >= nv:
+                break
+            d = np.hypot(xy[s, 0] - px, xy[s, 1] - py)
             if d <= best:
                 best = d
-                bi = i
+                bi = s
         if bi >= 0:
             out[k, 0] = xy[bi, 0]
             out[k, 1] = xy[bi, 1]
@@ -268,7 +345,10 @@ def snap(points, along, xy, starts, tol):
         # the edge nearest to p, among those within tol
         near_e = -1
         near_d = tol
-        for i in range(nv):
+        for s in near:
+            if s < nv:
+                continue
+            i = s - nv
             j = nxt[i]
             ux = xy[j, 0] - xy[i, 0]
             uy = xy[j, 1] - xy[i, 1]
@@ -296,7 +376,10 @@ def snap(points, along, xy, starts, tol):
         ax_ /= la
         ay_ /= la
         best = tol
-        for i in range(nv):
+        for s in near:
+            if s < nv:
+                continue
+            i = s - nv
             j = nxt[i]
             ux = xy[j, 0] - xy[i, 0]
             uy = xy[j, 1] - xy[i, 1]
@@ -311,9 +394,9 @@ def snap(points, along, xy, starts, tol):
             den = ax_ * wy - ay_ * wx
             if abs(den) < 1e-6:
                 continue
-            s = ((xy[i, 0] - bx_) * wy - (xy[i, 1] - by_) * wx) / den
-            qx = bx_ + s * ax_
-            qy = by_ + s * ay_
+            s_ = ((xy[i, 0] - bx_) * wy - (xy[i, 1] - by_) * wx) / den
+            qx = bx_ + s_ * ax_
+            qy = by_ + s_ * ay_
             d = np.hypot(qx - px, qy - py)
             if d <= best:
                 best = d

@@ -23,8 +23,8 @@ Status codes returned by the searches (see :class:`polycontact.ImpactStatus`):
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .advance import STACK_SIZE, edge_table, line_time, pair_step, window_kinematics
 from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
 from .packs import scratch_floats, state_scratch_views, vector, view
@@ -159,6 +159,40 @@ def speed_bound(ma, la, mb, lb, t0, t1):
     """
     kin = window_kinematics(ma, mb, t0, t1)[2]
     return kin[3] + kin[4] * la + kin[5] * lb
+
+
+@njit(cache=True, nogil=True)
+def fixed_relative_pose(ca, ma, la, cb, mb, lb, ulps):
+    """Whether B keeps its pose in A's frame over any window (up to the rounding of the
+    coordinates): then no motion can bring the bodies closer or apart, and the state at
+    t = 0 holds throughout.
+
+    B seen from A is ``R(−θ_A)(c_B − c_A) + R(θ_B − θ_A) r``: constant when the bodies
+    turn alike (equal ω and α: the relative rotation is constant), their centroids
+    translate alike (equal velocity and acceleration: ``Δ = c_B − c_A`` is constant) and
+    either they do not turn or ``R(−θ_A) Δ`` stays put, i.e. they turn about one centre
+    (``Δ = 0``; a polynomial ``Δ`` of constant norm is constant, so no other
+    translation keeps it). Centroids closer than the rounding of the coordinates
+    (``ulps`` times the larger reach at t = 0, the float-spacing term of the distance
+    tolerance) count as one centre: B then moves by at most twice that in A's frame,
+    less than the rounding of placing either body.
+
+    >>> import numpy as np
+    >>> spin = np.array([1.0, 0.0, 0.0, 0.0, 3.0, 0.0])
+    >>> c = np.zeros(2)
+    >>> fixed_relative_pose(c, spin, 1.0, c, spin.copy(), 2.0, 64 * 2.0**-52)
+    True
+    >>> fixed_relative_pose(c, spin, 1.0, c + 0.5, spin.copy(), 2.0, 64 * 2.0**-52)
+    False
+    """
+    for k in range(6):
+        if ma[k] != mb[k]:
+            return False
+    if ma[4] == 0.0 and ma[5] == 0.0:
+        return True
+    gap = np.hypot(cb[0] - ca[0], cb[1] - ca[1])
+    reach = max(_reach(ca, ma, la, 0.0, 0.0), _reach(cb, mb, lb, 0.0, 0.0))
+    return 2.0 * gap <= ulps * reach
 
 
 #: The pair steps of :func:`pair_step` stop this fraction of the contact resolution
@@ -425,6 +459,10 @@ def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
     h_prev = np.inf
     it = 0
     t = 0.0
+    # B fixed in A's frame (identical motions, or a common spin about one centre): the
+    # relative speed is zero, however fast each body moves, and the state at t = 0
+    # holds over every interval
+    still = fixed_relative_pose(ca, ma, la, cb, mb, lb, ulps)
     for k in range(intervals.shape[0]):
         t1 = intervals[k, 0]
         t2 = intervals[k, 1]
@@ -443,7 +481,7 @@ def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
                 return OUT_OF_ITERATIONS, -1.0, -1.0, first_contact, it, t
             # (never past where the tolerances would stop being those of t)
             t_end = min(t2, t + window, local_end(ca, ma, la, cb, mb, lb, t))
-            s = speed_bound(ma, la, mb, lb, t, t_end)
+            s = 0.0 if still else speed_bound(ma, la, mb, lb, t, t_end)
             tol = effective_time_tolerance(time_tol, t)
             # tolerances local to the window; a probe moves t by at least a float, which
             # moves the points by up to s times that: the resolution covers it
@@ -549,24 +587,27 @@ def tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps):
 
 
 @njit(cache=True, nogil=True)
-def sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps):
+def sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, max_iter):
     """The paper's §3 steps 3–6 on each interval, literally (``a``, ``ma``, ``b``,
-    ``mb``, ``intervals``: as for :func:`exact_search`).
+    ``mb``, ``intervals``: as for :func:`exact_search`), at most ``max_iter``
+    classifications.
 
     n time points t_1 = T1, ..., t_n = T2 (spacing (T2 − T1)/(n − 1)); t0 is the first
     penetrating one; the next interval is [t0 − (T2 − T1)/n, t0]; stop when
     T2 − T1 < threshold (or the interval is a single float) and report T2. Each sample
     is classified with the distance tolerance at its time (:func:`local_tolerances`).
     Returns ``(status, t_hi, t_lo, first_contact, evaluations)``; ``first_contact`` is
-    the earliest sample in contact (−1 if none).
+    the earliest sample in contact (−1 if none); the status is ``OUT_OF_ITERATIONS``
+    (no verdict, ``t_lo`` the sample it stopped at) when the budget is spent first.
     """
     _, _, placed, _ = _work_views(np.empty(work_floats(a[0].shape[0] + b[0].shape[0])),
                                   a[0].shape[0], b[0].shape[0])
-    return _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, placed)
+    return _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, max_iter,
+                           placed)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, placed):
+def _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, max_iter, placed):
     """:func:`sampled_search` with its buffers passed in (see :func:`_exact_search`)."""
     ca, la = a[2], a[3]
     cb, lb = b[2], b[3]
@@ -587,6 +628,9 @@ def _sampled_search(a, ma, b, mb, intervals, threshold, n, eps_rel, ulps, placed
             for i in range(n):
                 t = hi if i == n - 1 else lo + i * (hi - lo) / (n - 1)
                 evals += 1
+                if evals > max_iter:
+                    # (the samples before t were classified: t is how far it got)
+                    return OUT_OF_ITERATIONS, -1.0, t, first_contact, evals
                 st = state_at(a, ma, b, mb, t,
                               tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps), placed)
                 if st == 1 and (first_contact < 0.0 or t < first_contact):
@@ -617,7 +661,7 @@ def exact_query(a, ea, ma, b, eb, mb, query, work):
     ``query`` is ``(t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, samples)``:
     the window [0, t_max], the broad phase's relative inflation of the radii, the time
     tolerance, the terms of the distance tolerance, the contact resolution and the
-    iteration budget of the exact search, the samples of the sampled one (unused here).
+    iteration budget of the search, the samples of the sampled one (unused here).
     Returns ``(n, status, t_hi, t_lo, first_contact, iterations, t_reached)``, the n
     broad-phase intervals in ``work[:2 n]`` as (start, end) pairs."""
     t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, _ = query
@@ -698,14 +742,16 @@ def exact_call(fa, ia, ma, fb, ib, mb, t_max, inflate, time_tol, eps_rel, ulps, 
 def sampled_query(a, ma, b, mb, query, work):
     """Broad phase and :func:`sampled_search` with ``samples`` points in one call (``a``,
     ``ma``, ``b``, ``mb``: as for :func:`exact_search`; ``query``: as for
-    :func:`exact_query`); returns what :func:`exact_query` does (``iterations``: the
-    classifications; ``t_reached``: t_hi on a hit, else t_max), with its buffers in
-    ``work`` as there."""
-    t_max, inflate, time_tol, eps_rel, ulps, _, _, samples = query
+    :func:`exact_query`, its ``max_iter`` the budget of classifications); returns
+    what :func:`exact_query` does (``iterations``: the classifications;
+    ``t_reached``: t_hi on a hit, the sample it stopped at when out of iterations, else
+    t_max), with its buffers in ``work`` as there."""
+    t_max, inflate, time_tol, eps_rel, ulps, _, max_iter, samples = query
     ra, _, ca, la = a
     rb, _, cb, lb = b
     iv, bw, placed, _ = _work_views(work, ra.shape[0], rb.shape[0])
     n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
     code, hi, lo, contact, its = _sampled_search(a, ma, b, mb, iv[:n], time_tol, samples,
-                                                 eps_rel, ulps, placed)
-    return n, code, hi, lo, contact, its, hi if code == HIT else t_max
+                                                 eps_rel, ulps, max_iter, placed)
+    reached = hi if code == HIT else (lo if code == OUT_OF_ITERATIONS else t_max)
+    return n, code, hi, lo, contact, its, reached

@@ -10,7 +10,11 @@ sorted by x, and a grid whose cells remember the sums that contain them whole).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
+
+from .cells import in_grid, polygon_grid, segment_cells
+from .reduced import admits, piece_cones
 
 
 @njit(cache=True, nogil=True)
@@ -24,11 +28,22 @@ def lowest(xy, s, e):
 
 
 @njit(cache=True, nogil=True)
-def sum_into(bxy, ps, pe, i0, rxy, qs, qe, out, w):
+def sum_into(bxy, ps, pe, i0, rxy, qs, qe, out, w, reduced):
     """Write the Minkowski sum of the convex CCW pieces ``bxy[ps:pe]`` (lowest vertex
     ``i0``) and ``rxy[qs:qe]`` into ``out`` from row ``w``, counter-clockwise from the
     sum of their lowest vertices, by merging their edges by angle (O(p + q)); returns
-    the next free row."""
+    the next free row.
+
+    ``reduced`` = ``(keep, b_pieces, r_pieces)``: when ``keep`` has rows, ``keep[k]``
+    is set for each sum edge written (from row k to the next) to whether it lies on the
+    reduced convolution (:mod:`polycontact._kernels.reduced`), from the
+    :func:`polycontact._kernels.reduced.piece_cones` of both sets of pieces; an edge
+    that is a vertex of one piece plus an edge of the other is on it when that edge is
+    on its body's boundary and its direction is admitted by the vertex's cone; an edge
+    made of two parallel ones, when either is, at either end of the other.
+    """
+    keep, (bbd, bcone), (rbd, rcone) = reduced
+    flags = keep.shape[0] > 0
     n = pe - ps
     m = qe - qs
     j0 = lowest(rxy, qs, qe)
@@ -40,23 +55,44 @@ def sum_into(bxy, ps, pe, i0, rxy, qs, qe, out, w):
         out[w, 0] = bxy[pi, 0] + rxy[qj, 0]
         out[w, 1] = bxy[pi, 1] + rxy[qj, 1]
         w += 1
-        if i == n:
-            j += 1
-            continue
-        if j == m:
-            i += 1
-            continue
         pn = ps + (i0 - ps + i + 1) % n
         qn = qs + (j0 - qs + j + 1) % m
-        c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
-            bxy[pn, 1] - bxy[pi, 1]
-        ) * (rxy[qn, 0] - rxy[qj, 0])
+        if i == n:
+            c = -1.0  # (only R's edges left)
+        elif j == m:
+            c = 1.0  # (only B's)
+        else:
+            c = (bxy[pn, 0] - bxy[pi, 0]) * (rxy[qn, 1] - rxy[qj, 1]) - (
+                bxy[pn, 1] - bxy[pi, 1]
+            ) * (rxy[qn, 0] - rxy[qj, 0])
         # (a NaN turn, from non-finite input, advances both: the loop always ends)
-        if not c < 0.0:
+        b_edge = not c < 0.0
+        r_edge = not c > 0.0
+        if flags:
+            # (parallel edges, both advancing: each edge may pair with either end of
+            # the other, the vertex it leaves or the one it reaches)
+            both = b_edge and r_edge
+            bdx = bxy[pn, 0] - bxy[pi, 0]
+            bdy = bxy[pn, 1] - bxy[pi, 1]
+            rdx = rxy[qn, 0] - rxy[qj, 0]
+            rdy = rxy[qn, 1] - rxy[qj, 1]
+            keep[w - 1] = (
+                (b_edge and bbd[pi] and (admits(rcone, qj, bdx, bdy)
+                                         or (both and admits(rcone, qn, bdx, bdy))))
+                or (r_edge and rbd[qj] and (admits(bcone, pi, rdx, rdy)
+                                            or (both and admits(bcone, pn, rdx, rdy)))))
+        if b_edge:
             i += 1
-        if not c > 0.0:
+        if r_edge:
             j += 1
     return w
+
+
+@njit(cache=True, nogil=True)
+def no_flags():
+    """The ``reduced`` argument of :func:`sum_into` that asks for no flags."""
+    none = (np.zeros(0, np.bool_), np.zeros((0, 5)))
+    return np.zeros(0, np.bool_), none, none
 
 
 @njit(cache=True, nogil=True)
@@ -64,13 +100,16 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
     """Minkowski sums of every pair of convex CCW pieces, in O(p + q) each.
 
     ``(bxy, bstarts)`` and ``(rxy, rstarts)`` are packed convex pieces (B's and the
-    reflected A's). Returns packed sums ``(xy, starts)``, counter-clockwise, ordered
-    with the pieces of B outermost.
+    reflected A's). Returns packed sums ``(xy, starts, keep)``, counter-clockwise,
+    ordered with the pieces of B outermost; ``keep[k]``: whether the edge from row k
+    (to the next of its sum) lies on the reduced convolution (see :func:`sum_into`).
     """
     nb = bstarts.shape[0] - 1
     nr = rstarts.shape[0] - 1
     total = nr * bxy.shape[0] + nb * rxy.shape[0]
     out = np.empty((total, 2))
+    keep = np.empty(max(total, 1), np.bool_)
+    reduced = (keep, piece_cones(bxy, bstarts), piece_cones(rxy, rstarts))
     starts = np.empty(nb * nr + 1, np.int64)
     starts[0] = 0
     w = 0
@@ -80,10 +119,10 @@ def convex_sums(bxy, bstarts, rxy, rstarts):
         pe = bstarts[bi + 1]
         i0 = lowest(bxy, ps, pe)
         for rj in range(nr):
-            w = sum_into(bxy, ps, pe, i0, rxy, rstarts[rj], rstarts[rj + 1], out, w)
+            w = sum_into(bxy, ps, pe, i0, rxy, rstarts[rj], rstarts[rj + 1], out, w, reduced)
             k += 1
             starts[k] = w
-    return out[:w], starts
+    return out[:w], starts, keep[:w]
 
 
 @njit(cache=True, nogil=True)
@@ -101,9 +140,18 @@ def boxes(xy, starts):
     return bb
 
 
+#: Column 3 of :func:`frames`: an edge of zero length (no line), an edge, and an edge
+#: off the reduced convolution (:func:`mark_inner`: it bounds its sum like any other but
+#: cannot lie on the outline of the union).
+ZERO_LENGTH = 0.0
+EDGE = 1.0
+INNER_EDGE = 2.0
+
+
 @njit(cache=True, nogil=True)
 def frames(xy, starts):
-    """Per edge of packed loops: unit direction (ux, uy), offset c, and 1 if not zero-length.
+    """Per edge of packed loops: unit direction (ux, uy), offset c, and ``EDGE`` (1) if
+    not zero-length (``ZERO_LENGTH``, 0, and no line, if it is).
 
     The signed distance of p from edge i's line (positive on its left) is
     ``ux * py - uy * px - c``.
@@ -123,8 +171,17 @@ def frames(xy, starts):
                 fr[i, 0] = ux
                 fr[i, 1] = uy
                 fr[i, 2] = ux * xy[i, 1] - uy * xy[i, 0]
-                fr[i, 3] = 1.0
+                fr[i, 3] = EDGE
     return fr
+
+
+@njit(cache=True, nogil=True)
+def mark_inner(fr, keep):
+    """Mark in the frames ``fr`` (:func:`frames`, in place) the edges off the reduced
+    convolution (``keep`` False, see :func:`convex_sums`) as ``INNER_EDGE``."""
+    for i in range(fr.shape[0]):
+        if fr[i, 3] != ZERO_LENGTH and not keep[i]:
+            fr[i, 3] = INNER_EDGE
 
 
 @njit(cache=True, nogil=True)
@@ -136,9 +193,16 @@ def in_some_sum(px, py, starts, bb, fr, margin, skip):
     inner side by more than it, and likewise of the box). ``margin`` < 0: in a closed
     sum, with no tolerance (for points that the caller puts well inside or outside).
     """
+    return in_some_listed(px, py, np.arange(starts.shape[0] - 1), starts, bb, fr, margin,
+                          skip)
+
+
+@njit(cache=True, nogil=True)
+def in_some_listed(px, py, listed, starts, bb, fr, margin, skip):
+    """:func:`in_some_sum` among the sums ``listed`` only (every sum that may hold p)."""
     closed = margin < 0.0
     m = 0.0 if closed else margin
-    for q in range(starts.shape[0] - 1):
+    for q in listed:
         if q == skip:
             continue
         x0 = bb[q, 0] + m
@@ -162,23 +226,62 @@ def in_some_sum(px, py, starts, bb, fr, margin, skip):
     return False
 
 
-@njit(cache=True, nogil=True)
-def _clip(ax, ay, bx, by, fr, s, e, q_first, eps):
-    """Parts of segment ab (parameter t in [0, 1]) covered by convex polygon s:e.
+#: Polygons of more edges than this are clipped from the edge facing the segment
+#: (:func:`_facing`): finding it costs a binary search.
+_FACING_FROM = 16
 
-    ``fr`` holds the edge frames of :func:`frames`. Returns ``(lo1, hi1, lo0, hi0)``:
-    the open interval inside the polygon by more than eps (empty when lo >= hi), and the
+
+@njit(cache=True, nogil=True)
+def _facing(mx, my, xy, s, e):
+    """An edge of the convex CCW polygon ``xy[s:e]`` whose line has the point m on its
+    outer side when m lies outside near it: the edge closing the fan triangle from
+    vertex s that holds m's direction (found by bisection), or an edge at vertex s when
+    m lies outside the polygon's angle there."""
+    ox = xy[s, 0]
+    oy = xy[s, 1]
+    wx = mx - ox
+    wy = my - oy
+    if (xy[s + 1, 0] - ox) * wy - (xy[s + 1, 1] - oy) * wx < 0.0:
+        return s  # right of the first edge's line
+    lo = s + 1
+    hi = e - 1
+    while lo < hi:  # the last ray from vertex s with m on its left
+        mid = (lo + hi + 1) // 2
+        if (xy[mid, 0] - ox) * wy - (xy[mid, 1] - oy) * wx >= 0.0:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo  # (e - 1: the edge back to vertex s)
+
+
+@njit(cache=True, nogil=True)
+def _clip(ax, ay, bx, by, xy, fr, s, e, q_first, eps):
+    """Parts of segment ab (parameter t in [0, 1]) covered by convex polygon
+    ``xy[s:e]``.
+
+    ``fr`` holds the edge frames of :func:`frames`. Returns
+    ``(lo1, hi1, lo0, hi0)``: the open interval inside the polygon by more than eps
+    (empty when lo >= hi), and the
     interval to remove from the union's outline: strictly inside, or along a collinear
     edge of the polygon that runs the other way (a seam between two sums) or the same
     way when the polygon comes first (``q_first``; the duplicate outline edge is kept
-    once).
+    once) and that edge is not an ``INNER_EDGE`` (which is never kept itself).
     """
-    lo1 = -np.inf
-    hi1 = np.inf
-    lo0 = -np.inf
-    hi0 = np.inf
+    # (intervals within (-1, 2), which holds the segment: an edge's line cutting the
+    # segment's line beyond it then empties them at once; the intervals do not depend
+    # on the order of the edges, and a long polygon's are taken from the one facing the
+    # segment, which ends the loop soonest when the segment lies outside)
+    lo1 = -1.0
+    hi1 = 2.0
+    lo0 = -1.0
+    hi0 = 2.0
     empty0 = False
-    for i in range(s, e):
+    first = s if e - s <= _FACING_FROM else _facing(0.5 * (ax + bx), 0.5 * (ay + by), xy,
+                                                    s, e)
+    for k in range(s, e):
+        i = first + k - s
+        if i >= e:
+            i -= e - s
         if fr[i, 3] == 0.0:
             continue
         ux = fr[i, 0]
@@ -199,7 +302,7 @@ def _clip(ax, ay, bx, by, fr, s, e, q_first, eps):
         # outline: margin 0, collinear edges handled apart
         if abs(f0) <= eps and abs(f1) <= eps:
             same = ux * (bx - ax) + uy * (by - ay) > 0.0
-            if same and not q_first:
+            if same and not (q_first and fr[i, 3] == EDGE):
                 empty0 = True
         elif df == 0.0:
             if f0 <= 0.0:
@@ -299,14 +402,17 @@ GRID_MIN_SUMS = 256
 
 
 @njit(cache=True, nogil=True)
-def sum_index(sums, gx0, gy0, h, grid_from=GRID_MIN_SUMS):
+def sum_index(sums, gx0, gy0, h, eps, grid_from=GRID_MIN_SUMS):
     """What :func:`clip_edge` reads to clip edges by the convex ``sums``, ``(xy, starts,
     bb, fr)`` (the packed sums, their boxes and edge frames): the sums sorted by their
     smallest x (``by_x``, ``xs``) and their widest box (``wmax``); a ``GRID`` x ``GRID``
     grid of cells of side ``h`` from ``(gx0, gy0)`` with the sums containing each cell
-    whole (:func:`_cell_cover`), or no grid (0 x 0) for fewer than ``grid_from`` sums
-    (the same clips, found by the scan alone), and a buffer of the sums tried on an
-    edge; the four interval buffers of the clipped parts."""
+    whole (:func:`_cell_cover`), and a grid listing the sums that come within ``eps`` of
+    each of its cells (:func:`polycontact._kernels.cells.polygon_grid`, about as many
+    entries as the sums have vertices), or neither (0 x 0) for fewer than ``grid_from``
+    sums (the same clips, found by the scan alone); a buffer of the sums tried on an
+    edge and one of cells, with a mark per sum; the four interval buffers of the
+    clipped parts."""
     xy, starts, bb, fr = sums
     k = starts.shape[0] - 1
     by_x = np.argsort(bb[:, 0])
@@ -317,19 +423,48 @@ def sum_index(sums, gx0, gy0, h, grid_from=GRID_MIN_SUMS):
     g = GRID if k >= grid_from else 0
     cover = _cell_cover(xy, starts, bb, fr, gx0, gy0, h, g)
     tried = np.full(_PER_CELL * (g + 2) * 4 + 4, -1, np.int64)
+    near = polygon_grid(xy, starts, bb, eps, xy.shape[0] + 16 * k) if g else (
+        polygon_grid(xy[:0], starts[:1], bb, eps, 1))
+    # (cells along an edge, and per sum the last edge that tried it)
+    marks = (np.empty(3 * (near[3] + near[4]) + 8, np.int64), np.full(k + 1, -1, np.int64))
     cap = 2 * k + 4
-    return (by_x, xs, wmax, cover, gx0, gy0, h, tried,
+    return (by_x, xs, wmax, cover, gx0, gy0, h, tried, near, marks,
             np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap))
 
 
+@njit(cache=True, nogil=True)
+def clip_tests(sums, index, eps):
+    """An upper bound, known before any clipping, of the tests of an edge against a sum
+    that :func:`clip_edge` makes over every ``EDGE`` of the ``sums`` (``(xy, starts,
+    bb, fr)``), reading ``index`` (:func:`sum_index`): the sums listed in the cells
+    along each edge (the cover grid's and the hint's are among them); 0 without a grid,
+    for few sums. Costs the cells along the edges, no clipping."""
+    xy, starts, _, fr = sums
+    near, marks = index[8], index[9]
+    if index[3].shape[0] == 0:
+        return 0
+    cells = marks[0]
+    first = near[5]
+    total = 0
+    for p in range(starts.shape[0] - 1):
+        for i in range(starts[p], starts[p + 1]):
+            if fr[i, 3] != EDGE:
+                continue
+            j = i + 1 if i + 1 < starts[p + 1] else starts[p]
+            nc = segment_cells(near, xy[i, 0], xy[i, 1], xy[j, 0], xy[j, 1], eps, cells)
+            for c in range(nc):
+                total += first[cells[c] + 1] - first[cells[c]]
+    return total
+
+
 @njit(cache=True, nogil=True, inline="always")
-def _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0):
+def _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0):
     """Take from the parts of edge (a, b) of sum p what sum q covers: of ``parts`` =
     ``(lo1, hi1, lo0, hi0)``, from ``lo1[:n1], hi1[:n1]`` its closed interior shrunk by
     eps, from ``lo0[:n0], hi0[:n0]`` its open interior (see :func:`_clip`); returns the
     new ``(n1, n0)``."""
     lo1, hi1, lo0, hi0 = parts
-    a1, b1, a0, b0 = _clip(ax, ay, bx, by, fr, starts[q], starts[q + 1], q < p, eps)
+    a1, b1, a0, b0 = _clip(ax, ay, bx, by, xy, fr, starts[q], starts[q + 1], q < p, eps)
     if a1 < b1 and n1 > 0:
         n1 = _compact(lo1, hi1, _subtract(lo1, hi1, n1, a1, b1))
     if a0 < b0 and n0 > 0:
@@ -348,11 +483,12 @@ def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
 
     The sums covering whole cells along the edge are tried first, then ``hint`` (the
     sum that covered the previous edge: an edge inside the union is then usually done
-    after one test), then the others by their smallest x, from the first that can reach
-    the edge (none is wider than ``wmax``).
+    after one test), then the others: those listed in the cells along the part (each
+    once), or without that grid by their smallest x, from the first that can reach the
+    edge (none is wider than ``wmax``).
     """
-    _, starts, bb, fr = sums
-    by_x, xs, wmax, cover, gx0, gy0, h, tried, lo1, hi1, lo0, hi0 = index
+    xy, starts, bb, fr = sums
+    by_x, xs, wmax, cover, gx0, gy0, h, tried, near, marks, lo1, hi1, lo0, hi0 = index
     parts = (lo1, hi1, lo0, hi0)
     k = starts.shape[0] - 1
     lo1[0] = t0
@@ -384,13 +520,48 @@ def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
                 continue
             tried[nt] = q
             nt += 1
-            n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0)
+            n1, n0 = _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0)
             if n1 == 0 and n0 == 0:
                 return n1, n0, hint
     x0 = min(ax, bx) - eps
     x1 = max(ax, bx) + eps
     y0 = min(ay, by) - eps
     y1 = max(ay, by) + eps
+    if g > 0:
+        # the sums listed in the cells along the part clipped: those within eps of it
+        pax = ax + t0 * (bx - ax)
+        pay = ay + t0 * (by - ay)
+        pbx = ax + t1 * (bx - ax)
+        pby = ay + t1 * (by - ay)
+        cells, seen = marks
+        nc = -1
+        if in_grid(near, pax, pay) and in_grid(near, pbx, pby):
+            nc = segment_cells(near, pax, pay, pbx, pby, eps, cells)
+        if nc >= 0:
+            stamp = seen[k] = seen[k] + 1  # (this edge's mark)
+            for v in range(nt):
+                seen[tried[v]] = stamp
+            if hint >= 0:
+                if hint != p:
+                    n1, n0 = _cut(ax, ay, bx, by, xy, fr, starts, hint, p, eps, parts, n1,
+                                  n0)
+                    if n1 == 0 and n0 == 0:
+                        return n1, n0, hint
+                seen[hint] = stamp
+            first, items = near[5], near[6]
+            for ci in range(nc):
+                cell = cells[ci]
+                for u in range(first[cell], first[cell + 1]):
+                    q = items[u]
+                    if q == p or seen[q] == stamp:
+                        continue
+                    seen[q] = stamp
+                    if bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
+                        continue
+                    n1, n0 = _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0)
+                    if n1 == 0 and n0 == 0:
+                        return n1, n0, q
+            return n1, n0, hint
     first = np.searchsorted(xs, x0 - wmax)
     for qi in range(first - 1, k):
         q = hint if qi < first else by_x[qi]
@@ -400,7 +571,7 @@ def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
             continue
         if q == p or bb[q, 0] > x1 or bb[q, 2] < x0 or bb[q, 1] > y1 or bb[q, 3] < y0:
             continue
-        n1, n0 = _cut(ax, ay, bx, by, fr, starts, q, p, eps, parts, n1, n0)
+        n1, n0 = _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0)
         if n1 == 0 and n0 == 0:
             return n1, n0, q
     return n1, n0, hint

@@ -11,18 +11,18 @@ are ``int(E) \\ O`` (:mod:`polycontact._kernels.fits`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .decompose import ring_pieces
 from .fits import degenerate_contacts, exact_candidates
-from .minkowski import boxes, convex_sums, frames
-from .outline import (assemble_rings, closed_loops, edge_cover, ring_stats, tidy_rings,
-                      without_collinear)
+from .minkowski import boxes, clip_tests, convex_sums, frames, mark_inner
+from .outline import (assemble_rings, clip_edges, closed_loops, outline_index, ring_stats,
+                      tidy_rings, without_collinear)
 from .tolerance import tolerance_of
 
 
 @njit(cache=True, nogil=True)
-def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
+def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, max_tests):
     """Everything the no-fit polygon needs, in one call (few arrays: boxing costs).
 
     ``(bxy, bstarts)``: convex pieces of B; ``(rxy, rstarts)``: convex pieces of
@@ -32,11 +32,14 @@ def entrance_region(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
     rings, closed (each ends with its first point); their signed area and length
     (R, 2); candidate exact fits then candidate slides as segments (C, 4), an exact
     fit as a zero-length segment; ``meta`` =
-    ``[eps, ok, number of candidate exact fits]``, ``ok`` = 0 when the outline parts
-    did not link into rings (the caller then unions the sums another way), -1 when the
-    sums are not finite (input beyond float64: the caller refuses it).
+    ``[eps, ok, number of candidate exact fits, clip tests]``, ``ok`` = 0 when the
+    outline parts did not link into rings (the caller then unions the sums another way),
+    -1 when the sums are not finite (input beyond float64: the caller refuses it), -2
+    (nothing computed) when clipping the sums' edges would take more than
+    ``max_tests`` edge–sum tests (:func:`polycontact._kernels.minkowski.clip_tests`,
+    the last entry of ``meta``: the caller refuses the work).
     """
-    return _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol)[2:]
+    return _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, max_tests)[2:]
 
 
 @njit(cache=True, nogil=True)
@@ -49,17 +52,15 @@ def _finite(xy):
 
 
 @njit(cache=True, nogil=True)
-def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
+def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, max_tests):
     """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
-    sums, starts = convex_sums(bxy, bstarts, rxy, rstarts)
+    sums, starts, keep = convex_sums(bxy, bstarts, rxy, rstarts)
     if not _finite(sums):
         # error code, not a crash: the caller refuses the input
-        meta = np.array([1.0, -1.0, 0.0])
-        return (sums, starts, sums[:0], np.zeros(1, np.int64), np.empty((0, 2)),
-                np.empty((0, 4)), meta)
+        return _nothing(sums, starts, np.array([1.0, -1.0, 0.0, 0.0]))
     if eps <= 0.0:
         eps = tolerance_of(sums, rel_tol, ulps)
-    meta = np.array([eps, 1.0, 0.0])
+    meta = np.array([eps, 1.0, 0.0, 0.0])
     if starts.shape[0] == 2:
         # one sum: its vertices are the sums' (nothing to snap)
         ring_xy, rs = without_collinear(sums, np.array([0, sums.shape[0]], np.int64), eps)
@@ -69,7 +70,13 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
                 np.empty((0, 4)), meta)
     bb = boxes(sums, starts)
     fr = frames(sums, starts)
-    outline, loose = edge_cover(sums, starts, bb, fr, eps)
+    mark_inner(fr, keep)  # (edges off the reduced convolution: none of the outline)
+    index = outline_index(sums, starts, bb, fr, eps)
+    meta[3] = clip_tests((sums, starts, bb, fr), index, eps)
+    if meta[3] > max_tests:
+        meta[1] = -2.0  # (refused before clipping)
+        return _nothing(sums, starts, meta)
+    outline, loose = clip_edges(sums, starts, bb, fr, eps, index)
     ok, ring_xy, ring_starts = assemble_rings(outline, 4.0 * eps)
     ring_xy, ring_starts = tidy_rings(ring_xy, ring_starts, sums, eps)
     area, length = ring_stats(ring_xy, ring_starts)
@@ -85,8 +92,15 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol):
 
 
 @njit(cache=True, nogil=True)
+def _nothing(sums, starts, meta):
+    """:func:`_entrance`'s answer with no outline nor candidates (``meta`` says why)."""
+    return (sums, starts, sums[:0], np.zeros(1, np.int64), np.empty((0, 2)),
+            np.empty((0, 4)), meta)
+
+
+@njit(cache=True, nogil=True)
 def ring_entrance(bxy, axy, a0x, a0y, eps, rel_tol, ulps, ang_tol, snap_f, near_f, max_ear,
-                  max_sum):
+                  max_sum, max_tests):
     """:func:`entrance_region` of two simple CCW rings B and A (no holes), each cut into
     convex pieces here (:func:`polycontact._kernels.decompose.ring_pieces`, up to
     ``max_ear`` vertices), A's reflected through ``(a0x, a0y)``: one call where a
@@ -95,39 +109,40 @@ def ring_entrance(bxy, axy, a0x, a0y, eps, rel_tol, ulps, ang_tol, snap_f, near_
     Returns ``(head, buf)`` as :func:`entrance_packed`; ``head[0]`` (ok) is 0 (and the
     rest empty) when a ring is too large or has no ear left, or the sums would hold more
     than ``max_sum`` vertices: the caller then decomposes the rings another way (or
-    refuses them) and calls :func:`entrance_packed`.
+    refuses them) and calls :func:`entrance_packed`. ``max_tests``: as for
+    :func:`entrance_region`.
     """
     okb, bp, bst = ring_pieces(bxy, rel_tol, ulps, max_ear)
     oka, ap, ast = ring_pieces(axy, rel_tol, ulps, max_ear)
     total = bp.shape[0] * (ast.shape[0] - 1) + ap.shape[0] * (bst.shape[0] - 1)
     if not (okb and oka) or total > max_sum:
-        return _pack(False, bp, bst, bp[:0], np.zeros(1, np.int64), np.empty((0, 2)),
-                     np.empty((0, 4)), np.zeros(3), snap_f, near_f)
+        return _pack(False, *_nothing(bp, bst, np.zeros(4)), snap_f, near_f)
     r = np.empty_like(ap)
     for i in range(ap.shape[0]):
         r[i, 0] = a0x - ap[i, 0]
         r[i, 1] = a0y - ap[i, 1]
-    return _pack(True, *_entrance(bp, bst, r, ast, eps, rel_tol, ulps, ang_tol), snap_f,
-                 near_f)
+    return _pack(True, *_entrance(bp, bst, r, ast, eps, rel_tol, ulps, ang_tol, max_tests),
+                 snap_f, near_f)
 
 
 @njit(cache=True, nogil=True)
-def entrance_packed(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, snap_f, near_f):
+def entrance_packed(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, snap_f, near_f,
+                    max_tests):
     """:func:`entrance_region`'s answer as two objects, ``(head, buf)``: returning an
     array to Python costs about half a microsecond each, a third of a small no-fit
     polygon's kernel time with five. The candidates are made exact here, where the sums
     are at hand (see :func:`exact_candidates`; ``snap_f`` and ``near_f`` times the
     tolerance are its ``snap`` and ``near``).
 
-    ``head`` = ``(ok, eps, status, candidate fits, rings, ring vertices, candidates)``,
-    floats (``ok`` = 1; ``status`` is
-    ``meta[1]`` of :func:`entrance_region`); ``buf`` (float64) holds, one after the
+    ``head`` = ``(ok, eps, status, candidate fits, rings, ring vertices, candidates,
+    clip tests)``, floats (``ok`` = 1; ``status`` and the clip tests are ``meta[1]``
+    and ``meta[3]`` of :func:`entrance_region`); ``buf`` (float64) holds, one after the
     other, the rings' coordinates (x0, y0, x1, ...), their starts (rings + 1), their
     (area, length) and the candidates (4 each); see
     :func:`polycontact.nfp._unpack`.
     """
-    return _pack(True, *_entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol),
-                 snap_f, near_f)
+    return _pack(True, *_entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol,
+                                  max_tests), snap_f, near_f)
 
 
 @njit(cache=True, nogil=True)
@@ -157,5 +172,6 @@ def _pack(ok, sums, starts, ring_xy, ring_starts, stats, cand, meta, snap_f, nea
         for c in range(4):
             buf[w] = cand[k, c]
             w += 1
-    head = (1.0 if ok else 0.0, meta[0], meta[1], meta[2], float(nr), float(nv), float(nc))
+    head = (1.0 if ok else 0.0, meta[0], meta[1], meta[2], float(nr), float(nv), float(nc),
+            meta[3])
     return head, buf

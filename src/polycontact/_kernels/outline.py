@@ -11,9 +11,9 @@ change nothing.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from .minkowski import GRID, clip_edge, sum_index
+from .jit import njit
+from .minkowski import EDGE, GRID, clip_edge, sum_index
 from .primitives import append_part, closest_on_segment
 
 #: Outline coordinates within this many units of 2**-52 of the sums' largest
@@ -23,7 +23,8 @@ SNAP_ULPS = 4.0
 
 @njit(cache=True, nogil=True)
 def edge_cover(xy, starts, bb, fr, eps):
-    """Uncovered parts of the sums' edges.
+    """Uncovered parts of the sums' edges (those marked ``EDGE`` in the frames ``fr``:
+    an ``INNER_EDGE``, off the reduced convolution, has none).
 
     Returns ``(outline, loose)``, both (M, 4) segments x0, y0, x1, y1:
     ``outline`` are the parts in no other sum's interior and on no seam, each kept once:
@@ -31,19 +32,33 @@ def edge_cover(xy, starts, bb, fr, eps):
     parts in no other open sum shrunk by eps, where exact fits and slides lie, less
     those lying within a longer outline part.
     """
-    k = starts.shape[0] - 1
-    n_edges = xy.shape[0]
-    outline = np.empty((4 * n_edges, 4))
-    loose = np.empty((4 * n_edges, 4))
-    no = 0
-    nl = 0
-    hint = -1
-    # the grid over all sums
+    return clip_edges(xy, starts, bb, fr, eps, outline_index(xy, starts, bb, fr, eps))
+
+
+@njit(cache=True, nogil=True)
+def outline_index(xy, starts, bb, fr, eps):
+    """The :func:`polycontact._kernels.minkowski.sum_index` that :func:`clip_edges`
+    reads: its cover grid spans every sum."""
     gx0 = bb[:, 0].min()
     gy0 = bb[:, 1].min()
     h = max(bb[:, 2].max() - gx0, bb[:, 3].max() - gy0, 1e-300) / GRID
+    return sum_index((xy, starts, bb, fr), gx0, gy0, h, eps)
+
+
+@njit(cache=True, nogil=True)
+def clip_edges(xy, starts, bb, fr, eps, index):
+    """:func:`edge_cover` with its index (:func:`outline_index`) given."""
+    k = starts.shape[0] - 1
+    cap = 4
+    for i in range(xy.shape[0]):
+        if fr[i, 3] == EDGE:
+            cap += 4  # (rows grow when needed)
+    outline = np.empty((cap, 4))
+    loose = np.empty((cap, 4))
+    no = 0
+    nl = 0
+    hint = -1
     sums = (xy, starts, bb, fr)
-    index = sum_index(sums, gx0, gy0, h)
     lo1, hi1, lo0, hi0 = index[-4:]
     for p in range(k):
         s = starts[p]
@@ -52,7 +67,7 @@ def edge_cover(xy, starts, bb, fr, eps):
             j = i + 1 if i + 1 < e else s
             ax, ay = xy[i, 0], xy[i, 1]
             bx, by = xy[j, 0], xy[j, 1]
-            if ax == bx and ay == by:
+            if fr[i, 3] != EDGE or (ax == bx and ay == by):
                 continue
             n1, n0, hint = clip_edge(sums, index, p, ax, ay, bx, by, 0.0, 1.0, eps, hint)
             dx = bx - ax

@@ -30,11 +30,13 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
+from numba import types
 from numba.core import cgutils, config
 from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array, populate_array
+
+from .jit import njit
 
 
 def _dtype_of(dtype):
@@ -208,3 +210,34 @@ STACK_VERTICES = 256
 
 #: Floats of that stack scratch: :func:`scratch_floats` of :data:`STACK_VERTICES`.
 STACK_FLOATS = getattr(scratch_floats, "py_func", scratch_floats)(STACK_VERTICES)
+
+
+@njit(cache=True, nogil=True)
+def unpack_shapes(blob, count):
+    """The shapes of ``count`` kernel packs (the layout of :data:`PACK_HEAD`) one after
+    another in ``blob`` (float64), as ``(xy, rows, starts, st_off)``: shape k's rows
+    ``xy[rows[k]:rows[k + 1]]`` and its loop starts (from 0)
+    ``starts[st_off[k]:st_off[k + 1]]``."""
+    bits = blob.view(np.int64)
+    rows = np.zeros(count + 1, np.int64)
+    st_off = np.zeros(count + 1, np.int64)
+    at = np.empty(count, np.int64)
+    o = 0
+    for k in range(count):
+        nl = int(blob[o])
+        n = bits[o + PACK_HEAD + nl]
+        at[k] = o
+        rows[k + 1] = rows[k] + n
+        st_off[k + 1] = st_off[k] + nl + 1
+        o += PACK_HEAD + nl + 1 + 2 * n
+    xy = np.empty((rows[count], 2))
+    starts = np.empty(st_off[count], np.int64)
+    for k in range(count):
+        o = at[k]
+        m = st_off[k + 1] - st_off[k]
+        starts[st_off[k] : st_off[k + 1]] = bits[o + PACK_HEAD : o + PACK_HEAD + m]
+        first = o + PACK_HEAD + m
+        for i in range(rows[k + 1] - rows[k]):
+            xy[rows[k] + i, 0] = blob[first + 2 * i]
+            xy[rows[k] + i, 1] = blob[first + 2 * i + 1]
+    return xy, rows, starts, st_off

@@ -19,8 +19,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .tolerance import box_extent_magnitude, tolerance_for
 
 #: NumPy's pairwise summation: runs of up to this many terms are summed in 8 lanes.
@@ -152,18 +153,27 @@ def centroids(xy, ls, bs, cen, rad):
 
 
 @njit(cache=True, nogil=True)
-def _pose_range(ids, poses, bodies, base, tolerance, k0, k1):
-    """:func:`pose_rows` for ``ids[k0:k1]``."""
-    px, py, ang = poses
+def _pose_range(ids, poses, bodies, base, tolerance, store, k0, k1):
+    """:func:`pose_rows` for ``ids[k0:k1]``; returns the largest |coordinate| and the
+    largest tolerance written."""
+    pos, ang = poses
     xy, ls, lo, nl, box, eps = bodies
     bxy, cen = base
     rel, ulps = tolerance
+    pos_out, ang_out, ver = store
+    big = 0.0
+    emax = 0.0
     for k in range(k0, k1):
         b = ids[k]
+        a = ang[k] if ang.shape[0] else ang_out[b]
+        pos_out[b, 0] = pos[k, 0]
+        pos_out[b, 1] = pos[k, 1]
+        ang_out[b] = a
+        ver[b] += 1
         f = ls[lo[b]]
         e = ls[lo[b] + nl[b]]
-        cs = math.cos(ang[k])
-        sn = math.sin(ang[k])
+        cs = math.cos(a)
+        sn = math.sin(a)
         x0 = np.inf
         x1 = -np.inf
         y0 = np.inf
@@ -174,8 +184,8 @@ def _pose_range(ids, poses, bodies, base, tolerance, k0, k1):
             # place()'s operations, in the same order
             dx = bxy[i, 0] - cx
             dy = bxy[i, 1] - cy
-            x = px[k] + (dx * cs - dy * sn)
-            y = py[k] + (dx * sn + dy * cs)
+            x = pos[k, 0] + (dx * cs - dy * sn)
+            y = pos[k, 1] + (dx * sn + dy * cs)
             xy[i, 0] = x
             xy[i, 1] = y
             x0 = min(x0, x)
@@ -188,34 +198,89 @@ def _pose_range(ids, poses, bodies, base, tolerance, k0, k1):
         box[b, 3] = y1
         extent, magnitude = box_extent_magnitude(x0, x1, y0, y1)
         eps[b] = tolerance_for(extent, magnitude, rel, ulps)
+        big = max(big, magnitude)
+        emax = max(emax, eps[b])
+    return big, emax
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def pose_rows(ids, poses, bodies, base, tolerance, chunks):
+def pose_rows(ids, poses, bodies, base, tolerance, store, chunks):
     """Rows, boxes (``x0, x1, y0, y1``) and default tolerances of the bodies ``ids`` at
-    the poses ``poses`` = ``(px, py, ang)`` (row k for body ``ids[k]``), written into
-    the World's ``bodies`` record (:mod:`polycontact._kernels.world`): body b's rows
-    of ``xy`` become its base rows turned about its base centroid and moved so that the
-    centroid goes to the position (``base`` = ``(bxy, cen)``: the rows as added and
-    each body's centroid). ``tolerance`` = ``(rel, ulps)``: the default tolerance's
-    terms (:func:`polycontact._kernels.tolerance.tolerance_for`). In parallel chunks
+    the poses ``poses`` = ``(pos (P, 2), ang (P,))`` (row k for body ``ids[k]``; ``ang``
+    empty: each body keeps its angle), written into the World's ``bodies`` record
+    (:mod:`polycontact._kernels.world`), and the poses into ``store`` = ``(pos, ang,
+    version)`` (each body's version counted up): body b's rows of ``xy`` become its base
+    rows turned about its base centroid and moved so that the centroid goes to the
+    position (``base`` = ``(bxy, cen)``: the rows as added and each body's centroid).
+    ``tolerance`` = ``(rel, ulps)``: the default tolerance's terms
+    (:func:`polycontact._kernels.tolerance.tolerance_for`). In parallel chunks
     (``chunks`` = 1: serial, no thread start). Returns the largest |coordinate| and the
     largest tolerance written."""
     n = ids.shape[0]
     if chunks == 1:
-        _pose_range(ids, poses, bodies, base, tolerance, 0, n)
-    else:
-        for c in prange(chunks):
-            _pose_range(ids, poses, bodies, base, tolerance, n * c // chunks,
-                        n * (c + 1) // chunks)
-    box, eps = bodies[4], bodies[5]
-    big = 0.0
-    emax = 0.0
-    for k in range(n):
+        return _pose_range(ids, poses, bodies, base, tolerance, store, 0, n)
+    big = np.zeros(chunks)
+    emax = np.zeros(chunks)
+    for c in prange(chunks):
+        big[c], emax[c] = _pose_range(ids, poses, bodies, base, tolerance, store,
+                                      n * c // chunks, n * (c + 1) // chunks)
+    return big.max(), emax.max()
+
+
+@njit(cache=True, nogil=True)
+def _checks_range(ids, poses, live, rad, owner, limit, k0, k1):
+    """Whether the requests ``k0:k1`` of :func:`pose_checks` pass (and their marks)."""
+    pos, ang = poses
+    ok = True
+    for k in range(k0, k1):
         b = ids[k]
-        big = max(big, -box[b, 0], box[b, 1], -box[b, 2], box[b, 3])
-        emax = max(emax, eps[b])
-    return big, emax
+        if b < 0 or b >= live.shape[0] or not live[b]:
+            ok = False
+            continue
+        x = pos[k, 0]
+        y = pos[k, 1]
+        if ang.shape[0] and not math.isfinite(ang[k]):
+            ok = False
+        # (World._check_reach's test: position plus radius, with its margin)
+        if not (abs(x) <= limit and abs(y) <= limit
+                and max(abs(x), abs(y)) + rad[b] * (1.0 + 1e-9) <= limit):
+            ok = False
+        owner[b] = -(k + 1)
+    return ok
+
+
+@njit(cache=True, nogil=True)
+def _owned(ids, owner, k0, k1):
+    """Whether every body ``ids[k]``, k in ``k0:k1``, carries the mark of its own k."""
+    for k in range(k0, k1):
+        if owner[ids[k]] != -(k + 1):
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pose_checks(ids, poses, live, rad, owner, limit, chunks):
+    """Whether the poses ``poses`` = ``(pos (P, 2), ang (P,) or empty)`` of the bodies
+    ``ids`` can all be set at once: every id a live body (``live``, one entry per id),
+    none twice, positions and angles finite, and each body's position plus its bounding
+    radius ``rad`` within ``limit``. False when one of these may fail: the caller then
+    checks the requests one by one (and says which). ``owner`` (one int64 per id, never
+    negative before the call) is scratch: each listed body is marked with -(k + 1), its
+    request's k, in parallel; a body listed twice then holds the mark of only one of
+    its requests, which the second pass sees. In ``chunks`` parallel chunks."""
+    n = ids.shape[0]
+    if chunks == 1:
+        return (_checks_range(ids, poses, live, rad, owner, limit, 0, n)
+                and _owned(ids, owner, 0, n))
+    ok = np.ones(chunks, np.bool_)
+    for c in prange(chunks):
+        ok[c] = _checks_range(ids, poses, live, rad, owner, limit, n * c // chunks,
+                              n * (c + 1) // chunks)
+    if not ok.all():
+        return False
+    for c in prange(chunks):
+        ok[c] = _owned(ids, owner, n * c // chunks, n * (c + 1) // chunks)
+    return ok.all()
 
 
 @njit(cache=True, nogil=True)

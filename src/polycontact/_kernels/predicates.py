@@ -27,7 +27,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 _EPS = 2.0**-53
 #: Shewchuk's bound on the rounding of the filtered determinant (relative to the sum
@@ -132,7 +133,8 @@ def _exact_orientation(ax, ay, bx, by, cx, cy):
         top = top if top != 0.0 else low
         return 0 if top == 0.0 else (1 if top > 0.0 else -1)
     # |E| > |top| / 2 and |T| < 2 |low| 2**-1000: E decides unless it is as small as T
-    if math.ldexp(abs(top), 2 * _LIFT) > 4.0 * abs(low):
+    # (|low| < 2**44, so E at or above 2**-950 decides before any lifting could overflow)
+    if abs(top) >= 2.0**-950 or math.ldexp(abs(top), 2 * _LIFT) > 4.0 * abs(low):
         return 1 if top > 0.0 else -1
     both = np.empty(24)  # (E is below 2**-955 here: lifting it by 2**1000 is exact)
     for i in range(12):

@@ -12,7 +12,8 @@ the one copy the kernels share.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 
 @njit(cache=True, nogil=True)
@@ -177,6 +178,39 @@ def loop_next(i, starts, k):
 def loop_prev(i, starts, k):
     """The vertex before vertex i of loop k of packed loops ``starts``."""
     return i - 1 if i > starts[k] else starts[k + 1] - 1
+
+
+# (no reference counting: the pair kernels that call it pass their buffers)
+@njit(cache=True, nogil=True, _nrt=False, inline="always")
+def edge_rows(x, starts, e, nxt):
+    """Each edge's direction, length and box, written into ``e``: rows ``(gx, gy,
+    length, xmin, xmax, ymin, ymax)`` of edge i, from vertex i to the next of its loop,
+    whose row goes to ``nxt[i]``; the table the kernels of a pair share instead of each
+    recomputing it.
+
+    >>> import numpy as np
+    >>> e, nxt = np.empty((3, 7)), np.empty(3, np.int64)
+    >>> edge_rows(np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]]), np.array([0, 3]), e, nxt)
+    >>> e[1].tolist(), nxt.tolist()
+    ([-4.0, 3.0, 5.0, 0.0, 4.0, 0.0, 3.0], [1, 2, 0])
+    """
+    for k in range(starts.shape[0] - 1):
+        for i in range(starts[k], starts[k + 1]):
+            j = loop_next(i, starts, k)
+            nxt[i] = j
+            ax = x[i, 0]
+            ay = x[i, 1]
+            bx = x[j, 0]
+            by = x[j, 1]
+            gx = bx - ax
+            gy = by - ay
+            e[i, 0] = gx
+            e[i, 1] = gy
+            e[i, 2] = np.sqrt(gx * gx + gy * gy)
+            e[i, 3] = min(ax, bx)
+            e[i, 4] = max(ax, bx)
+            e[i, 5] = min(ay, by)
+            e[i, 6] = max(ay, by)
 
 
 @njit(cache=True, nogil=True)

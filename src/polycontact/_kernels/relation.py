@@ -21,8 +21,8 @@ common bounding box, so the cost is O((m + n) log(m + n) + pairs whose boxes mee
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .cones import cones_overlap, pair_point
 from .packs import (STACK_FLOATS, STACK_VERTICES, stack_floats, state_scratch, state_scratch_views,
                     unpack_shape)
@@ -76,8 +76,7 @@ def _untouched_inside(xv, sv, touch, offset, xo, so, x0, x1, y0, y1):
 _ALL_PAIRS = 256
 
 
-@njit(cache=True, nogil=True)
-def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
+def _edge_pair_test(xa, xb, na, ga, a1, gb, b1, eps, touch):
     """Edge ga->a1 of A against edge gb->b1 of B (B's rows offset by na).
 
     Marks in ``touch`` every end vertex within eps of the other edge; returns 1 if some
@@ -120,6 +119,11 @@ def _edge_pair(xa, xb, na, ga, a1, gb, b1, eps, touch):
     if ((o1 > 0.0) != (o2 > 0.0)) and ((o3 > 0.0) != (o4 > 0.0)):
         return 2
     return 0
+
+
+_edge_pair = njit(cache=True, nogil=True)(_edge_pair_test)
+# Inlined into :func:`moved_state`, which calls it for each pair of edges in its window.
+_edge_pair_inlined = njit(nogil=True, _nrt=False, inline="always")(_edge_pair_test)
 
 
 @njit(cache=True, nogil=True)
@@ -308,6 +312,132 @@ _overlap_state = njit(cache=True, nogil=True, _nrt=False)(_overlap_test)
 # a pair of small shapes takes. The kernels that loop over many pairs call it: inlined
 # into each of them it would multiply their compile time.
 _overlap_state_inlined = njit(nogil=True, _nrt=False, inline="always")(_overlap_test)
+
+
+#: The witnesses :func:`moved_state` gives of a penetration: none (the state kernel
+#: decided), two edges that cross, a vertex of A inside B, a vertex of B inside A.
+NO_WITNESS = 0
+CROSSING = 1
+A_INSIDE = 2
+B_INSIDE = 3
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def moved_state(a, b, dx, dy, eps, moved, scratch):
+    """Whether A moved by (dx, dy) penetrates B, as :func:`state_in` decides it, and
+    why: ``(penetrating, witness, i, j)``, the witness :data:`CROSSING` (A's edge i
+    and B's edge j cross properly), :data:`A_INSIDE` (A's vertex i lies inside B, no
+    edge within ``eps``), :data:`B_INSIDE` (B's vertex j inside A) or
+    :data:`NO_WITNESS`; :func:`witness_holds` tells whether it still holds at another
+    translation.
+
+    ``a`` = ``(xa, sa, ea, nxa, box)``: A's packed loops (interior on the left), its
+    :func:`polycontact._kernels.primitives.edge_rows` table and successors, its bounding
+    box; ``b`` likewise. ``moved`` (shaped like ``xa``) receives A moved; ``scratch`` is
+    the state kernel's (:func:`polycontact._kernels.packs.scratch_floats` of both
+    bodies' vertices). For the translations of one pair the edge boxes come from the
+    tables (a translation shifts them exactly: rounding is monotonic), not from the
+    coordinates; the edges whose boxes meet the common window are tested all against
+    all, as :func:`_overlap_test` does. A touch (an end within ``eps`` of the other
+    edge), or more pairs of edges in the window than :data:`_ALL_PAIRS`, is left to
+    :func:`_overlap_test`, so the verdict is the state kernel's in every case.
+    """
+    xa, sa, ea, nxa, ba = a
+    xb, sb, eb, nxb, bb = b
+    m = xa.shape[0]
+    nb = xb.shape[0]
+    for i in range(m):
+        moved[i, 0] = xa[i, 0] + dx
+        moved[i, 1] = xa[i, 1] + dy
+    bm = (ba[0] + dx, ba[1] + dx, ba[2] + dy, ba[3] + dy)
+    if _boxes_apart(bm, bb, eps):
+        return False, NO_WITNESS, -1, -1
+    wx0, wx1, wy0, wy1 = _window(bm, bb, eps)
+    views = state_scratch_views(scratch, m + nb)
+    box, ids, touch = views[0], views[1], views[2]
+    ca = 0
+    for i in range(m):
+        x0 = ea[i, 3] + dx
+        x1 = ea[i, 4] + dx
+        y0 = ea[i, 5] + dy
+        y1 = ea[i, 6] + dy
+        box[ca, 0] = x0 - eps
+        box[ca, 1] = x1 + eps
+        box[ca, 2] = y0 - eps
+        box[ca, 3] = y1 + eps
+        ids[ca, 0] = i
+        ca += not (x1 < wx0 or x0 > wx1 or y1 < wy0 or y0 > wy1)
+    c = ca
+    for j in range(nb):
+        box[c, 0] = eb[j, 3]
+        box[c, 1] = eb[j, 4]
+        box[c, 2] = eb[j, 5]
+        box[c, 3] = eb[j, 6]
+        ids[c, 0] = j
+        c += not (eb[j, 4] < wx0 or eb[j, 3] > wx1 or eb[j, 6] < wy0 or eb[j, 5] > wy1)
+    if ca * (c - ca) > _ALL_PAIRS:
+        return (_overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views) == PENETRATING,
+                NO_WITNESS, -1, -1)
+    touch[:m + nb] = False
+    for p in range(ca):
+        i = ids[p, 0]
+        for q in range(ca, c):
+            if (box[q, 0] > box[p, 1] or box[q, 1] < box[p, 0] or box[q, 2] > box[p, 3]
+                    or box[q, 3] < box[p, 2]):
+                continue
+            j = ids[q, 0]
+            met = _edge_pair_inlined(moved, xb, m, i, nxa[i], m + j, m + nxb[j], eps, touch)
+            if met == 1:  # a touch: the cones decide
+                return (_overlap_state(moved, sa, 1.0, xb, sb, 1.0, eps, bm, bb, views)
+                        == PENETRATING, NO_WITNESS, -1, -1)
+            if met == 2:
+                return True, CROSSING, i, j
+    # (2) of the state test: the first vertex of each loop (none touches), inside
+    for k in range(sa.shape[0] - 1):
+        x = moved[sa[k], 0]
+        y = moved[sa[k], 1]
+        if bb[0] <= x <= bb[1] and bb[2] <= y <= bb[3] and point_inside(x, y, xb, sb):
+            return True, A_INSIDE, sa[k], -1
+    for k in range(sb.shape[0] - 1):
+        x = xb[sb[k], 0]
+        y = xb[sb[k], 1]
+        if bm[0] <= x <= bm[1] and bm[2] <= y <= bm[3] and point_inside(x, y, moved, sa):
+            return True, B_INSIDE, -1, sb[k]
+    return False, NO_WITNESS, -1, -1
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def witness_holds(a, b, dx, dy, eps, witness, i, j, moved, touch):
+    """Whether a witness of :func:`moved_state` makes A moved by (dx, dy) penetrate B
+    as :func:`state_in` decides it: the two edges still cross properly, or the vertex
+    still lies inside the other body with no edge within ``eps`` (computed as the state
+    kernel would, from A's rows moved into ``moved``; ``touch``: room for a flag per
+    vertex of both bodies). A proper crossing, or a vertex so inside, is a penetration
+    whatever else the bodies do there."""
+    xa, sa, _, nxa, _ = a
+    xb, sb, _, nxb, _ = b
+    m = xa.shape[0]
+    for r in range(m):
+        moved[r, 0] = xa[r, 0] + dx
+        moved[r, 1] = xa[r, 1] + dy
+    if witness == CROSSING:
+        return _edge_pair_inlined(moved, xb, m, i, nxa[i], m + j, m + nxb[j], eps, touch) == 2
+    if witness == A_INSIDE:
+        return _deep_inside(moved[i, 0], moved[i, 1], xb, sb, nxb, eps)
+    if witness == B_INSIDE:
+        return _deep_inside(xb[j, 0], xb[j, 1], moved, sa, nxa, eps)
+    return False
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _deep_inside(px, py, xo, so, nxo, eps):
+    """Whether (px, py) lies inside O with none of O's edges within ``eps``."""
+    e2 = eps * eps
+    for f in range(xo.shape[0]):
+        g = nxo[f]
+        if closest_on_segment(px, py, xo[f, 0], xo[f, 1], xo[g, 0], xo[g, 1])[2] <= e2:
+            return False
+    return point_inside(px, py, xo, so)
 
 
 @njit(cache=True, nogil=True)

@@ -15,8 +15,9 @@ the right (a clockwise raw ring, classified without a copy).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .distance import closest_pair
 from .packs import state_scratch
 from .primitives import point_segment_sq

@@ -16,8 +16,8 @@ rules of :func:`polycontact._kernels.validate.first_defect` too. A ring that fai
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .primitives import norm, orient, point_segment_distance, segment_meet
 from .relation import oriented_state
 from .sweep import sorted_edge_boxes

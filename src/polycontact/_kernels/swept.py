@@ -21,8 +21,8 @@ Batched search. :func:`impacts_chunk` runs, for a list of pairs, exactly what
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .impact import exact_query, sampled_query, unpack_body, work_floats
 
 
@@ -111,7 +111,12 @@ def box_pairs(boxes, owner, n_bodies):
     """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
     time (closed intervals), once each, sorted; shape (K, 2).
 
-    Sort and sweep on the axis (x or y) along which the boxes' centres spread most.
+    Sort and sweep on the axis (x or y) along which the boxes' centres spread most,
+    in strips across the other axis: each box goes to every strip its extent there
+    meets, so two boxes that overlap share a strip (the strip of any common point), and
+    a box is swept against those of its strips only (about the boxes of one row of a
+    crowd, not of a whole column). The strips are as high as a box on average, at most
+    one per box; boxes that reach infinity make one strip.
     """
     nb = boxes.shape[0]
     if nb == 0:
@@ -129,35 +134,71 @@ def box_pairs(boxes, owner, n_bodies):
         vx += (0.5 * (boxes[k, 0] + boxes[k, 1]) - mx) ** 2
         vy += (0.5 * (boxes[k, 2] + boxes[k, 3]) - my) ** 2
     ax = 0 if vx >= vy else 2          # sweep axis: columns ax, ax + 1
-    ox = 2 - ax                        # the other axis
-    order = np.argsort(boxes[:, ax], kind="mergesort")
+    ox = 2 - ax                        # the other axis, cut into strips
+    lo = np.inf
+    hi = -np.inf
+    tall = 0.0
+    for k in range(nb):
+        lo = min(lo, boxes[k, ox])
+        hi = max(hi, boxes[k, ox + 1])
+        tall += boxes[k, ox + 1] - boxes[k, ox]
+    strips = 1
+    width = 1.0
+    if hi > lo and np.isfinite(hi - lo) and np.isfinite(tall):
+        width = max(tall / nb, (hi - lo) / nb)
+        strips = min(nb, int((hi - lo) / width) + 1)
+        width = (hi - lo) / strips
+    first = np.empty(nb, np.int64)
+    last = np.empty(nb, np.int64)
+    start = np.zeros(strips + 1, np.int64)
+    for k in range(nb):
+        s0 = 0
+        s1 = strips - 1
+        if strips > 1:
+            s0 = min(strips - 1, max(0, int((boxes[k, ox] - lo) / width)))
+            s1 = min(strips - 1, max(s0, int((boxes[k, ox + 1] - lo) / width)))
+        first[k] = s0
+        last[k] = s1
+        for q in range(s0, s1 + 1):
+            start[q + 1] += 1
+    for q in range(strips):
+        start[q + 1] += start[q]
+    members = np.empty(start[strips], np.int64)
+    fill = start[:strips].copy()
+    for k in range(nb):
+        for q in range(first[k], last[k] + 1):
+            members[fill[q]] = k
+            fill[q] += 1
     cap = 4 * nb + 16
     keys = np.empty(cap, np.int64)
     nk = 0
-    for p in range(nb):
-        a = order[p]
-        hi = boxes[a, ax + 1]
-        ia = owner[a]
-        for q in range(p + 1, nb):
-            b = order[q]
-            if boxes[b, ax] > hi:
-                break
-            ib = owner[b]
-            if ia == ib:
-                continue
-            if boxes[b, ox] > boxes[a, ox + 1] or boxes[a, ox] > boxes[b, ox + 1]:
-                continue
-            if boxes[b, 4] > boxes[a, 5] or boxes[a, 4] > boxes[b, 5]:
-                continue
-            if nk == cap:
-                grown = np.empty(2 * cap, np.int64)
-                grown[:cap] = keys
-                keys = grown
-                cap *= 2
-            i = min(ia, ib)
-            j = max(ia, ib)
-            keys[nk] = i * n_bodies + j
-            nk += 1
+    for q in range(strips):
+        group = members[start[q]:start[q + 1]]
+        order = group[np.argsort(boxes[group, ax], kind="mergesort")]
+        for p in range(order.shape[0]):
+            a = order[p]
+            top = boxes[a, ax + 1]
+            ia = owner[a]
+            for r in range(p + 1, order.shape[0]):
+                b = order[r]
+                if boxes[b, ax] > top:
+                    break
+                ib = owner[b]
+                if ia == ib:
+                    continue
+                if boxes[b, ox] > boxes[a, ox + 1] or boxes[a, ox] > boxes[b, ox + 1]:
+                    continue
+                if boxes[b, 4] > boxes[a, 5] or boxes[a, 4] > boxes[b, 5]:
+                    continue
+                if nk == cap:
+                    grown = np.empty(2 * cap, np.int64)
+                    grown[:cap] = keys
+                    keys = grown
+                    cap *= 2
+                i = min(ia, ib)
+                j = max(ia, ib)
+                keys[nk] = i * n_bodies + j
+                nk += 1
     uniq = np.unique(keys[:nk])
     out = np.empty((uniq.shape[0], 2), np.int64)
     for k in range(uniq.shape[0]):

@@ -8,8 +8,8 @@ otherwise, and the answer does not depend on where the polygon lies or on its sc
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .predicates import collinear_overlap, orientation, segments_meet
 
 

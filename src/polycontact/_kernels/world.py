@@ -16,6 +16,10 @@ and ``prv``). A box query visits, on every non-empty level, the cells whose wide
 bounds meet the box. Cell indices are clamped to ±2**25 about ``origin``: far cells
 merge (more candidates), never lose one.
 
+:func:`contact_pairs` lists and classifies the pairs in one parallel pass over the live
+bodies (the broad phase's queries and the state kernel, chunk by chunk), then sorts them
+in parallel buckets (:func:`sorted_pairs`).
+
 The kernels take the store as records: ``bodies`` = ``(xy, ls, lo, nl, box, eps)``, and
 the broad phase's ``grid`` = ``(keys, heads, nxt, level, lvl_count, levels, origin)``
 (``levels``: the level indices in use).
@@ -26,8 +30,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .packs import state_scratch
 from .primitives import bbox
 from .relation import state_in
@@ -162,22 +167,53 @@ def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, ali
 
 @njit(cache=True, nogil=True)
 def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled):
-    """Move each body of ``ids`` (boxes already set) to the cell of its box, if it left
-    its own (a body that stays costs no index work), in a table holding ``filled``
-    cells; stops before it would be more than half full. Returns (cells made, bodies
-    done)."""
+    """Move each body of ``ids`` (boxes already set, and each out of its cell: see
+    :func:`left_cells`) to the cell of its box, in a table holding ``filled`` cells;
+    stops before it would be more than half full. Returns (cells made, bodies done)."""
     made = 0
     limit = keys.shape[0] // 2
     for k in range(ids.shape[0]):
         b = ids[k]
-        key = _cell_key(box, b, origin)[1]
-        if slot[b] >= 0 and keys[slot[b]] == key:
-            continue
         if filled + made + 1 > limit:
             return made, k
         grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
         made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
     return made, ids.shape[0]
+
+
+@njit(cache=True, nogil=True)
+def _left(ids, keys, slot, box, origin, k0, k1, out):
+    """The bodies of ``ids[k0:k1]`` out of their cell, into ``out``; how many."""
+    n = 0
+    for k in range(k0, k1):
+        b = ids[k]
+        if not (slot[b] >= 0 and keys[slot[b]] == _cell_key(box, b, origin)[1]):
+            out[n] = b
+            n += 1
+    return n
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def left_cells(ids, keys, slot, box, origin, chunks):
+    """The bodies of ``ids`` (boxes already set) whose box is no longer in their cell of
+    the grid, in the order of ``ids``: the only ones :func:`regrid` has to move (a body
+    that stays costs the grid nothing). In ``chunks`` parallel chunks."""
+    n = ids.shape[0]
+    part = np.empty(n, np.int64)
+    if chunks == 1:
+        return part[: _left(ids, keys, slot, box, origin, 0, n, part)]
+    count = np.zeros(chunks, np.int64)
+    for c in prange(chunks):
+        k0 = n * c // chunks
+        count[c] = _left(ids, keys, slot, box, origin, k0, n * (c + 1) // chunks, part[k0:])
+    start = np.zeros(chunks + 1, np.int64)
+    for c in range(chunks):
+        start[c + 1] = start[c] + count[c]
+    out = np.empty(start[chunks], np.int64)
+    for c in prange(chunks):
+        k0 = n * c // chunks
+        out[start[c] : start[c + 1]] = part[k0 : k0 + count[c]]
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -225,53 +261,6 @@ def _meet(box, b, q0, q1, q2, q3):
     return not (box[b, 0] > q1 or box[b, 1] < q0 or box[b, 2] > q3 or box[b, 3] < q2)
 
 
-@njit(cache=True, nogil=True)
-def candidate_pairs(grid, box, eps, tol, alive, n_ids, margin):
-    """Pairs (i, j) of live bodies whose boxes come within their tolerance plus
-    ``margin``: i < j on a shared level, else i on the lower level. Returns (pi, pj).
-    ``grid`` is the broad phase's record (see the module's docstring)."""
-    level = grid[3]
-    cap = 4 * alive.shape[0] + 16
-    pi = np.empty(cap, np.int64)
-    pj = np.empty(cap, np.int64)
-    cand = np.empty(n_ids, np.int64)
-    emax = tol
-    if tol < 0.0:
-        emax = 0.0
-        for k in range(alive.shape[0]):
-            emax = max(emax, eps[alive[k]])
-    n = 0
-    for k in range(alive.shape[0]):
-        i = alive[k]
-        ei = (tol if tol >= 0.0 else eps[i]) + margin
-        d = ei + emax
-        q0 = box[i, 0] - d
-        q1 = box[i, 1] + d
-        q2 = box[i, 2] - d
-        q3 = box[i, 3] + d
-        m = _gather(grid, q0, q1, q2, q3, level[i], n_ids, cand)
-        for t in range(m):
-            j = cand[t]
-            if j == i or (level[j] == level[i] and j < i):
-                continue
-            dj = ei + (tol if tol >= 0.0 else eps[j])
-            if not _meet(box, j, box[i, 0] - dj, box[i, 1] + dj, box[i, 2] - dj,
-                         box[i, 3] + dj):
-                continue
-            if n == cap:
-                cap *= 2
-                pi2 = np.empty(cap, np.int64)
-                pj2 = np.empty(cap, np.int64)
-                pi2[:n] = pi[:n]
-                pj2[:n] = pj[:n]
-                pi = pi2
-                pj = pj2
-            pi[n] = min(i, j)
-            pj[n] = max(i, j)
-            n += 1
-    return pi[:n], pj[:n]
-
-
 @njit(cache=True, nogil=True, inline="always")
 def body_view(xy, ls, lo, nl, b, buf):
     """Rows of body ``b`` and its loop starts relative to them (written into ``buf``)."""
@@ -282,48 +271,217 @@ def body_view(xy, ls, lo, nl, b, buf):
     return xy[first : ls[lo[b] + m]], buf[: m + 1]
 
 
-@njit(cache=True, nogil=True)
-def _classify_range(bodies, tol, pi, pj, vmax, lmax, k0, k1, out):
-    """:func:`_classify_into` for the pairs ``k0:k1``, with buffers for bodies of up to
-    ``vmax`` vertices and ``lmax`` loops."""
-    _classify_into(bodies, tol, pi, pj, k0, k1, out, state_scratch(2 * vmax),
-                   np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+#: What :func:`contact_pairs` returns: the candidate pairs unclassified, the pairs in
+#: contact or penetrating, or every candidate pair classified.
+CANDIDATES = 0
+TOUCHING = 1
+CLASSIFIED = 2
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): per pair it makes four
 # views and passes a dozen arrays to the state kernel, and their atomic reference counts
 # cost ~25 ns per pair. Nothing in it may allocate: the buffers are passed in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _classify_into(bodies, tol, pi, pj, k0, k1, out, scratch, ba, bb):
-    """The states and tolerances (``out``) of the pairs (pi[k], pj[k]), k in ``k0:k1``,
-    with the state kernel's ``scratch`` (``ba``, ``bb``: loop starts of the two
-    bodies)."""
-    xy, ls, lo, nl, _, eps = bodies
-    states, used = out
+def _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers):
+    """The pairs that the live bodies ``alive[k0:k1]`` find in the broad phase, with
+    their states and tolerances, into ``out`` = ``(pi, pj, states, used)`` up to ``cap``
+    of them; returns how many there are (those beyond ``cap`` counted, not written).
+
+    ``settings`` = ``(tol, emax, margin, n_ids, mode)`` (see :func:`contact_pairs`);
+    ``buffers`` = ``(cand, scratch, ba, bb)``: the grid's candidates, the state kernel's
+    scratch and the loop starts of the two bodies. Body i finds j when their boxes come
+    within the pair's tolerance plus ``margin``, j on a higher level than i's or on the
+    same level with j > i (so each pair once); the pair is ``(min, max)``.
+    """
+    xy, ls, lo, nl, box, eps = bodies
+    tol, emax, margin, n_ids, mode = settings
+    level = grid[3]
+    oi, oj, ost, oe = out
+    cand, scratch, ba, bb = buffers
+    n = 0
     for k in range(k0, k1):
-        i = pi[k]
-        j = pj[k]
-        ya, sa = body_view(xy, ls, lo, nl, i, ba)
-        yb, sb = body_view(xy, ls, lo, nl, j, bb)
-        e = tol if tol >= 0.0 else max(eps[i], eps[j])
-        used[k] = e
-        states[k] = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
+        i = alive[k]
+        ei = (tol if tol >= 0.0 else eps[i]) + margin
+        d = ei + emax
+        m = _gather(grid, box[i, 0] - d, box[i, 1] + d, box[i, 2] - d, box[i, 3] + d,
+                    level[i], n_ids, cand)
+        for t in range(m):
+            j = cand[t]
+            if j == i or (level[j] == level[i] and j < i):
+                continue
+            dj = ei + (tol if tol >= 0.0 else eps[j])
+            if not _meet(box, j, box[i, 0] - dj, box[i, 1] + dj, box[i, 2] - dj,
+                         box[i, 3] + dj):
+                continue
+            a = min(i, j)
+            b = max(i, j)
+            e = tol if tol >= 0.0 else max(eps[a], eps[b])
+            state = -1
+            if mode != CANDIDATES:
+                ya, sa = body_view(xy, ls, lo, nl, a, ba)
+                yb, sb = body_view(xy, ls, lo, nl, b, bb)
+                state = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
+                if mode == TOUCHING and state == 0:
+                    continue
+            if n < cap:
+                oi[n] = a
+                oj[n] = b
+                ost[n] = state
+                oe[n] = e
+            n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _chunk_pairs(grid, bodies, settings, alive, k0, k1, out, cap, vmax, lmax):
+    """:func:`_pairs_into` with its buffers, for bodies of up to ``vmax`` vertices and
+    ``lmax`` loops."""
+    buffers = (np.empty(settings[3], np.int64), state_scratch(2 * vmax),
+               np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
+    return _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def classify_pairs(bodies, tol, pi, pj, vmax, lmax, chunks):
-    """States (int8) and tolerances of the pairs (pi[k], pj[k]) of ``bodies`` (the
-    World's record, see the module's docstring), in parallel chunks (``chunks`` = 1:
-    serial, no thread start)."""
-    k_count = pi.shape[0]
-    out = (np.empty(k_count, np.int8), np.empty(k_count))
+def contact_pairs(grid, bodies, tol, alive, n_ids, margin, mode, vmax, lmax, chunks):
+    """The pairs of live bodies whose boxes come within their tolerance plus
+    ``margin``, classified by the state kernel, in parallel chunks of ``alive``
+    (``chunks`` = 1: serial, no thread start): ``(pairs (P, 2), states (P,) int8,
+    tolerances (P,))``, the pairs ``(i, j)`` with i < j, sorted. ``mode``:
+    :data:`CANDIDATES` (every such pair, states -1), :data:`TOUCHING` (those in contact
+    or penetrating) or :data:`CLASSIFIED` (every such pair). ``tol`` < 0: each pair's
+    default tolerance, the larger of its bodies' ``eps``. ``grid`` and ``bodies`` are
+    the World's records (see the module's docstring); ``n_ids`` bounds the ids.
+
+    Each chunk writes its pairs into a buffer of its own, sized for four per body (a
+    chunk that finds more is run again into the output once the counts are known);
+    the counts give each chunk its place in the output, and the pairs are sorted by
+    :func:`sorted_pairs`: the answer does not depend on the chunks.
+    """
+    eps = bodies[5]
+    n = alive.shape[0]
+    emax = tol
+    if tol < 0.0 and chunks == 1:
+        emax = _largest(eps, alive, 0, n)
+    elif tol < 0.0:
+        part = np.empty(chunks)
+        for c in prange(chunks):
+            part[c] = _largest(eps, alive, n * c // chunks, n * (c + 1) // chunks)
+        emax = part.max()
+    settings = (tol, emax, margin, n_ids, mode)
+    cap = 4 * ((n + chunks - 1) // chunks) + 16
+    bi = np.empty((chunks, cap), np.int64)
+    bj = np.empty((chunks, cap), np.int64)
+    bs = np.empty((chunks, cap), np.int8)
+    be = np.empty((chunks, cap))
+    count = np.zeros(chunks, np.int64)
     if chunks == 1:
-        _classify_range(bodies, tol, pi, pj, vmax, lmax, 0, k_count, out)
-        return out
+        m = _chunk_pairs(grid, bodies, settings, alive, 0, n, (bi[0], bj[0], bs[0], be[0]),
+                         cap, vmax, lmax)
+        if m <= cap:
+            return sorted_pairs(bi[0, :m], bj[0, :m], bs[0, :m], be[0, :m], n_ids, 1)
+        out = (np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
+               np.empty(m))
+        _chunk_pairs(grid, bodies, settings, alive, 0, n, out, m, vmax, lmax)
+        return sorted_pairs(out[0], out[1], out[2], out[3], n_ids, 1)
     for c in prange(chunks):
-        _classify_range(bodies, tol, pi, pj, vmax, lmax, k_count * c // chunks,
-                        k_count * (c + 1) // chunks, out)
-    return out
+        count[c] = _chunk_pairs(grid, bodies, settings, alive, n * c // chunks,
+                                n * (c + 1) // chunks, (bi[c], bj[c], bs[c], be[c]), cap,
+                                vmax, lmax)
+    start = np.zeros(chunks + 1, np.int64)
+    for c in range(chunks):
+        start[c + 1] = start[c] + count[c]
+    total = start[chunks]
+    pi = np.empty(total, np.int64)
+    pj = np.empty(total, np.int64)
+    states = np.empty(total, np.int8)
+    used = np.empty(total)
+    for c in prange(chunks):
+        s0 = start[c]
+        s1 = start[c + 1]
+        if s1 - s0 <= cap:
+            pi[s0:s1] = bi[c, : s1 - s0]
+            pj[s0:s1] = bj[c, : s1 - s0]
+            states[s0:s1] = bs[c, : s1 - s0]
+            used[s0:s1] = be[c, : s1 - s0]
+        else:
+            _chunk_pairs(grid, bodies, settings, alive, n * c // chunks,
+                         n * (c + 1) // chunks,
+                         (pi[s0:s1], pj[s0:s1], states[s0:s1], used[s0:s1]), s1 - s0,
+                         vmax, lmax)
+    return sorted_pairs(pi, pj, states, used, n_ids, chunks)
+
+
+@njit(cache=True, nogil=True)
+def _largest(eps, alive, k0, k1):
+    """The largest ``eps`` of the bodies ``alive[k0:k1]`` (0 for none)."""
+    m = 0.0
+    for k in range(k0, k1):
+        m = max(m, eps[alive[k]])
+    return m
+
+
+@njit(cache=True, nogil=True)
+def _order(pi, pj, n_ids):
+    """The order that sorts the distinct pairs ``(pi[k], pj[k])`` (ids below
+    ``n_ids``): by one key where ``pi * n_ids + pj`` fits int64, else by pj then
+    (stably) pi."""
+    if n_ids < 3037000499:  # (n_ids**2 < 2**63)
+        return np.argsort(pi * n_ids + pj)
+    first = np.argsort(pj, kind="mergesort")
+    return first[np.argsort(pi[first], kind="mergesort")]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def sorted_pairs(pi, pj, states, used, n_ids, chunks):
+    """The distinct pairs ``(pi[k], pj[k])`` (ids below ``n_ids``) sorted, as ``(pairs
+    (P, 2), states, used)``, their ``states`` and ``used`` in the same order; in
+    ``chunks`` parallel chunks: the pairs go to ``chunks`` buckets of ``pi`` (counted,
+    then placed, chunk by chunk), and each bucket is sorted apart. The pairs being
+    distinct, the order does not depend on the chunks."""
+    p_count = pi.shape[0]
+    pairs = np.empty((p_count, 2), np.int64)
+    st = np.empty(p_count, np.int8)
+    us = np.empty(p_count)
+    if chunks == 1:
+        order = _order(pi, pj, n_ids)
+        for t in range(p_count):
+            k = order[t]
+            pairs[t, 0] = pi[k]
+            pairs[t, 1] = pj[k]
+            st[t] = states[k]
+            us[t] = used[k]
+        return pairs, st, us
+    # bucket b holds the pairs whose pi is in [n_ids * b / chunks, n_ids * (b + 1) / chunks)
+    count = np.zeros((chunks, chunks), np.int64)
+    for c in prange(chunks):
+        for k in range(p_count * c // chunks, p_count * (c + 1) // chunks):
+            count[c, pi[k] * chunks // n_ids] += 1
+    place = np.empty((chunks, chunks), np.int64)
+    edge = np.empty(chunks + 1, np.int64)
+    w = 0
+    for b in range(chunks):
+        edge[b] = w
+        for c in range(chunks):
+            place[c, b] = w
+            w += count[c, b]
+    edge[chunks] = w
+    src = np.empty(p_count, np.int64)
+    for c in prange(chunks):
+        at = place[c].copy()
+        for k in range(p_count * c // chunks, p_count * (c + 1) // chunks):
+            b = pi[k] * chunks // n_ids
+            src[at[b]] = k
+            at[b] += 1
+    for b in prange(chunks):
+        part = src[edge[b] : edge[b + 1]]
+        order = _order(pi[part], pj[part], n_ids)
+        for t in range(part.shape[0]):
+            k = part[order[t]]
+            pairs[edge[b] + t, 0] = pi[k]
+            pairs[edge[b] + t, 1] = pj[k]
+            st[edge[b] + t] = states[k]
+            us[edge[b] + t] = used[k]
+    return pairs, st, us
 
 
 @njit(cache=True, nogil=True)

@@ -10,8 +10,11 @@ to the bit). The candidate pairs come from the swept broad phase of
 
 The circle tree of each body's edges (:func:`polycontact._kernels.advance.edge_table`)
 is built once, about the body's base rows (:func:`frame_tables`), and turned with the
-body at each step: a rigid turn moves the smallest circles with the points they hold
-(their radii keep their relative margin of 1e-12 over the rounding of the turn).
+body at each step, once per step for all the pairs it is in (:func:`turned_frames`): a
+rigid turn moves the smallest circles with the points they hold (their radii keep
+their relative margin of 1e-12 over the rounding of the turn). A pair whose bounding
+circles overlap at the start and that penetrates there is reported as ``exact_query``
+reports it without turning anything: the bodies at t = 0 are their stored rows.
 
 At the first contact time of a pair (time 0 when it touches or penetrates at the
 start), both bodies are placed and classified, and the contact's point and normal are
@@ -23,12 +26,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .jit import njit
 from .advance import edge_table
-from .contact_geometry import geometry_buffers, pair_geometry_into
-from .impact import exact_query, state_at, tolerance_at, work_floats
+from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
+from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
+from .impact import INITIALLY_PENETRATING, exact_query, state_at, tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, view
+from .relation import PENETRATING, state_in
+from .world import body_view
 
 
 @njit(cache=True, nogil=True)
@@ -64,54 +71,72 @@ def frame_tables(base, bodies, tables):
 
 
 @njit(cache=True, nogil=True)
-def _frame(b, turn, base, tables, scratch):
-    """Body b in its frame turned by ``turn``: its rows and circles written into
-    ``scratch`` = ``(r, circles, r_len, st)``; returns ``(r, starts, table)``, the
-    body and its :func:`polycontact._kernels.advance.edge_table` as
-    :func:`polycontact._kernels.impact.exact_query` takes them."""
+def _turn_body(b, turn, base, tables, frames):
+    """Body b's rows and circles turned by ``turn`` into ``frames`` (see
+    :func:`turned_frames`)."""
     bxy, ls, lo, nl, cen = base
-    tint, tflt, tio, tfo = tables
-    r, circles, r_len, st = scratch
+    tflt, tfo = tables[1], tables[3]
+    rt, lt, ct = frames
     f = ls[lo[b]]
     n = ls[lo[b] + nl[b]] - f
-    m = 2 * n - 1
     cs = math.cos(turn)
     sn = math.sin(turn)
     cx = cen[b, 0]
     cy = cen[b, 1]
-    for i in range(n):
-        dx = bxy[f + i, 0] - cx
-        dy = bxy[f + i, 1] - cy
+    for i in range(f, f + n):
+        dx = bxy[i, 0] - cx
+        dy = bxy[i, 1] - cy
         x = dx * cs - dy * sn
         y = dx * sn + dy * cs
-        r[i, 0] = x
-        r[i, 1] = y
-        r_len[i] = np.sqrt(x * x + y * y)
+        rt[i, 0] = x
+        rt[i, 1] = y
+        lt[i] = np.sqrt(x * x + y * y)
     fo = tfo[b]
-    for q in range(m):
-        x = tflt[fo + 4 * q]
-        y = tflt[fo + 4 * q + 1]
+    for q in range(fo, fo + 4 * (2 * n - 1), 4):
+        x = tflt[q]
+        y = tflt[q + 1]
         u = x * cs - y * sn
         v = x * sn + y * cs
-        circles[q, 0] = u
-        circles[q, 1] = v
-        circles[q, 2] = tflt[fo + 4 * q + 2]
-        circles[q, 3] = np.sqrt(u * u + v * v)
-    for q in range(nl[b] + 1):
-        st[q] = ls[lo[b] + q] - f
-    io = tio[b]
-    links = view(tint, io + n, m, 3, np.int64)
-    return r[:n], st[:nl[b] + 1], (tint[io:io + n], links, circles[:m], r_len[:n])
+        ct[q] = u
+        ct[q + 1] = v
+        ct[q + 2] = tflt[q + 2]
+        ct[q + 3] = np.sqrt(u * u + v * v)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def turned_frames(base, tables, bodies, ang, chunks):
+    """Every body of ``bodies`` turned by its angle ``ang[b]``, once for all the pairs it
+    is in: ``(rt, lt, ct)``, its rows about its centroid
+    and their lengths (laid out as the base rows) and its circles (as ``tables``' floats,
+    from ``tfo[b]``). ``base``, ``tables``: as for :func:`frame_tables`. In parallel
+    chunks (``chunks`` = 1: serial)."""
+    bxy = base[0]
+    tflt = tables[1]
+    frames = (np.empty_like(bxy), np.empty(bxy.shape[0]), np.empty_like(tflt))
+    n = bodies.shape[0]
+    for c in prange(chunks):
+        for k in range(n * c // chunks, n * (c + 1) // chunks):
+            _turn_body(bodies[k], ang[bodies[k]], base, tables, frames)
+    return frames
 
 
 @njit(cache=True, nogil=True)
-def _frame_scratch(vmax, lmax):
-    """Scratch of :func:`_frame` for two bodies of up to ``vmax`` vertices and ``lmax``
-    loops: one record for each."""
-    return ((np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
-             np.empty(lmax + 1, np.int64)),
-            (np.empty((vmax, 2)), np.empty((2 * vmax, 4)), np.empty(vmax),
-             np.empty(lmax + 1, np.int64)))
+def _turned(b, base, tables, frames, st):
+    """Body b as turned by :func:`turned_frames`: ``(r, starts, table)``, its rows about
+    its centroid, loop starts (written into ``st``) and
+    :func:`polycontact._kernels.advance.edge_table`, as
+    :func:`polycontact._kernels.impact.exact_query` takes them."""
+    ls, lo, nl = base[1], base[2], base[3]
+    tint, tio, tfo = tables[0], tables[2], tables[3]
+    rt, lt, ct = frames
+    f = ls[lo[b]]
+    n = ls[lo[b] + nl[b]] - f
+    m = 2 * n - 1
+    for q in range(nl[b] + 1):
+        st[q] = ls[lo[b] + q] - f
+    io = tio[b]
+    return rt[f:f + n], st[:nl[b] + 1], (tint[io:io + n], view(tint, io + n, m, 3, np.int64),
+                                         view(ct, tfo[b], m, 4, np.float64), lt[f:f + n])
 
 
 #: Units of 2**-52 of the terms of the centres' paths allowed for the rounding of
@@ -148,13 +173,18 @@ def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
 
 
 @njit(cache=True, nogil=True)
-def _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, k0, k1, out):
+def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
     """:func:`sweep_search` for the pairs ``k0:k1``, into ``out``."""
     ids, pos, ang, rad, extent, motion = movers
+    base, tables, frames, rows = world
     t_max, inflate, time_tol, rel, ulps, resolution, max_iter = settings
     code, t_hi, t_contact, state = out
-    fa, fb = _frame_scratch(vmax, lmax)
+    sa = np.empty(lmax + 1, np.int64)
+    sb = np.empty(lmax + 1, np.int64)
     work = np.empty(work_floats(2 * vmax))
+    iv = np.empty((MAX_INTERVALS, 2))
+    bw = np.empty(BROAD_PHASE_FLOATS)
+    scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
     for k in range(k0, k1):
         a = ids[pi[k]]
         b = ids[pj[k]]
@@ -166,10 +196,25 @@ def _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, k0, k1, ou
             t_contact[k] = -1.0
             state[k] = 0
             continue
-        r1, s1, e1 = _frame(a, ang[a], base, tables, fa)
-        r2, s2, e2 = _frame(b, ang[b], base, tables, fb)
-        query = (t_max, inflate, time_tol, rel * max(extent[a], extent[b]), ulps,
-                 resolution * (rad[a] + rad[b]), max_iter, 0)
+        rel_k = rel * max(extent[a], extent[b])
+        # exact_query's first step where the bounding circles overlap at the start: the
+        # state at t = 0, of the bodies placed there, which are their stored rows
+        n = overlap_intervals_into(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate,
+                                   iv, bw)
+        if n > 0 and iv[0, 0] == 0.0:
+            ya, s1 = body_view(rows[0], rows[1], rows[2], rows[3], a, sa)
+            yb, s2 = body_view(rows[0], rows[1], rows[2], rows[3], b, sb)
+            eps = tolerance_at(pos[a], ma, rad[a], pos[b], mb, rad[b], 0.0, rel_k, ulps)
+            if state_in(ya, s1, 1.0, yb, s2, 1.0, eps, scratch) == PENETRATING:
+                code[k] = INITIALLY_PENETRATING
+                t_hi[k] = 0.0
+                t_contact[k] = 0.0
+                state[k] = 2
+                continue
+        r1, s1, e1 = _turned(a, base, tables, frames, sa)
+        r2, s2, e2 = _turned(b, base, tables, frames, sb)
+        query = (t_max, inflate, time_tol, rel_k, ulps, resolution * (rad[a] + rad[b]),
+                 max_iter, 0)
         got = exact_query((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
                           query, work)
         c = got[1]
@@ -183,19 +228,20 @@ def _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, k0, k1, ou
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def sweep_search(pi, pj, movers, base, tables, settings, vmax, lmax, chunks):
+def sweep_search(pi, pj, movers, base, tables, frames, rows, settings, vmax, lmax, chunks):
     """The exact time-of-impact search of each candidate pair (``ids[pi[k]]``,
     ``ids[pj[k]]``) over [0, ``t_max``], in parallel chunks (``chunks`` = 1: serial).
 
     ``movers`` = ``(ids, pos, ang, rad, extent, motion)``: the World's ids of the
     moving bodies, and by id each body's position (its centroid), angle, bounding
     radius and box extent; ``motion`` holds the rows ``[vx, vy, ax, ay, ω, α]``,
-    indexed like ``ids``. ``base``, ``tables``: as for :func:`frame_tables`.
-    ``settings`` = ``(t_max, inflate, time_tol, rel, ulps, resolution, max_iter)``:
-    those of :func:`polycontact._kernels.impact.exact_query`, with the relative terms
-    of the distance tolerance and of the contact resolution (times each pair's larger
-    extent, and its sum of radii). ``vmax``, ``lmax``: the most vertices and loops of a
-    body.
+    indexed like ``ids``. ``base``, ``tables``: as for :func:`frame_tables`;
+    ``frames``: the bodies turned by :func:`turned_frames`; ``rows``: the World's stored
+    rows ``(xy, ls, lo, nl)``. ``settings`` = ``(t_max, inflate, time_tol, rel,
+    ulps, resolution, max_iter)``: those of
+    :func:`polycontact._kernels.impact.exact_query`, with the relative terms of the
+    distance tolerance and of the contact resolution (times each pair's larger extent,
+    and its sum of radii). ``vmax``, ``lmax``: the most vertices and loops of a body.
 
     Returns ``(code, t_hi, t_contact, state)``: the search's status code and
     penetration time (as ``exact_query``), the first contact time (0 when penetrating
@@ -205,59 +251,80 @@ def sweep_search(pi, pj, movers, base, tables, settings, vmax, lmax, chunks):
     n = pi.shape[0]
     out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8))
     if chunks == 1:
-        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, 0, n, out)
+        _search_range(pi, pj, movers, (base, tables, frames, rows), settings, vmax, lmax, 0,
+                      n, out)
         return out
     for c in prange(chunks):
-        _search_range(pi, pj, movers, base, tables, settings, vmax, lmax, n * c // chunks,
-                      n * (c + 1) // chunks, out)
+        _search_range(pi, pj, movers, (base, tables, frames, rows), settings, vmax, lmax,
+                      n * c // chunks, n * (c + 1) // chunks, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _event_range(events, base, tables, vmax, lmax, ulps, k0, k1, point, normal):
-    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``."""
+def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
+    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``.
+    The two bodies of an event are placed side by side as the rows of a World of two
+    (``rows``, one pair), for :func:`polycontact._kernels.contact_geometry.geometry_into`."""
     pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb = events
-    fa, fb = _frame_scratch(vmax, lmax)
-    xa = np.empty((vmax, 2))
-    xb = np.empty((vmax, 2))
+    base, tables, frames = world
+    fa = np.empty(lmax + 1, np.int64)
+    fb = np.empty(lmax + 1, np.int64)
+    xy = np.empty((2 * vmax, 2))
+    ls = np.empty(2 * lmax + 1, np.int64)
+    lo = np.zeros(2, np.int64)
+    nl = np.empty(2, np.int64)
+    rows = (xy, ls, lo, nl)
+    pair = (np.zeros(1, np.int64), np.ones(1, np.int64), np.empty(1, np.int8), np.empty(1))
     scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
     buffers = geometry_buffers(vmax)
-    m = k1 - k0
-    dist = np.empty(m)
-    gout = (dist, normal[k0:k1], point[k0:k1], np.empty(m), np.empty((m, 2)),
-            np.empty(m, np.int8), np.empty(m, np.int64), np.empty(m, np.int64))
+    ba = np.empty(lmax + 1, np.int64)
+    bb = np.empty(lmax + 1, np.int64)
+    dist = np.empty(1)
+    rest = (np.empty(1), np.empty((1, 2)), np.empty(1, np.int8), np.empty(1, np.int64),
+            np.empty(1, np.int64))
     for k in range(k0, k1):
-        r1, s1, _ = _frame(pa[k], ta[k], base, tables, fa)
-        r2, s2, _ = _frame(pb[k], tb[k], base, tables, fb)
+        r1, s1, _ = _turned(pa[k], base, tables, frames, fa)
+        r2, s2, _ = _turned(pb[k], base, tables, frames, fb)
+        n1 = r1.shape[0]
+        n2 = r2.shape[0]
+        nl[0] = s1.shape[0] - 1
+        nl[1] = s2.shape[0] - 1
+        lo[1] = nl[0]
+        ls[:nl[0] + 1] = s1
+        ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
         t = times[k]
-        ya = xa[:r1.shape[0]]
-        yb = xb[:r2.shape[0]]
         eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
-        now = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t, eps,
-                       (ya, yb, scratch))
-        pair_geometry_into(ya, s1, yb, s2, now, eps, buffers, gout, k - k0)
-        if not dist[k - k0] == dist[k - k0]:  # a depth left undecided: for the caller
+        pair[2][0] = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t,
+                              eps, (xy[:n1], xy[n1:n1 + n2], scratch))
+        pair[3][0] = eps
+        out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
+        while True:
+            done, status = geometry_into(rows, pair, 0, 1, out, buffers, ba, bb)
+            if done == 1:
+                break
+            buffers = grown_buffers(buffers, status, vmax)
+        if not dist[0] == dist[0]:  # a depth left undecided: for the caller
             normal[k, 0] = np.nan
             normal[k, 1] = np.nan
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def event_geometry(events, base, tables, vmax, lmax, ulps, chunks):
+def event_geometry(events, base, tables, frames, vmax, lmax, ulps, chunks):
     """The contact point and normal of each event of ``events`` = ``(pa, pb, times, ca,
     cb, ta, tb, la, lb, eps_rel, ma, mb)``: bodies ``pa[k]`` and ``pb[k]`` at
     ``times[k]``, each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]``
     (``tb[k]``) with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact
     search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``) and
     described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
-    normals where the depth is left undecided. ``base``, ``tables``: as for
-    :func:`frame_tables`. In parallel chunks."""
+    normals where the depth is left undecided. ``base``, ``tables``, ``frames``: as for
+    :func:`sweep_search`, the bodies turned by those turns. In parallel chunks."""
     n = events[0].shape[0]
     point = np.full((n, 2), np.nan)
     normal = np.full((n, 2), np.nan)
     if chunks == 1:
-        _event_range(events, base, tables, vmax, lmax, ulps, 0, n, point, normal)
+        _event_range(events, (base, tables, frames), vmax, lmax, ulps, 0, n, point, normal)
         return point, normal
     for c in prange(chunks):
-        _event_range(events, base, tables, vmax, lmax, ulps, n * c // chunks,
+        _event_range(events, (base, tables, frames), vmax, lmax, ulps, n * c // chunks,
                      n * (c + 1) // chunks, point, normal)
     return point, normal

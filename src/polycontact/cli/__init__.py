@@ -8,10 +8,9 @@ the ``ValueError`` or ``TypeError`` with which the library refuses an argument: 
 argument comes from the user's files and options) and printed as one line on stderr
 with exit status 2, never as a traceback.
 
-Once a command has read its input, and before it computes, kernels not compiled yet (a
-first run) are compiled with a notice and one line per kernel family on stderr, never
-stdout, so ``--json`` output stays parseable (:func:`._progress.compile_if_cold`); a
-wrong input is refused before any compiling.
+A command compiles only the kernels its job calls, on their first call (a first run),
+and the library's compile notice says so once on stderr, never stdout, so ``--json``
+output stays parseable (see :mod:`polycontact.compiling`).
 """
 
 from __future__ import annotations

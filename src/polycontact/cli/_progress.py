@@ -23,19 +23,9 @@ from contextlib import contextmanager
 from ..limits import NOTICE_AFTER
 from ._errors import CommandError
 
-__all__ = ["announced", "compile_if_cold", "notice_delay", "progress_line"]
+__all__ = ["announced", "notice_delay", "progress_line"]
 
 _VARIABLE = "POLYCONTACT_NOTICE_AFTER"
-
-#: The kernel families (:data:`polycontact.compiling.FAMILIES`) each command runs.
-_NEEDS = {
-    "classify": ("classification",),
-    "collide": ("classification", "time of impact", "many moving bodies"),
-    "entrance-block": ("classification", "entrance block"),
-    "nfp": ("no-fit polygon",),
-    "contacts": ("classification",),
-    "nfp-table": ("no-fit polygon",),
-}
 
 
 def notice_delay() -> float:
@@ -100,22 +90,6 @@ def announced(what: str) -> Iterator[None]:
             state["over"] = True
             if state["said"] and ok:
                 _say(f"{what}: done in {time.perf_counter() - t0:.1f} s")
-
-
-def compile_if_cold(command: str) -> None:
-    """Compile the kernels ``command`` runs if they are not in the cache yet (a first
-    run), saying so on stderr with one line per kernel family; nothing when they are.
-
-    Commands call it once their input is read, so that a wrong input is refused at once.
-    """
-    from ..compiling import cache_directory, is_warm, warmup
-
-    families = _NEEDS[command]
-    if is_warm(families):
-        return
-    _say("compiling kernels, first run only, about a minute "
-         f"(cached in {cache_directory()})")
-    warmup(families, progress=progress_line)
 
 
 def progress_line(family: str, k: int, n: int, seconds: float | None) -> None:

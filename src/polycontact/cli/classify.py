@@ -8,7 +8,7 @@ import sys
 from typing import Any
 
 from ._io import BODY_FILE_FORMS, index_text, non_negative_number, read_shape
-from ._progress import announced, compile_if_cold
+from ._progress import announced
 
 
 def add_parser(subparsers: Any) -> None:
@@ -66,7 +66,6 @@ def run(args: argparse.Namespace) -> int:
     for path, shape in ((args.a, a), (args.b, b)):
         for note in shape.repairs:
             print(f"polycontact classify: repaired {path}: {note}", file=sys.stderr)
-    compile_if_cold("classify")
     bodies = f"{args.a} ({a.n_vertices} vertices) and {args.b} ({b.n_vertices} vertices)"
     with announced(f"classifying {bodies}"):
         relation = classify(a, b, tolerance=args.tolerance)

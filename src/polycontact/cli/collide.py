@@ -14,7 +14,7 @@ from ..errors import InvalidSceneError
 from ..limits import SAMPLES, TIME_TOLERANCE
 from ._errors import CommandError
 from ._io import index_text, integer_at_least, plotting, positive_number, save_figure
-from ._progress import announced, compile_if_cold
+from ._progress import announced
 
 #: What a scene is, in one line (for the message about a body file given instead).
 SCENE_IN_A_LINE = ('a JSON object {"t_max": ..., "bodies": [...]}: two or more bodies, '
@@ -126,7 +126,6 @@ def run(args: argparse.Namespace) -> int:
         for note in body.shape.repairs:
             print(f"polycontact collide: repaired {body.name}: {note}",
                   file=sys.stderr)
-    compile_if_cold("collide")
     options = {"method": args.method, "time_tolerance": args.time_tolerance,
                "samples": args.samples}
     bodies = f"{len(scene.bodies)} bodies ({sum(b.shape.n_vertices for b in scene.bodies)} " \

@@ -13,7 +13,7 @@ from .._json import load_json
 from ..errors import InvalidShapeError
 from ._errors import CommandError
 from ._io import non_negative_number, plotting, save_figure
-from ._progress import announced, compile_if_cold
+from ._progress import announced
 
 
 def add_parser(subparsers: Any) -> None:
@@ -120,7 +120,6 @@ def run(args: argparse.Namespace) -> int:
         plotting()
     container, bodies, names = read_layout(datasets.locate(args.layout, "layouts"),
                                            progress=not args.no_progress)
-    compile_if_cold("contacts")
     world = World(container)
     with announced(f"finding the contacts of {len(bodies)} bodies"):
         world.add_many(bodies, names=names)

@@ -9,7 +9,7 @@ import sys
 from typing import Any
 
 from ._io import plotting, read_shape, save_figure
-from ._progress import announced, compile_if_cold
+from ._progress import announced
 from .classify import relation_text
 
 _FAMILIES = (("A2-B0", "E(A(2), B(0))"), ("A0-B2", "E(A(0), B(2))"), ("A1-B1", "E(A(1), B(1))"))
@@ -73,7 +73,6 @@ def run(args: argparse.Namespace) -> int:
     for path, shape in ((args.a, a), (args.b, b)):
         for note in shape.repairs:
             print(f"polycontact entrance-block: repaired {path}: {note}", file=sys.stderr)
-    compile_if_cold("entrance-block")
     with announced(f"building the entrance block of A {args.a} ({a.n_vertices} vertices) "
                    f"to B {args.b} ({b.n_vertices} vertices)"):
         block = entrance_block(a, b, args.reference, method=args.method)

@@ -8,7 +8,7 @@ import math
 from typing import Any
 
 from ._io import BODY_FILE_FORMS, plotting, positive_number, read_shape, save_figure
-from ._progress import announced, compile_if_cold
+from ._progress import announced
 
 
 def _reference(text: str) -> Any:
@@ -66,7 +66,6 @@ def run(args: argparse.Namespace) -> int:
         plotting()
     a = read_shape(args.a, repair=args.repair)
     b = read_shape(args.b, repair=args.repair)
-    compile_if_cold("nfp")
     bodies = f"A {args.a} ({a.n_vertices} vertices) and B {args.b} ({b.n_vertices} vertices)"
     if args.inner:
         with announced(f"computing the inner-fit polygon of {bodies}"):

@@ -11,7 +11,6 @@ from typing import Any
 from .. import datasets
 from ._errors import CommandError
 from ._io import integer_at_least
-from ._progress import compile_if_cold
 
 
 def _angle(text: str) -> float:
@@ -57,7 +56,6 @@ def run(args: argparse.Namespace) -> int:
     from ..nfp_tables import nfp_table
 
     instance = read_esicup(datasets.locate(args.instance, "esicup"))
-    compile_if_cold("nfp-table")
     client: Any = None
     if args.scheduler is not None:
         try:

@@ -1,0 +1,128 @@
+"""Kernels: the bodies of many time-of-impact pairs prepared at once, in parallel.
+
+:func:`body_tables` builds every distinct body's arguments of the exact search (its
+vertices about its centroid, circle tree and lengths: what
+:func:`polycontact._kernels.impact.pack_body` packs for one body, the same arrays bit
+for bit) into two flat arrays, each body at offsets known beforehand;
+:func:`suspect_bodies` marks the bodies whose coordinates or motion may be beyond the
+range the kernels take, for the caller to check exactly and refuse.
+
+Bodies are packed as ``xy`` (V, 2) float64, every body's loops one after another,
+``rows`` (U + 1,) the first row of each body, and ``starts`` with ``st_off`` (U + 1,):
+body u's loop starts (0 first, its vertex count last) are
+``starts[st_off[u]:st_off[u + 1]]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from .jit import njit
+from .advance import edge_table
+from .impact import pack_body
+
+
+@njit(cache=True, nogil=True)
+def table_sizes(rows, st_off):
+    """Offsets of each body's floats and ints in :func:`body_tables`' arrays: a body of
+    n vertices and k loop starts takes ``11 n - 1`` floats and ``7 n + k`` ints (those
+    of ``pack_body`` with its tree of ``2 n - 1`` nodes)."""
+    u_count = rows.shape[0] - 1
+    f_off = np.zeros(u_count + 1, np.int64)
+    i_off = np.zeros(u_count + 1, np.int64)
+    for u in range(u_count):
+        n = rows[u + 1] - rows[u]
+        f_off[u + 1] = f_off[u] + 11 * n - 1
+        i_off[u + 1] = i_off[u] + 7 * n + st_off[u + 1] - st_off[u]
+    return f_off, i_off
+
+
+@njit(cache=True, nogil=True)
+def _body_into(xy, rows, starts, st_off, centroids, radii, u, f_out, i_out):
+    """Body u's ``pack_body`` arrays, written into ``f_out`` and ``i_out``."""
+    r0 = rows[u]
+    n = rows[u + 1] - r0
+    r = np.empty((n, 2))
+    for i in range(n):
+        r[i, 0] = xy[r0 + i, 0] - centroids[u, 0]
+        r[i, 1] = xy[r0 + i, 1] - centroids[u, 1]
+    st = starts[st_off[u] : st_off[u + 1]]
+    f, ints = pack_body(r, st, centroids[u], radii[u], edge_table(r, st))
+    f_out[:] = f
+    i_out[:] = ints
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def body_tables(xy, rows, starts, st_off, centroids, radii, chunks):
+    """Every body's :func:`polycontact._kernels.impact.pack_body` arrays, one after
+    another: ``(floats, f_off, ints, i_off)`` (body u's at ``floats[f_off[u]:f_off[u +
+    1]]`` and ``ints[i_off[u]:i_off[u + 1]]``), as ``impacts_chunk`` reads them; in
+    ``chunks`` parallel chunks (1: serial, no thread start). ``centroids`` (U, 2) and
+    ``radii`` (U,): each body's area centroid and bounding radius."""
+    u_count = rows.shape[0] - 1
+    f_off, i_off = table_sizes(rows, st_off)
+    floats = np.empty(f_off[u_count])
+    ints = np.empty(i_off[u_count], np.int64)
+    if chunks == 1:
+        for u in range(u_count):
+            _body_into(xy, rows, starts, st_off, centroids, radii, u,
+                       floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
+        return floats, f_off, ints, i_off
+    for c in prange(chunks):
+        for u in range(u_count * c // chunks, u_count * (c + 1) // chunks):
+            _body_into(xy, rows, starts, st_off, centroids, radii, u,
+                       floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
+    return floats, f_off, ints, i_off
+
+
+@njit(cache=True, nogil=True)
+def _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k):
+    """Whether body k (shape ``owner[k]`` moving with ``motions[k]``) may be refused:
+    see :func:`suspect_bodies`."""
+    u = owner[k]
+    x0 = math.inf
+    x1 = -math.inf
+    y0 = math.inf
+    y1 = -math.inf
+    for i in range(rows[u], rows[u + 1]):
+        x0 = min(x0, xy[i, 0])
+        x1 = max(x1, xy[i, 0])
+        y0 = min(y0, xy[i, 1])
+        y1 = max(y1, xy[i, 1])
+    extent = max(x1 - x0, y1 - y0)
+    margin = 1.0 - 1e-9  # (the exact check rounds differently: a margin, then that check)
+    if not max(-x0, x1, -y0, y1) <= limit * margin or (0.0 < extent < floor / margin):
+        return True
+    m = motions[k]
+    v = math.hypot(m[0], m[1])
+    a = math.hypot(m[2], m[3])
+    w = abs(m[4])
+    alpha = abs(m[5])
+    radius = radii[u]
+    base = max(abs(centroids[u, 0]), abs(centroids[u, 1])) + radius
+    w_max = w + alpha * t_max
+    reach = base + v * t_max + 0.5 * a * t_max * t_max
+    speed = v + a * t_max + w_max * radius
+    accel = a + (alpha + w_max * w_max) * radius
+    bound = limit * margin
+    return not (reach <= bound and speed <= bound and accel <= bound and w_max <= bound)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, chunks):
+    """For each body k (shape ``owner[k]`` of the packing, moving with the kernel vector
+    ``motions[k]``): True when its coordinates may lie beyond ``limit`` or its extent
+    below ``floor``, or when within ``[0, t_max]`` its coordinates, its points' speeds
+    or accelerations or its angular speed may exceed ``limit`` (the bounds of
+    ``polycontact.broad_phase.reach_excess``, with a margin of 1e-9 of the limit for the
+    rounding); in ``chunks`` parallel chunks."""
+    k_count = owner.shape[0]
+    out = np.zeros(k_count, np.bool_)
+    for c in prange(chunks):
+        for k in range(k_count * c // chunks, k_count * (c + 1) // chunks):
+            out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit,
+                              floor, k)
+    return out

@@ -1,0 +1,104 @@
+"""The local worker processes of an NFP-table build end when their parent dies, killed
+or not: none (nor the resource tracker they keep alive) is left behind."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import polycontact
+
+SRC = str(Path(polycontact.__file__).resolve().parents[1])  # the code under test
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc (Linux)"),
+]
+
+
+def _processes() -> dict[int, tuple[int, str, str]]:
+    """pid -> (parent pid, state, command line) of every process."""
+    out = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmd = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()
+        out[int(entry.name)] = (int(fields[1]), fields[0], cmd)
+    return out
+
+
+def _descendants(pid: int) -> dict[int, str]:
+    procs = _processes()
+    found: dict[int, str] = {}
+    todo = [pid]
+    while todo:
+        parent = todo.pop()
+        for p, (pp, _, cmd) in procs.items():
+            if pp == parent and p not in found:
+                found[p] = cmd
+                todo.append(p)
+    return found
+
+
+def _alive(pids) -> list[int]:
+    procs = _processes()
+    return [p for p in pids if p in procs and procs[p][1] != "Z"]  # a zombie has ended
+
+
+def _instance(path: Path) -> Path:
+    """Enough pieces and orientations (518 400 entries) for a build of many seconds on
+    two processes: it is still running when the parent is killed."""
+    rng = np.random.default_rng(3)
+    items = []
+    for k in range(20):
+        n = 10
+        t = 2 * np.pi * np.arange(n) / n
+        r = rng.uniform(0.5, 1.5, n)
+        ring = np.c_[r * np.cos(t), r * np.sin(t)] * 10
+        items.append({"id": k, "demand": 1, "allowed_orientations": list(range(0, 360, 10)),
+                      "shape": {"type": "simple_polygon", "data": ring.tolist()}})
+    path.write_text(json.dumps({"name": "long", "strip_height": 100, "items": items}))
+    return path
+
+
+def test_killing_a_table_build_leaves_no_worker_alive(tmp_path):
+    inst = _instance(tmp_path / "long.json")
+    build = subprocess.Popen(
+        [sys.executable, "-m", "polycontact", "nfp-table", str(inst), "--out",
+         str(tmp_path / "out"), "--workers", "2", "--no-progress"],
+        env={**os.environ, "PYTHONPATH": SRC}, stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL)
+    children: dict[int, str] = {}
+    try:
+        deadline = time.monotonic() + 300
+        workers: list[int] = []
+        while time.monotonic() < deadline and build.poll() is None:
+            children = _descendants(build.pid)
+            workers = [p for p, cmd in children.items() if "spawn_main" in cmd]
+            if len(workers) == 2 and list((tmp_path / "out" / "shards").glob("*.json")):
+                break  # both workers started, and at work
+            time.sleep(0.2)
+        assert build.poll() is None and len(workers) == 2, (build.poll(), children)
+        os.kill(build.pid, signal.SIGKILL)
+        build.wait()
+        time.sleep(10)
+        assert _alive(children) == [], {p: children[p] for p in _alive(children)}
+    finally:
+        if build.poll() is None:
+            build.kill()
+            build.wait()
+        for pid in _alive(children):  # (only when the test failed: ours to end)
+            os.kill(pid, signal.SIGKILL)
