@@ -132,7 +132,8 @@ def test_overlap_of_shared_and_collinear_boundaries():
 @examples(100)
 @given(placed, placed, frames)
 def test_closest_features_give_the_gap_of_bodies_apart(sa, sb, frame):
-    a, b = make(sa, frame), make((sb[0], sb[1] + 9.0, sb[2], sb[3]), frame)  # apart
+    # apart: B moved past the widest reach of any turned shape (the L spans 3, the star 1.6)
+    a, b = make(sa, frame), make((sb[0], sb[1] + 20.0, sb[2], sb[3]), frame)
     (xa, sta), (xb, stb) = a.packed, b.packed
     gap, ax, ay, bx, by, side, v, f = kg.closest_features(xa, sta, xb, stb)
     # bodies that touch (gap 0 for GEOS) may be a few float spacings apart here
