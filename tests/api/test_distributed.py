@@ -13,6 +13,8 @@ from polycontact import distributed as pd
 from polycontact import impacts
 from polycontact.esicup import turned
 
+from .test_pose_arguments import BAD_NUMBERS, BAD_POINTS
+
 distributed = pytest.importorskip("distributed")
 
 pytestmark = pytest.mark.slow  # a cluster of worker processes
@@ -286,3 +288,26 @@ def test_tasks_are_sized_from_a_first_task(client):
 
 def _total(_, task):
     return int(np.sum(task))
+
+
+def test_poses_and_motions_given_to_the_cluster_are_checked_before_any_task(client):
+    """The property of the pose checks (every value that is not a finite real number in
+    range refused, naming the argument) holds with a client too, and nothing is sent."""
+    sq = pc.Shape(SQUARE)
+    tasks = client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+    for bad in BAD_POINTS:
+        with pytest.raises((TypeError, ValueError), match="motions_a"):
+            pc.time_of_impact_many([sq], [bad], [sq.moved((3, 0))], [pc.Motion()], t_max=5.0,
+                                   client=client)
+    for bad in BAD_NUMBERS:
+        with pytest.raises((TypeError, ValueError), match="motions_a"):
+            pc.time_of_impact_many([sq], [[bad, 0, 0, 0, 0, 0]], [sq.moved((3, 0))],
+                                   [pc.Motion()], t_max=5.0, client=client)
+        with pytest.raises((TypeError, ValueError), match="t_max"):
+            pc.time_of_impact_many([sq], [pc.Motion(velocity=(1, 0))], [sq.moved((3, 0))],
+                                   [pc.Motion()], t_max=bad, client=client)
+        if isinstance(bad, float) and abs(bad) > 1e100:
+            continue  # a finite angle of any size is one
+        with pytest.raises((TypeError, ValueError), match="orientations"):
+            pc.nfp_table([sq], [[bad]], client=client, progress=False)
+    assert client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) <= tasks
