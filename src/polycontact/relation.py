@@ -213,8 +213,9 @@ class Relation:
         Unit vector from A towards B. Contact: the normal of a touched edge, one that
         keeps the touching vertex's own edges on its side (so at a vertex-on-vertex
         touch of flush edges it is the flush edge's normal), preferring the touch
-        farthest from the edge's ends. Penetrating:
-        the direction opposite the smallest separating translation of A. Separate: None.
+        farthest from the edge's ends (on a tie, such as a vertex on a vertex, the
+        first: A's vertices before B's). :meth:`World.contacts` gives the same.
+        Penetrating: the direction opposite the smallest separating translation of A. Separate: None.
     escape : ndarray of shape (2,) or None
         Penetrating only: the smallest translation of A that ends the overlap.
 
@@ -420,31 +421,11 @@ class Relation:
         if self.state is State.PENETRATING:
             d = -np.asarray(self._penetration[1:])
             return cast("np.ndarray", d / np.hypot(*d) + 0.0)
-        xa, sa, xb, sb = self._packed
-        a_on, b_on, _, _, _ = self._raw_features
-        best = None
-        # A vertex of A on an edge of B: B's inward normal; a vertex of B on an edge of
-        # A: A's outward normal. A candidate must keep the touching vertex's own edges
-        # on its side (so a square's corner on the end of a flush edge does not offer
-        # the normal of the perpendicular edge); among those, prefer the touch farthest
-        # from the ends of the edge.
-        for xv, sv, xo, so, rows, sign in ((xa, sa, xb, sb, a_on, 1.0), (xb, sb, xa, sa, b_on, -1.0)):
-            for v, e, _ in rows:
-                k, ei = _local(so, e)
-                loop = xo[so[k] : so[k + 1]]
-                p, q = loop[ei], loop[(ei + 1) % len(loop)]
-                u = q - p
-                length = float(np.hypot(*u))
-                n = sign * np.array([-u[1], u[0]]) / length + 0.0
-                t = float(np.dot(xv[v] - p, u)) / length
-                kv, vi = _local(sv, v)
-                own = xv[sv[kv] : sv[kv + 1]]
-                rays = own[[(vi - 1) % len(own), (vi + 1) % len(own)]] - own[vi]
-                fits = bool(np.all(sign * (rays @ n) <= 1e-9 * np.hypot(rays[:, 0], rays[:, 1])))
-                score = (fits, min(t, length - t))
-                if best is None or score > best[0]:
-                    best = (score, n)
-        return None if best is None else best[1]
+        from ._kernels.features import touch
+
+        # the touch World.contacts gives too (see that kernel for the rule)
+        nx, ny, side, _, _ = touch(*self._packed, self.tolerance)
+        return None if side < 0 else np.array([nx, ny])
 
 
 def _read_only(arr: np.ndarray) -> np.ndarray:
@@ -456,11 +437,6 @@ def _read_only(arr: np.ndarray) -> np.ndarray:
 def _xy(p: np.ndarray | None) -> list[float] | None:
     """A point or vector as a JSON-ready ``[x, y]`` (None stays None)."""
     return None if p is None else [float(v) for v in p]
-
-
-def _local(starts: np.ndarray, g: int) -> tuple[int, int]:
-    k = int(np.searchsorted(starts, g, side="right")) - 1
-    return k, int(g - starts[k])
 
 
 def _to_shape(src: Any) -> Shape:

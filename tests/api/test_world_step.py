@@ -253,7 +253,7 @@ def check_pair(c: pc.Contacts, k: int, world: pc.World, margin: float) -> None:
                 <= 1e-6 * size
         assert inter.boundary.distance(shapely.Point(p)) <= 8 * tol
     elif c.states[k] == 1:
-        assert np.allclose(n, r.normal, atol=1e-12)
+        assert np.array_equal(n, r.normal), (n, r.normal)
         assert segment_distance(vertex, *edge) <= tol
         assert sa.boundary.distance(shapely.Point(p)) <= tol
         assert sb.boundary.distance(shapely.Point(p)) <= tol
@@ -284,6 +284,18 @@ def test_every_geometry_array_equals_classify_and_shapely(spec, frame, margin):
                 min_size=2, max_size=8), frames)
 def test_geometry_of_exact_contacts_on_a_grid(spec, frame):
     """Flush edges, vertices on vertices, identical bodies: contacts by construction."""
+    check_grid(spec, frame)
+
+
+def test_a_vertex_on_vertex_touch_gets_classify_s_normal():
+    """A clockwise square's corner on a star's tip: two touches fit (the square's side,
+    the star's edge), both end at the shared vertex; World and classify pick the same."""
+    check_grid([(3, 0, 3, 0.0), (5, 4, 2, math.pi)], (1000.0, 0.0))
+
+
+def check_grid(spec, frame):
+    """Bodies ``spec`` = (template, x, y, angle) on a grid of half-sizes in ``frame`` =
+    (scale, shift): every pair of World.contacts is checked by :func:`check_pair`."""
     scale, shift = frame
     items = [body(t, scale, "shape") for t, *_ in spec]
     world = pc.World()

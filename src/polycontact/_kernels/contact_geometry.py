@@ -5,9 +5,8 @@ For each pair of bodies (packed as in :mod:`polycontact._kernels.world`), by its
 - **separate** (a near pair): the gap between the boundaries, the unit vector from A's
   closest point to B's, their midpoint, and the vertex and edge that hold the gap;
 - **contact**: distance 0; the touch that :attr:`polycontact.Relation.normal` chooses
-  (a vertex within the tolerance of an edge of the other body, preferring one whose own
-  edges stay on their side of the edge, then the one farthest from the edge's ends),
-  its edge's normal from A towards B and the touching vertex;
+  (:func:`polycontact._kernels.features.touch`), its edge's normal from A towards B
+  and the touching vertex;
 - **penetrating**: minus the penetration depth, the unit vector opposite A's smallest
   escape, from the contact segment the escape lies on
   (:func:`polycontact._kernels.convolution.contact_depth_into`), the vertex and edge of
@@ -36,9 +35,10 @@ from .jit import njit
 from .convolution import DEPTH_MORE_ROWS, DEPTH_UNDECIDED, FEW_VERTICES, contact_depth_of, \
     depth_buffers
 from .depth import box_escape
+from .features import touch
 from .overlap import overlap_moments, overlap_of_tables, overlap_scratch
 from .packs import scratch_floats
-from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next, loop_prev
+from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next
 from .relation import NO_WITNESS, moved_state
 from .world import body_view
 
@@ -99,60 +99,6 @@ def closest_features(xa, sa, xb, sb):
                             out = (d, px, py, qx, qy, 0, i, f)
                         else:
                             out = (d, qx, qy, px, py, 1, i, f)
-    return out
-
-
-@njit(cache=True, nogil=True, _nrt=False)
-def touch(xa, sa, xb, sb, eps):
-    """The touch of two bodies in contact that :attr:`polycontact.Relation.normal`
-    chooses: ``(nx, ny, side, vertex, edge)``, the unit normal from A towards B (B's
-    inward normal under a vertex of A, A's outward normal under a vertex of B), or
-    ``side`` -1 when no vertex lies within ``eps`` of an edge of the other body.
-
-    Candidates are taken in the order of :func:`polycontact._kernels.relation.features`
-    (A's vertices, then B's; each against the other's edges) and scored as the Relation
-    does: first whether the touching vertex's own edges stay on their side (within
-    1e-9 of their length), then the distance of the touch from the edge's nearer end.
-    """
-    best_fits = False
-    best_t = -np.inf
-    out = (np.nan, np.nan, -1, -1, -1)
-    for side in range(2):
-        xv, sv, xo, so = (xa, sa, xb, sb) if side == 0 else (xb, sb, xa, sa)
-        sign = 1.0 if side == 0 else -1.0
-        no = so[so.shape[0] - 1]
-        ox0, ox1, oy0, oy1 = bbox(xo, no)
-        for kv in range(sv.shape[0] - 1):
-            for i in range(sv[kv], sv[kv + 1]):
-                px = xv[i, 0]
-                py = xv[i, 1]
-                if px < ox0 - eps or px > ox1 + eps or py < oy0 - eps or py > oy1 + eps:
-                    continue
-                ip = loop_prev(i, sv, kv)
-                inx = loop_next(i, sv, kv)
-                for ko in range(so.shape[0] - 1):
-                    for f in range(so[ko], so[ko + 1]):
-                        f1 = loop_next(f, so, ko)
-                        ax, ay, bx, by = xo[f, 0], xo[f, 1], xo[f1, 0], xo[f1, 1]
-                        if closest_on_segment(px, py, ax, ay, bx, by)[2] > eps * eps:
-                            continue
-                        ux = bx - ax
-                        uy = by - ay
-                        length = np.sqrt(ux * ux + uy * uy)
-                        nx = sign * -uy / length + 0.0
-                        ny = sign * ux / length + 0.0
-                        t = ((px - ax) * ux + (py - ay) * uy) / length
-                        fits = True
-                        for w in (ip, inx):
-                            rx = xv[w, 0] - px
-                            ry = xv[w, 1] - py
-                            if sign * (rx * nx + ry * ny) > 1e-9 * np.sqrt(rx * rx + ry * ry):
-                                fits = False
-                        score = min(t, length - t)
-                        if (fits and not best_fits) or (fits == best_fits and score > best_t):
-                            best_fits = fits
-                            best_t = score
-                            out = (nx, ny, side, i, f)
     return out
 
 
