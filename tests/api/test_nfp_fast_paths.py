@@ -24,8 +24,8 @@ from polycontact._kernels import minkowski as kmink
 from polycontact._kernels import nfp as kn
 from polycontact._kernels import outline as kout
 from polycontact.limits import (ANGLE_TOLERANCE, EAR_CLIPPING_MAX, HOLE_WIDTH_FACTOR,
-                               MAX_SUM_VERTICES, RELATIVE_TOLERANCE, ROUNDING_ULPS,
-                               SNAP_FACTOR)
+                               MAX_CLIP_TESTS, MAX_SUM_VERTICES, RELATIVE_TOLERANCE,
+                               ROUNDING_ULPS, SNAP_FACTOR)
 
 @pytest.fixture(autouse=True)
 def no_geos_fallback():
