@@ -431,7 +431,9 @@ def test_inner_fit_of_grid_shapes_is_assembled_by_the_kernel(a, container, want)
     assert shapely.equals(ifp, want), ifp.wkt
     # no vertex that changes nothing (none on the segment of its neighbours)
     ring = np.asarray(ifp.exterior.coords)[:-1]
-    turn = np.cross(ring - np.roll(ring, 1, axis=0), np.roll(ring, -1, axis=0) - ring)
+    u = ring - np.roll(ring, 1, axis=0)
+    v = np.roll(ring, -1, axis=0) - ring
+    turn = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
     assert np.all(turn != 0), ifp.wkt
     c = shapely.Polygon(container)
     ap = shapely.Polygon(a)
