@@ -18,7 +18,9 @@ Paths (size, then the ``--quick`` size):
 - ``first_impacts``: 2·10⁴ moving 12-gons (2·10³) on a jittered grid, random velocities
   and spins, over [0, 0.5];
 - ``nfp_table``: the shipped jakobs1 (25 pieces) at 12 orientations, 90 000 entries
-  (at 4 orientations, 10 000), reference at the origin, no cache;
+  (at 4 orientations, 10 000), reference at the origin, no cache, by its default choice
+  (threads, for pieces without holes); ``nfp_table_workers``: the same table on 1, 2,
+  ... local processes (``workers=``, as ``--workers``; 1 is the calling process);
 - ``dask ...`` (only when ``distributed`` is installed, else said and skipped):
   ``nfp_table``, ``classify_many`` and ``time_of_impact_many`` with ``client=`` on a
   ``LocalCluster`` of 1, 2, ... worker processes of one thread each, started and warmed
@@ -36,6 +38,8 @@ the serial fractions much less.
 
 Run: ``python benchmarks/bench_parallel.py [--quick] [--threads 1,2,4,8,16]
 [--workers 1,2,4] [--repeat 5] [--paths contacts,nfp_table] [--json OUT]``.
+With ``--json OUT`` every row is written to ``OUT`` as soon as it is measured (with
+the machine, the date and the command), so a run cut short keeps what it measured.
 Needs polycontact's own dependencies only (Dask optional).
 """
 
@@ -316,6 +320,19 @@ class NfpTable(Path):
         return (np.array([t.computed]),)
 
 
+class NfpTableWorkers(NfpTable):
+    """The table of :class:`NfpTable` on ``workers`` local processes (the count given to
+    ``run``)."""
+
+    name = "nfp_table_workers"
+    unit = "workers"
+
+    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+        t = pc.nfp_table(self.inst.pieces, self.angles, progress=False, workers=threads)
+        self.last = t
+        return (np.array([t.computed]),)
+
+
 # -- measuring -----------------------------------------------------------------------------
 def same(x: tuple[np.ndarray, ...], y: tuple[np.ndarray, ...]) -> bool:
     return len(x) == len(y) and all(
@@ -328,26 +345,31 @@ def copies(arrays: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
 
 
 def measure(path: Path, threads: list[int], repeat: int) -> dict[str, Any]:
-    """The path's row: seconds per thread count, speed-ups, the serial fraction."""
+    """The path's row: seconds per thread (or process) count, speed-ups, the serial
+    fraction (threads only)."""
     numba.set_num_threads(1)
     path.prepare()
     want = copies(path.run(1))  # (warm: the kernels loaded, the pools and buffers made)
     if isinstance(path, NfpTable):
         want = table_arrays(path.last)
-    regions = Regions()
-    serial = []
-    with regions.measuring():
-        for _ in range(repeat):
-            path.prepare()
-            regions.seconds = 0.0
-            t0 = time.perf_counter()
-            path.run(1)
-            total = time.perf_counter() - t0
-            serial.append((total - regions.seconds) / total)
+    unit = getattr(path, "unit", "threads")
     row: dict[str, Any] = {"path": path.name, "size": path.size, "threads": {},
-                           "serial_fraction": statistics.median(serial)}
+                           "serial_fraction": None, "amdahl16": None, "unit": unit}
+    if unit == "threads":
+        regions = Regions()
+        serial = []
+        with regions.measuring():
+            for _ in range(repeat):
+                path.prepare()
+                regions.seconds = 0.0
+                t0 = time.perf_counter()
+                path.run(1)
+                total = time.perf_counter() - t0
+                serial.append((total - regions.seconds) / total)
+        s = row["serial_fraction"] = statistics.median(serial)
+        row["amdahl16"] = 1.0 / (s + (1.0 - s) / 16.0)
     for t in threads:
-        numba.set_num_threads(t)
+        numba.set_num_threads(t if unit == "threads" else 1)
         path.prepare()
         got = copies(path.run(t))
         if isinstance(path, NfpTable):
@@ -360,18 +382,18 @@ def measure(path: Path, threads: list[int], repeat: int) -> dict[str, Any]:
             times.append(time.perf_counter() - t0)
         row["threads"][t] = {"median": statistics.median(times), "min": min(times),
                              "max": max(times), "same": same(want, got)}
-    numba.set_num_threads(max(threads))
+    numba.set_num_threads(int(numba.config.NUMBA_NUM_THREADS))
     one = row["threads"][threads[0]]["median"] if threads[0] == 1 else None
     for t, r in row["threads"].items():
         r["speedup"] = None if one is None else one / r["median"]
-    s = row["serial_fraction"]
-    row["amdahl16"] = 1.0 / (s + (1.0 - s) / 16.0)
     return row
 
 
-def dask_rows(workers: list[int], quick: bool, repeat: int) -> list[dict[str, Any]]:
+def dask_rows(workers: list[int], quick: bool, repeat: int,
+              report: Callable[[list[dict[str, Any]]], None]) -> list[dict[str, Any]]:
     """nfp_table, classify_many and time_of_impact_many with ``client=`` on clusters of
-    1, 2, ... worker processes (one thread each)."""
+    1, 2, ... worker processes (one thread each); ``report(rows)`` after each cluster,
+    with the rows measured so far."""
     try:
         from distributed import Client, LocalCluster
     except ImportError:
@@ -398,6 +420,13 @@ def dask_rows(workers: list[int], quick: bool, repeat: int) -> list[dict[str, An
     rows = {name: {"path": name, "size": "", "threads": {}, "serial_fraction": None,
                    "amdahl16": None, "unit": "workers"} for name in calls}
     want: dict[str, Any] = {}
+    def speedups() -> list[dict[str, Any]]:
+        for row in rows.values():
+            one = row["threads"].get(1, {}).get("median")
+            for r in row["threads"].values():
+                r["speedup"] = None if one is None else one / r["median"]
+        return [row for row in rows.values() if row["threads"]]
+
     for w in workers:
         with LocalCluster(n_workers=w, threads_per_worker=1, processes=True,
                           dashboard_address=None) as cluster, Client(cluster) as client:
@@ -413,11 +442,8 @@ def dask_rows(workers: list[int], quick: bool, repeat: int) -> list[dict[str, An
                 rows[name]["threads"][w] = {"median": statistics.median(times),
                                             "min": min(times), "max": max(times),
                                             "same": same(want[name], got)}
-    for row in rows.values():
-        one = row["threads"].get(workers[0], {}).get("median") if workers[0] == 1 else None
-        for r in row["threads"].values():
-            r["speedup"] = None if one is None else one / r["median"]
-    return list(rows.values())
+        report(speedups())
+    return speedups()
 
 
 def show(row: dict[str, Any]) -> None:
@@ -444,7 +470,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=None, help="calls per figure (5; 3 quick)")
     ap.add_argument("--paths", default=None, help="comma-separated paths (default all): "
                     "contacts,time_of_impact_many,time_of_impact_many_rows,nfp_table,"
-                    "classify_many,set_poses,first_impacts,distances,geometry,dask")
+                    "nfp_table_workers,classify_many,set_poses,first_impacts,distances,"
+                    "geometry,dask")
     ap.add_argument("--json", metavar="OUT", help="write the figures to this file")
     args = ap.parse_args()
     most = int(numba.config.NUMBA_NUM_THREADS)
@@ -462,12 +489,21 @@ def main() -> None:
     q = int(args.quick)
     chosen = (args.paths.split(",") if args.paths else
               ["contacts", "time_of_impact_many", "time_of_impact_many_rows", "nfp_table",
-               "classify_many", "set_poses", "first_impacts", "distances", "geometry", "dask"])
-    print(f"{os.cpu_count()} CPUs, Numba {numba.__version__} ({most} threads, layer "
-          f"{numba.config.THREADING_LAYER}), Python {platform.python_version()}, "
-          f"{'quick' if args.quick else 'full'} sizes, {repeat} calls per figure")
+               "nfp_table_workers", "classify_many", "set_poses", "first_impacts",
+               "distances", "geometry", "dask"])
+    head = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "command": " ".join(["python", *sys.argv]), "machine": machine(),
+            "cpus": os.cpu_count(), "numba_threads": most,
+            "threading_layer": numba.config.THREADING_LAYER,
+            "python": platform.python_version(), "numba": numba.__version__,
+            "quick": args.quick, "repeat": repeat, "load_average": os.getloadavg()}
+    print(f"{head['date']}, {head['machine']}: {os.cpu_count()} CPUs, Numba "
+          f"{numba.__version__} ({most} threads, layer {head['threading_layer']}), Python "
+          f"{platform.python_version()}, {'quick' if args.quick else 'full'} sizes, "
+          f"{repeat} calls per figure, load average "
+          f"{', '.join(f'{x:.2f}' for x in head['load_average'])}")
     pc.warmup()
-    rows = []
+    rows: list[dict[str, Any]] = []
     world = None
     for name in chosen:
         if name == "dask":
@@ -484,28 +520,42 @@ def main() -> None:
             path = FirstImpacts(SIZES[name][q])
         elif name == "nfp_table":
             path = NfpTable(SIZES[name][q])
+        elif name == "nfp_table_workers":
+            path = NfpTableWorkers(SIZES["nfp_table"][q])
         else:
             sys.exit(f"--paths: unknown path {name!r}")
-        row = measure(path, threads, repeat)
+        row = measure(path, workers if name == "nfp_table_workers" else threads, repeat)
         show(row)
         rows.append(row)
-        save(args.json, rows, most, args.quick, repeat)
+        save(args.json, head, rows)
     if "dask" in chosen:
-        for row in dask_rows(workers, args.quick, repeat):
+        for row in dask_rows(workers, args.quick, repeat,
+                             lambda partial: save(args.json, head, rows + partial)):
             show(row)
             rows.append(row)
-        save(args.json, rows, most, args.quick, repeat)
+        save(args.json, head, rows)
 
 
-def save(out: str | None, rows: list[dict[str, Any]], most: int, quick: bool,
-         repeat: int) -> None:
-    """Write the rows so far to ``out`` (if given): a run cut short keeps its figures."""
+def machine() -> str:
+    """The processor's name (Linux: /proc/cpuinfo; else the platform's)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def save(out: str | None, head: dict[str, Any], rows: list[dict[str, Any]]) -> None:
+    """Write the rows so far to ``out`` (if given), through a temporary file and a
+    rename: a run cut short keeps the rows it measured, and the file is always whole."""
     if out:
-        doc = {"cpus": os.cpu_count(), "numba_threads": most,
-               "python": platform.python_version(), "numba": numba.__version__,
-               "quick": quick, "repeat": repeat, "rows": rows}
-        with open(out, "w") as f:
-            json.dump(doc, f, indent=1)
+        tmp = f"{out}.tmp"
+        with open(tmp, "w") as f:
+            json.dump({**head, "rows": rows}, f, indent=1)
+        os.replace(tmp, out)
 
 
 if __name__ == "__main__":

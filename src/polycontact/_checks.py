@@ -82,7 +82,7 @@ def real_array(value: Any, what: str, error: type[ValueError] = ValueError) -> n
     except (TypeError, ValueError) as exc:
         raise error(f"{what}: not an array of numbers ({exc})") from None
     kind = arr.dtype.kind
-    if isinstance(value, (list, tuple)) and kind in "iu":  # NumPy made ints of any bools
+    if isinstance(value, (list, tuple)) and kind in "fiu":  # NumPy made numbers of bools
         if _holds_bool(value):
             raise TypeError(f"{what}: expected real numbers, got an element of type bool")
     if kind == "O":
@@ -99,14 +99,33 @@ def real_array(value: Any, what: str, error: type[ValueError] = ValueError) -> n
         raise error(f"{what}: not an array of numbers ({exc})") from None
 
 
+def one_value(value: Any) -> bool:
+    """Whether ``value`` is given as one value rather than as many (a list, tuple, set,
+    mapping, string or array of dimension 1 or more), without converting it (a ragged
+    list would not convert).
+
+    >>> one_value(0.5), one_value(np.float64(1)), one_value([0.5]), one_value("0.5")
+    (True, True, False, False)
+    """
+    if isinstance(value, np.ndarray):
+        return value.ndim == 0
+    return not isinstance(value, (str, bytes, list, tuple, set, frozenset, Mapping))
+
+
 def _holds_bool(value: Any) -> bool:
-    """Whether a (nested) list or tuple holds a bool (NumPy would make it 0 or 1)."""
+    """Whether a (nested) list or tuple holds a bool or an array of bools (NumPy would
+    make them numbers)."""
     items = [value]
     while items:
         item = items.pop()
         if isinstance(item, (bool, np.bool_)):
             return True
-        if isinstance(item, (list, tuple)):
+        if isinstance(item, np.ndarray):
+            if item.dtype.kind == "b":
+                return True
+            if item.dtype.kind == "O":
+                items.extend(item.ravel().tolist())
+        elif isinstance(item, (list, tuple)):
             items.extend(item)
     return False
 

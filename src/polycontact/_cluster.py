@@ -4,7 +4,7 @@ public :mod:`polycontact.distributed`): the client a batch runs on, the tasks' s
 and their run. Nothing here imports Dask before a client is used.
 
 >>> task_size(1_000_000, 1e-6, 4), current_client() is None
-(200000, True)
+(250000, True)
 """
 
 from __future__ import annotations
@@ -76,16 +76,20 @@ def worker_plugins(dask_worker: Any) -> list[str]:
 
 def task_size(count: int, per_item: float, workers: int) -> int:
     """Items per task for ``count`` items of ``per_item`` seconds each on ``workers``
-    worker threads: at least :data:`~polycontact.limits.TASK_SECONDS` of work, and as
-    many more as keeps four tasks per worker thread.
+    worker threads: as many tasks as the work holds
+    :data:`~polycontact.limits.TASK_SECONDS`, at most four per worker thread, and, where
+    there are more tasks than worker threads, whole rounds of one per worker thread (so
+    that no thread is left with a last task while the others wait).
 
-    >>> task_size(1_000_000, 1e-6, 4), task_size(1000, 1e-6, 4)
-    (200000, 1000)
+    >>> task_size(1_000_000, 1e-6, 4), task_size(1000, 1e-6, 4), task_size(10**8, 1e-6, 4)
+    (250000, 1000, 6250000)
     """
     from .limits import TASK_SECONDS
 
-    by_time = math.ceil(TASK_SECONDS / max(per_item, 1e-12) * (1.0 - 1e-12))  # (no 1 ulp up)
-    return max(1, min(count, max(by_time, math.ceil(count / (4 * workers)))))
+    tasks = max(1, min(4 * workers, math.floor(count * per_item / TASK_SECONDS + 1e-9)))
+    if tasks > workers:
+        tasks -= tasks % workers
+    return max(1, math.ceil(count / tasks))
 
 
 def _timed(fn: Callable[..., Any], shared: Any, task: Any, *args: Any) -> tuple[Any, float]:

@@ -7,8 +7,8 @@ of impact on a 2-core machine), and every run after it loads the compiled code i
 under a second.
 
 **The notice.** The first compile of a process says so once, as a warning on the
-``polycontact`` logger (:data:`polycontact._kernels.jit.LOGGER`), shown on stderr when
-logging is not configured: ``polycontact is compiling the kernels this call needs (...)``.
+``polycontact`` logger, shown on stderr when logging is not configured:
+``polycontact is compiling the kernels this call needs, once: ...``.
 ``logging.getLogger("polycontact").setLevel(logging.ERROR)`` silences it. Kernels
 loaded from the cache say nothing.
 
@@ -201,7 +201,7 @@ def _warmup_in_processes(
     processes: int,
 ) -> None:
     """:func:`warmup` of ``chosen`` in ``processes`` worker processes, each family in
-    one of them, in order (the longest, classification, first)."""
+    one of them, taken in the order given."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 

@@ -16,8 +16,9 @@ to the local one. This module offers what they share (from
   kernels they run) compiles or loads the kernels once per worker, when the worker
   starts or joins, not once per task.
 - :func:`run_spans` cuts ``range(count)`` into tasks: a first task measures the work per
-  item, the others get at least :data:`~polycontact.limits.TASK_SECONDS` of work each
-  and four per worker thread where there is enough; what every task needs is sent to
+  item, the others get at least :data:`~polycontact.limits.TASK_SECONDS` of work each,
+  at most four per worker thread, in whole rounds of one per worker thread
+  (:func:`task_size`); what every task needs is sent to
   every worker once, and the results come back as they finish.
 - :func:`map_batches` calls any function on aligned slices of sequences that way.
 

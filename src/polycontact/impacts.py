@@ -237,7 +237,7 @@ def _rows(motions: Motions) -> np.ndarray:
     """The kernel vectors of ``motions``, (N, 6)."""
     if isinstance(motions, MotionRows):
         return motions.rows
-    return np.frombuffer(b"".join(map(_ARRAY, motions)), np.float64).reshape(-1, 6)
+    return np.frombuffer(b"".join(map(_BYTES, motions)), np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -250,19 +250,28 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
 
 
 # -- the batched search ----------------------------------------------------------------
-def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
+def pack_shapes(shapes: Sequence[Any], sizes: np.ndarray | None = None
+                ) -> tuple[np.ndarray, ...]:
     """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
     starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, and
-    each shape's stored centroid and bounding radius)."""
-    n = len(shapes)
-    return (*shapes_packed(shapes),
-            np.frombuffer(b"".join(map(_CENTROID, shapes)), np.float64).reshape(n, 2),
-            np.fromiter(map(_RADIUS, shapes), np.float64, n))
+    each shape's stored centroid and bounding radius, from ``sizes``, their
+    :func:`shape_sizes` if already read)."""
+    sizes = shape_sizes(shapes) if sizes is None else sizes
+    return (*shapes_packed(shapes), np.ascontiguousarray(sizes[:, :2]),
+            np.ascontiguousarray(sizes[:, 2]))
+
+
+def shape_sizes(shapes: Sequence[Any]) -> np.ndarray:
+    """Each shape's stored centroid, bounding radius and extent, ``(N, 4)`` (read-only).
+
+    >>> shape_sizes([Shape([(0, 0), (2, 0), (2, 2), (0, 2)])]).round(6).tolist()
+    [[1.0, 1.0, 1.414214, 2.0]]
+    """
+    return np.frombuffer(b"".join(map(_SIZES, shapes)), np.float64).reshape(-1, 4)
 
 
 _KERNEL = operator.attrgetter("_kernel")
-_CENTROID = operator.attrgetter("_centroid")
-_RADIUS = operator.attrgetter("_radius")
+_SIZES = operator.attrgetter("_sizes")
 
 
 def empty_result(count: int) -> tuple[np.ndarray, ...]:
@@ -370,7 +379,8 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
     uniq = [shapes[k] for k in first.tolist()]
     owner = owner.reshape(-1).astype(np.int64)
-    packed = pack_shapes(uniq)
+    sizes = shape_sizes(uniq)
+    packed = pack_shapes(uniq, sizes)
     xy, vrows, _, _, centroids, radii = packed
     with numba_threads(useful(threads, count * _TABLE_SECONDS)) as n:
         suspect = suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
@@ -383,19 +393,17 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
             sh, m = shapes[k], motion_of(k)
             if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
                 check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
-    extents = np.fromiter(map(_EXTENT, uniq), np.float64, len(uniq))
-    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
+    return _Bodies(uniq, packed, owner, rows, centroids, radii, sizes[:, 3])
 
 
-_ARRAY = operator.attrgetter("_array")
-_EXTENT = operator.attrgetter("_extent")
+_BYTES = operator.attrgetter("_bytes")
 
 
 def time_of_impact_many(
-    shapes_a: Any,
-    motions_a: Any,
-    shapes_b: Any,
-    motions_b: Any,
+    shapes_a: Sequence[ShapeLike],
+    motions_a: Sequence[Motion] | np.ndarray,
+    shapes_b: Sequence[ShapeLike],
+    motions_b: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
     method: str = "exact",
@@ -411,8 +419,8 @@ def time_of_impact_many(
 
     Pair k's answer is the one ``time_of_impact(shapes_a[k], motions_a[k], shapes_b[k],
     motions_b[k], t_max=..., ...)`` gives (the same kernel with the same arguments; times
-    within the time tolerance, see the module docstring); the pairs are shared among ``threads`` threads, since the compiled
-    search releases the GIL. A shape that appears in many pairs (the same object) has
+    within the time tolerance, see the module docstring); the pairs are shared among
+    ``threads`` threads, since the compiled search releases the GIL. A shape that appears in many pairs (the same object) has
     its tables built once.
 
     The result is a batch of arrays (``status``, ``collides``, ``times``,
@@ -623,11 +631,10 @@ class _ShapePack:
     """
 
     def __init__(self, shapes: Sequence[Any]) -> None:
-        n = len(shapes)
         self.kernels = list(map(_KERNEL, shapes))
-        self.centroids = np.frombuffer(b"".join(map(_CENTROID, shapes)),
-                                       np.float64).reshape(n, 2)
-        self.radii = np.fromiter(map(_RADIUS, shapes), np.float64, n)
+        sizes = shape_sizes(shapes)
+        self.centroids = np.ascontiguousarray(sizes[:, :2])
+        self.radii = np.ascontiguousarray(sizes[:, 2])
 
     def __len__(self) -> int:
         return len(self.kernels)

@@ -61,8 +61,10 @@ class Motion:
     acceleration: tuple[float, float] = (0.0, 0.0)
     angular_velocity: float = 0.0
     angular_acceleration: float = 0.0
-    # derived in __post_init__: the kernel vector, |v|, |a|, |ω|, |α| and the largest
+    # derived in __post_init__: the kernel vector and its bytes, |v|, |a|, |ω|, |α| and
+    # the largest
     _array: np.ndarray = field(init=False, repr=False, compare=False)
+    _bytes: bytes = field(init=False, repr=False, compare=False)
     _norms: tuple[float, float, float, float] = field(init=False, repr=False, compare=False)
     _largest: float = field(init=False, repr=False, compare=False)
 
@@ -77,11 +79,12 @@ class Motion:
             "angular_acceleration",
             finite_number(self.angular_acceleration, "angular_acceleration"),
         )
-        # the kernel vector, built once: a time-of-impact query passes it as it is
-        vector = np.array([*self.velocity, *self.acceleration, self.angular_velocity,
-                           self.angular_acceleration], dtype=np.float64)
-        vector.flags.writeable = False
-        object.__setattr__(self, "_array", vector)
+        # the kernel vector, built once: a time-of-impact query passes it as it is, and
+        # a batch joins the bytes it views (read-only) with the other motions'
+        data = np.array([*self.velocity, *self.acceleration, self.angular_velocity,
+                         self.angular_acceleration], dtype=np.float64).tobytes()
+        object.__setattr__(self, "_bytes", data)
+        object.__setattr__(self, "_array", np.frombuffer(data, np.float64))
         # |v|, |a|, |ω|, |α|: what the reach check of every query reads
         object.__setattr__(self, "_norms", (
             math.hypot(*self.velocity), math.hypot(*self.acceleration),

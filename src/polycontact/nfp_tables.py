@@ -37,16 +37,20 @@ threads (``threads=``, by the threading policy of :doc:`conventions`), in chunks
 (pieces with holes, rings too large for ear clipping) hold the GIL; when they are most
 of a large build, the build uses a pool of ``workers`` processes instead, but only
 where the work measured on a first chunk outweighs the processes' start
-(:data:`PROCESS_START`), so that processes never make a build slower; the pool is
-started once, after the kernels are compiled here, so the processes load them and never
-compile. Scripts that may build large tables with processes must guard their entry
-point with ``if __name__ == "__main__":`` (processes are spawned, as on macOS and
-Windows). With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
+(:data:`PROCESS_START`); the pool is started once, after the kernels are compiled here,
+so the processes load them and never compile. This process works alongside the pool,
+from the other end of the tasks, and computes the tasks of processes that are slow to
+start (or stop) itself, so that processes never make a build much slower than this
+process alone. The processes are spawned (as on macOS and Windows), and a spawned process
+runs the main script's top-level code again: a build called from there, outside an
+``if __name__ == "__main__":`` block, runs on threads instead (with a warning when
+``workers`` asked for processes), since each process would otherwise start the build
+again. With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
 client is the default, the missing entries run as tasks on the cluster
 (:mod:`polycontact.distributed`), each of at least
-:data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task and
-several per worker thread, the pieces sent to every worker once; the client writes the
-shards as results arrive.
+:data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task, up to
+four per worker thread in whole rounds, the pieces sent to every worker once; the
+client writes the shards as results arrive.
 
 Examples
 --------
@@ -59,6 +63,7 @@ Examples
 
 from __future__ import annotations
 
+import ast
 import bisect
 import hashlib
 import json
@@ -74,12 +79,13 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Generator, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import closing
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -101,8 +107,8 @@ MANIFEST = "table.json"
 SHARDS = "shards"
 
 #: What starting one local worker process costs (seconds: the interpreter, the imports
-#: and loading the compiled kernels from the cache, measured at about a second): a
-#: build uses processes only where each has more work than this.
+#: and loading the compiled kernels from the cache): a build uses processes only where
+#: each has more work than this.
 PROCESS_START = 1.0
 
 #: Entries of the first chunk, computed in the calling process (or as the first Dask
@@ -398,9 +404,10 @@ def nfp_table(
         Show a progress bar (tqdm on stderr), or call ``progress(done, total)`` after
         each batch of entries.
     workers : int, optional
-        Local processes when there is no Dask client. By default none, unless most of
-        the work holds the GIL (pieces with holes, large rings) and each process has
-        more of it than its start costs (:data:`PROCESS_START`); 1: in this process.
+        Local processes when there is no Dask client (besides this process, which works
+        alongside them). By default none, unless most of the work holds the GIL (pieces
+        with holes, large rings) and each process has more of it than its start costs
+        (:data:`PROCESS_START`); 1: in this process.
     threads : int, optional
         Threads of a local build (default and meaning: the threading policy of
         :doc:`conventions`: at most ``numba.get_num_threads()``, and no more than the
@@ -747,6 +754,14 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     n_proc = workers or 1
     if workers is None and gil_seconds > 0.5 * seconds:
         n_proc = min(threads, int(gil_seconds / first * rest / PROCESS_START))
+    if n_proc > 1 and _spawn_reruns_caller():
+        if workers is not None:
+            warnings.warn(
+                f"nfp_table: workers={workers} runs on threads: it is called from a "
+                "script's top-level code, which spawned processes would run again (put "
+                "the call under `if __name__ == '__main__':` to use processes)",
+                RuntimeWarning, stacklevel=4)
+        n_proc, workers = 1, None
     n_threads = 1 if n_proc > 1 or workers == 1 else useful(threads, seconds / first * rest)
     size = chunk_size or min(1024, max(64, math.ceil(rest / (4 * max(n_proc, n_threads)))))
     spans = _spans(first, count, size)
@@ -759,6 +774,49 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     with closing(results):  # type: ignore[type-var]
         for k, got in results:
             yield *spans[k], got
+
+
+def _spawn_reruns_caller() -> bool:
+    """Whether a spawned process would run this call again: the call comes (through any
+    number of functions) from the top-level code of the ``__main__`` module outside an
+    ``if __name__ == "__main__":`` block, and ``multiprocessing`` runs that module again
+    in a spawned process (a script run by path or ``python -m module``; not a package's
+    ``__main__.py``, nor an interactive session)."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if main is None or path is None or name == "__main__" or (
+            name is not None and name.endswith(".__main__")) or (
+            name is None and os.path.splitext(os.path.basename(path))[0] == "ipython"):
+        return False
+    frame: FrameType | None = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(main)
+                                     and frame.f_code.co_name == "<module>"):
+        frame = frame.f_back
+    if frame is None:
+        return False  # not called from the main module's top-level code
+    line = frame.f_lineno
+    try:
+        with open(path, "rb") as f:
+            tree = ast.parse(f.read())
+    except (OSError, SyntaxError, ValueError):
+        return True  # (the source cannot be read: taken as unguarded)
+    for statement in tree.body:
+        if statement.lineno <= line <= (statement.end_lineno or statement.lineno):
+            return not (isinstance(statement, ast.If) and _is_main_test(statement.test)
+                        and any(s.lineno <= line <= (s.end_lineno or s.lineno)
+                                for s in statement.body))
+    return True
+
+
+def _is_main_test(test: ast.expr) -> bool:
+    """Whether ``test`` is ``__name__ == "__main__"`` (either way round)."""
+    if (not isinstance(test, ast.Compare) or len(test.ops) != 1
+            or not isinstance(test.ops[0], ast.Eq)):
+        return False
+    sides = (test.left, test.comparators[0])
+    return (any(isinstance(x, ast.Name) and x.id == "__name__" for x in sides)
+            and any(isinstance(x, ast.Constant) and x.value == "__main__" for x in sides))
 
 
 def _progress_bar(progress: Progress, total: int) -> Any:
@@ -804,25 +862,63 @@ def _process_task(pairs: np.ndarray, reference: str) -> Packed:
 def _run_processes(
     n: int, pieces: _Pieces, tasks: list[np.ndarray], reference: str
 ) -> Generator[tuple[int, Packed], None, None]:
-    """Run the tasks on ``n`` spawned processes (one pool for the build); yield (task
-    index, result) as they end."""
+    """Run the tasks on ``n`` spawned processes (one pool for the build) and in this
+    process; yield (task index, result) as they end, each task once.
+
+    The pool takes tasks from the front, ``n + 1`` at a time, and this process from the
+    back, so it works while the processes start: when the processes are slow to start
+    (or stop), this process computes the tasks it handed them too (the first result
+    wins; both are the same), and the build takes no longer than here alone."""
     pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
                                initializer=_init_process, initargs=(pieces, reference))
+    owner: dict[Future[Packed], int] = {}
+    done = np.zeros(len(tasks), bool)
+    front, back = 0, len(tasks)  # tasks[front:back]: handed to nobody yet
+    answered = broken = False
+
+    def finished(timeout: float | None) -> list[tuple[int, Packed]]:
+        nonlocal answered, broken
+        ended, _ = wait(list(owner), timeout=timeout, return_when=FIRST_COMPLETED)
+        out = []
+        for f in ended:
+            k = owner.pop(f)
+            try:
+                result = f.result()
+            except BrokenProcessPool:
+                if not broken:
+                    warnings.warn("nfp_table: the local worker processes stopped; the "
+                                  "build goes on in this process", RuntimeWarning,
+                                  stacklevel=5)
+                broken = True
+                continue
+            answered = True
+            if not done[k]:
+                done[k] = True
+                out.append((k, result))
+        return out
+
     try:
-        futures = {pool.submit(_process_task, t, reference): k for k, t in enumerate(tasks)}
-        pending = set(futures)
-        while pending:
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in finished:
-                try:
-                    result = f.result()
-                except BrokenProcessPool:
-                    raise RuntimeError(
-                        "the local worker processes of nfp_table stopped: a script that "
-                        "builds a large table must guard its entry point with "
-                        "`if __name__ == '__main__':` (processes are spawned), or pass "
-                        "workers=1") from None
-                yield futures[f], result
+        while not done.all():
+            for item in finished(0):
+                yield item
+            while not broken and front < back and len(owner) < n + 1:
+                owner[pool.submit(_process_task, tasks[front], reference)] = front
+                front += 1
+            if front < back:
+                back -= 1
+                k = back
+            else:  # every task handed out: compute the pool's, unless it is at work
+                left = [] if answered and not broken and owner else [
+                    k for k in range(front - 1, -1, -1) if not done[k]]
+                if not left:
+                    for item in finished(None):
+                        yield item
+                    continue
+                k = left[0]
+            result = _compute_chunk(pieces, tasks[k], reference)
+            if not done[k]:
+                done[k] = True
+                yield k, result
     finally:
         pool.shutdown(wait=False, cancel_futures=True)
 

@@ -279,13 +279,15 @@ class Shape:
         Only with an array of vertices: the other forms carry their own holes.
     repair : bool, default False
         If the loops are invalid, try ``shapely.make_valid(method="structure")`` and keep
-        the result when it is a single polygon; where GEOS's result still meets itself
-        exactly, it is snap-rounded first (``shapely.set_precision``) onto a grid of
-        :func:`polycontact.tolerances.snap_grid` of the tolerance (each vertex moves by
-        far less than the tolerance). :attr:`repairs` then says what changed. Indices
-        still refer to the caller's vertices where the repaired loops keep them (or,
-        snapped, keep them within one grid step); a vertex or edge the repair created
-        has none (see :meth:`input_vertex`).
+        the result when it is a single polygon, valid exactly and within the tolerance
+        of the loops (where GEOS's result moves the outline further, the loops are read
+        from GEOS's noding instead; where it still meets itself, it is snap-rounded onto
+        a grid far finer than the tolerance: ``shapely.set_precision``).
+        Every vertex of the result lies within the tolerance of the loops.
+        :attr:`repairs` then says what changed. Indices still refer to the caller's
+        vertices where the repaired loops keep them (or, snapped, keep them within one
+        grid step); a vertex or edge the repair created has none (see
+        :meth:`input_vertex`).
 
     Raises
     ------
@@ -321,7 +323,8 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel",
+                 "_sizes")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -440,6 +443,9 @@ class Shape:
         # rule is a max of terms that grow with the extent and the magnitude)
         self._tolerance = tolerance_for(extent, magnitude)
         self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
+        # the centroid, the bounding radius and the extent as the bytes of four float64:
+        # what a batch of moving bodies reads of each shape, joined with the others'
+        self._sizes = np.array([*centroid, self._radius, extent], np.float64).tobytes()
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from ._checks import finite_number, points, real_array
+from ._checks import finite_number, one_value, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
@@ -1053,7 +1053,7 @@ class World:
             pos = points(positions, "positions", (len(idx), 2))  # (says what is wrong)
         if angles is None:
             ang = np.empty(0)  # (each body keeps its angle)
-        elif np.ndim(angles) == 0:
+        elif one_value(angles):
             ang = np.full(len(idx), finite_number(angles, "angles"))
         else:
             ang = _floats(angles, "angles")
@@ -1527,7 +1527,7 @@ class World:
         """
         base = as_shape(shape, "shape")
         pos = points(positions, "positions")
-        if np.ndim(angles) == 0 and not isinstance(angles, (str, bytes)):
+        if one_value(angles):
             ang = np.full(len(pos), _angle(angles))
         else:
             ang = real_array(angles, "angles")
@@ -1669,25 +1669,41 @@ class World:
     def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float) -> None:
         """Refuse motions that would carry a body's coordinates, its points' speeds or
         accelerations beyond the kernels' range within the step (as
-        :func:`polycontact.time_of_impact` does), naming the body's row."""
+        :func:`polycontact.time_of_impact` does), naming the argument that carries them
+        (the largest term of the bound) and the body's row."""
         rad = self._rad[ids]
-        v = np.hypot(motion[:, 0], motion[:, 1])
-        acc = np.hypot(motion[:, 2], motion[:, 3])
-        w, alpha = np.abs(motion[:, 4]), np.abs(motion[:, 5])
-        w_max = w + alpha * dt
-        base = np.abs(self._pos[ids]).max(axis=1, initial=0.0) + rad
-        bounds = (base + v * dt + 0.5 * acc * dt * dt, v + acc * dt + w_max * rad,
-                  acc + (alpha + w_max * w_max) * rad, w_max)
-        names = ("coordinates reach", "points' speeds reach", "points' accelerations reach",
-                 "angular speed reaches")
-        for value, name in zip(bounds, names):
+        with np.errstate(over="ignore", invalid="ignore"):
+            v = np.hypot(motion[:, 0], motion[:, 1])
+            acc = np.hypot(motion[:, 2], motion[:, 3])
+            w, alpha = np.abs(motion[:, 4]), np.abs(motion[:, 5])
+            w_max = w + alpha * dt
+            # the index of the argument a term comes from (-1: the pose, not an argument)
+            vel, accel, ang_vel, ang_accel = (np.full(len(ids), i) for i in range(4))
+            pose = np.full(len(ids), -1)
+            spin = np.where(w >= alpha * dt, ang_vel, ang_accel)  # the leading angular one
+            base = np.abs(self._pos[ids]).max(axis=1, initial=0.0) + rad
+            bounds: list[tuple[str, list[tuple[np.ndarray, np.ndarray]]]] = [
+                ("coordinates reach", [(base, pose), (v * dt, vel),
+                                       (0.5 * acc * dt * dt, accel)]),
+                ("points' speeds reach", [(v, vel), (acc * dt, accel), (w_max * rad, spin)]),
+                ("points' accelerations reach", [(acc, accel), (alpha * rad, ang_accel),
+                                                 (w_max * w_max * rad, spin)]),
+                ("angular speed reaches", [(w, ang_vel), (alpha * dt, ang_accel)])]
+        arguments = ("velocities", "accelerations", "angular_velocities",
+                     "angular_accelerations")
+        for name, terms in bounds:
+            with np.errstate(over="ignore", invalid="ignore"):
+                value = np.sum([term for term, _ in terms], axis=0)
             bad = ~(value <= COORDINATE_LIMIT)
             if bad.any():
                 k = int(np.argmax(bad))
+                # the argument whose term is largest in that row (a NaN term counts as inf)
+                lead = max(((float(np.nan_to_num(term[k], nan=np.inf)), int(arg[k]))
+                            for term, arg in terms if arg[k] >= 0), default=(0.0, 0))[1]
                 raise ValueError(
-                    f"velocities[{k}]: body {int(ids[k])}'s {name} {float(value[k]):g} within "
-                    f"dt = {dt:g}, beyond ±{COORDINATE_LIMIT:g}: products of coordinates "
-                    "would overflow float64")
+                    f"{arguments[lead]}[{k}]: body {int(ids[k])}'s {name} "
+                    f"{float(value[k]):g} within dt = {dt:g}, beyond ±{COORDINATE_LIMIT:g}: "
+                    "products of coordinates would overflow float64")
 
     def _sweep_frames(self, bodies: np.ndarray) -> None:
         """Build the sweep's circle trees (one per body, about its base rows) of the

@@ -4,6 +4,8 @@ loses nothing; tasks are sized from a first one."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import shapely
@@ -12,6 +14,8 @@ import polycontact as pc
 from polycontact import distributed as pd
 from polycontact import impacts
 from polycontact.esicup import turned
+
+from .test_pose_arguments import BAD_NUMBERS, BAD_POINTS
 
 distributed = pytest.importorskip("distributed")
 
@@ -270,7 +274,7 @@ def test_cli_on_a_scheduler_builds_the_same_table(client, tmp_path, capsys):
 
 def test_tasks_are_sized_from_a_first_task(client):
     # a first task of PROBE_ITEMS items, then tasks of at least TASK_SECONDS of work each
-    # (here: every item left in one task), four per worker thread where there is enough
+    # (here: every item left in one task)
     spans = []
 
     def tasks_of(got):
@@ -280,9 +284,42 @@ def test_tasks_are_sized_from_a_first_task(client):
     parts = dict(((p0, p1), r) for p0, p1, r in pd.run_spans(client, _total, 1000, tasks_of))
     assert spans[0] == (0, pd.PROBE_ITEMS) and spans[1:] == [(pd.PROBE_ITEMS, 1000)]
     assert sum(parts.values()) == sum(range(1000))
-    assert pd.task_size(10**6, 1e-6, 4) == 200_000  # 0.2 s of work
+
+
+def test_task_sizes_fill_whole_rounds_of_worker_threads():
+    # at least TASK_SECONDS of work per task, at most four tasks per worker thread, and
+    # where there are more tasks than threads a whole number of rounds (five tasks of
+    # 0.2 s on four threads would take 0.4 s; four of 0.25 s take 0.25 s)
+    assert pd.task_size(10**6, 1e-6, 4) == 250_000
     assert pd.task_size(10**8, 1e-6, 4) == 10**8 // 16  # four per worker thread
+    assert pd.task_size(9 * 10**4, 3e-5, 2) == 9 * 10**4 // 8  # 2.7 s: four rounds
+    assert pd.task_size(9 * 10**4, 3e-5, 16) == math.ceil(9 * 10**4 / 13)  # 13 of 0.2 s
+    assert pd.task_size(1000, 1e-6, 4) == 1000  # 1 ms: one task
+    assert pd.task_size(10, 1.0, 4) == 1  # never an empty task
 
 
 def _total(_, task):
     return int(np.sum(task))
+
+
+def test_poses_and_motions_given_to_the_cluster_are_checked_before_any_task(client):
+    """The property of the pose checks (every value that is not a finite real number in
+    range refused, naming the argument) holds with a client too, and nothing is sent."""
+    sq = pc.Shape(SQUARE)
+    tasks = client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+    for bad in BAD_POINTS:
+        with pytest.raises((TypeError, ValueError), match="motions_a"):
+            pc.time_of_impact_many([sq], [bad], [sq.moved((3, 0))], [pc.Motion()], t_max=5.0,
+                                   client=client)
+    for bad in BAD_NUMBERS:
+        with pytest.raises((TypeError, ValueError), match="motions_a"):
+            pc.time_of_impact_many([sq], [[bad, 0, 0, 0, 0, 0]], [sq.moved((3, 0))],
+                                   [pc.Motion()], t_max=5.0, client=client)
+        with pytest.raises((TypeError, ValueError), match="t_max"):
+            pc.time_of_impact_many([sq], [pc.Motion(velocity=(1, 0))], [sq.moved((3, 0))],
+                                   [pc.Motion()], t_max=bad, client=client)
+        if isinstance(bad, float) and abs(bad) > 1e100:
+            continue  # a finite angle of any size is one
+        with pytest.raises((TypeError, ValueError), match="orientations"):
+            pc.nfp_table([sq], [[bad]], client=client, progress=False)
+    assert client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) <= tasks

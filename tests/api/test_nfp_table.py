@@ -7,7 +7,9 @@ import os
 import subprocess
 import sys
 import textwrap
+import threading
 import warnings
+from concurrent.futures import Future
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +20,7 @@ import shapely.affinity
 import polycontact as pc
 from polycontact.cli import main
 from polycontact.esicup import InvalidInstanceError, turned
+from polycontact import nfp_tables
 from polycontact.nfp_tables import SHARDS, CacheWarning, NfpTable
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
@@ -291,3 +294,30 @@ def test_cli_reports_a_bad_instance_in_one_line(tmp_path, capsys):
     assert main(["nfp-table", str(tmp_path / "none.json"), "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("polycontact nfp-table: error:") and "none.json" in err
+
+
+def test_a_build_whose_processes_never_start_finishes_in_this_process(monkeypatch):
+    # the calling process works alongside its pool, and computes the tasks it handed to
+    # processes that never take them: the build ends, with the table of one process
+    class IdlePool:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def submit(self, *args):
+            return Future()  # never run
+
+        def shutdown(self, **kwargs):
+            pass
+
+    sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+    one = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=1)
+    monkeypatch.setattr(nfp_tables, "ProcessPoolExecutor", IdlePool)
+    built = []
+    build = threading.Thread(target=lambda: built.append(pc.nfp_table(
+        [sq, ell], [0, 90], progress=False, workers=2, chunk_size=2)), daemon=True)
+    build.start()
+    build.join(120)
+    assert built, "the build waited for processes that never started"
+    assert {k: shapely.to_wkb(built[0][k].region) for k in built[0]} == {
+        k: shapely.to_wkb(one[k].region) for k in one}

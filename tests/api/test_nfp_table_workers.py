@@ -1,5 +1,6 @@
 """The local worker processes of an NFP-table build end when their parent dies, killed
-or not: none (nor the resource tracker they keep alive) is left behind."""
+or not: none (nor the resource tracker they keep alive) is left behind; a script whose
+top-level code builds a table (no ``if __name__ == "__main__":``) gets it on threads."""
 
 from __future__ import annotations
 
@@ -102,3 +103,58 @@ def test_killing_a_table_build_leaves_no_worker_alive(tmp_path):
             build.wait()
         for pid in _alive(children):  # (only when the test failed: ours to end)
             os.kill(pid, signal.SIGKILL)
+
+
+_BUILD = """
+import warnings
+
+import shapely
+
+import polycontact as pc
+from polycontact import nfp_tables
+
+sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+
+
+def build():
+    pools = []
+    start = nfp_tables._run_processes
+    nfp_tables._run_processes = lambda n, *args: (pools.append(n), start(n, *args))[1]
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        table = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=2, chunk_size=2)
+    one = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=1)
+    same = all(shapely.to_wkb(table[k].region) == shapely.to_wkb(one[k].region)
+               for k in one)
+    print("same" if same and len(table) == 16 else "differ")
+    print("process pools:", pools)
+    for w in seen:
+        print("warning:", w.category.__name__, w.message)
+"""
+
+
+def _run_script(tmp_path: Path, text: str) -> subprocess.CompletedProcess[str]:
+    script = tmp_path / "build_table.py"
+    script.write_text(text)
+    return subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path, env={**os.environ, "PYTHONPATH": SRC})
+
+
+def test_a_script_without_a_main_guard_builds_on_threads(tmp_path):
+    # spawned processes would run the script's top-level call again: threads instead,
+    # with one warning naming the fix, and the table of one process
+    done = _run_script(tmp_path, _BUILD + "\nbuild()\n")
+    assert done.returncode == 0, done.stderr
+    assert "bootstrapping" not in done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[:2] == ["same", "process pools: []"], done.stdout
+    assert len(lines) == 3 and lines[2].startswith("warning: RuntimeWarning"), lines
+    assert "runs on threads" in lines[2] and "__name__ == '__main__'" in lines[2]
+
+
+def test_a_script_with_a_main_guard_builds_on_processes(tmp_path):
+    done = _run_script(tmp_path, _BUILD + "\nif __name__ == '__main__':\n    build()\n")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["same", "process pools: [2]"], (done.stdout,
+                                                                          done.stderr)

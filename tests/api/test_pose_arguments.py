@@ -41,6 +41,12 @@ def _world() -> tuple[pc.World, int]:
     return w, w.add(SQ, (0, 0))
 
 
+def _pair_world() -> tuple[pc.World, np.ndarray]:
+    """A World of two squares added as arrays (the simulation loop's calls)."""
+    w = pc.World()
+    return w, w.add_many([SQ, SQ], [(0, 0), (3, 0)])
+
+
 def _moving(**motion):
     """time_of_impact of a square given this motion: a Motion refuses what is not a
     finite real number, the query a motion its products would overflow with."""
@@ -65,6 +71,13 @@ NUMBER_CALLS = {
     "World.add angle": ("angle", lambda bad: _world()[0].add(SQ, (1, 1), bad), False),
     "World.move angle": ("angle", lambda bad: (lambda w, i: w.move(i, (0, 0), bad))(*_world()),
                          False),
+    "World.add_many angles": ("angles", lambda bad: pc.World().add_many([SQ], [(0, 0)],
+                                                                         [bad]), False),
+    "World.set_poses angles": ("angles", lambda bad: (lambda w, ids: w.set_poses(
+        ids, [(0, 0), (3, 0)], [bad, 0.0]))(*_pair_world()), False),
+    "World.sweep dt": ("dt", lambda bad: _pair_world()[0].sweep(bad, [(1, 0), (0, 0)]), True),
+    "World.sweep angular_velocities": ("angular_velocities", lambda bad: _pair_world()[0].sweep(
+        0.1, [(1, 0), (0, 0)], [bad, 0.0]), True),
     "World.query angle": ("angle", lambda bad: _world()[0].query(SQ, (2, 2), bad), False),
     "World.query_many angles": ("angle", lambda bad: _world()[0].query_many(SQ, [(2, 2), (3, 3)],
                                                                           bad),
@@ -89,6 +102,13 @@ POINT_CALLS = {
     "World.add position": ("position", lambda bad: _world()[0].add(SQ, bad)),
     "World.move position": ("position", lambda bad: (lambda w, i: w.move(i, bad))(*_world())),
     "World.query position": ("position", lambda bad: _world()[0].query(SQ, bad)),
+    "World.add_many positions": ("positions", lambda bad: pc.World().add_many([SQ], [bad])),
+    "World.set_poses positions": ("positions", lambda bad: (lambda w, ids: w.set_poses(
+        ids, [bad, (3, 0)]))(*_pair_world())),
+    "World.sweep velocities": ("velocities", lambda bad: _pair_world()[0].sweep(
+        0.1, [bad, (0, 0)])),
+    "World.sweep accelerations": ("accelerations", lambda bad: _pair_world()[0].sweep(
+        0.1, [(1, 0), (0, 0)], accelerations=[bad, (0, 0)])),
     "World.query_many positions": ("positions", lambda bad: _world()[0].query_many(SQ, [bad])),
     "no_fit_polygon reference": ("reference", lambda bad: pc.no_fit_polygon(SQ, SQ, bad)),
     "inner_fit_polygon reference": ("reference", lambda bad: pc.inner_fit_polygon(SQ, BIN, bad)),
@@ -206,3 +226,28 @@ def test_result_arrays_are_read_only():
         with pytest.raises(ValueError):
             arr[...] = 99
     assert r.to_dict() == before
+
+
+def test_a_sweep_refusal_names_the_argument_that_carries_the_overflow():
+    w, _ = _pair_world()
+    with pytest.raises(ValueError, match=r"^angular_velocities\[0\]"):
+        w.sweep(0.1, [(1, 0), (0, 0)], [1e200, 0.0])
+    with pytest.raises(ValueError, match=r"^accelerations\[1\]"):
+        w.sweep(0.1, [(1, 0), (0, 0)], accelerations=[(0, 0), (1e200, 0)])
+    with pytest.raises(ValueError, match=r"^velocities\[0\]"):
+        w.sweep(0.1, [(1e200, 0), (0, 0)])
+
+
+def test_booleans_among_real_numbers_are_refused():
+    w, ids = _pair_world()
+    with pytest.raises(TypeError, match="angles"):
+        w.set_poses(ids, [(0, 0), (3, 0)], [True, 0.5])
+    with pytest.raises(TypeError, match="positions"):
+        w.set_poses(ids, [np.array([True, False]), (3, 0)])
+    assert w.poses()[0].tolist() == [[0.0, 0.0], [3.0, 0.0]]
+
+
+def test_ragged_angles_are_refused_with_their_name():
+    w, ids = _pair_world()
+    with pytest.raises(ValueError, match="angles"):
+        w.set_poses(ids, [(0, 0), (3, 0)], [[1.0], 0.0])

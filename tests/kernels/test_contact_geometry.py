@@ -1,6 +1,7 @@
 """Kernels of a World's step: NumPy's summation order, the overlap of two regions
-against Shapely's intersection, the closest features against Shapely's distance, and the
-depth's contact segment."""
+against Shapely's intersection, the closest features against Shapely's distance, the
+depth's contact segment and its search given a known witness, and the state of a body
+moved from its edge table."""
 
 from __future__ import annotations
 
@@ -14,10 +15,13 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact._kernels import contact_geometry as kg
-from polycontact._kernels.convolution import contact_depth_into, depth_buffers
+from polycontact._kernels.convolution import contact_depth_into, contact_depth_of, depth_buffers
 from polycontact._kernels.depth import box_escape
 from polycontact._kernels.overlap import overlap_moments, overlap_scratch, where
+from polycontact._kernels.packs import scratch_floats
 from polycontact._kernels.poses import centroids, pairwise_sum
+from polycontact._kernels.primitives import edge_rows
+from polycontact._kernels.relation import NO_WITNESS, moved_state, relate_state, witness_holds
 
 SHAPES = [
     pc.Shape([(0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0, 3)]),
@@ -128,7 +132,8 @@ def test_overlap_of_shared_and_collinear_boundaries():
 @examples(100)
 @given(placed, placed, frames)
 def test_closest_features_give_the_gap_of_bodies_apart(sa, sb, frame):
-    a, b = make(sa, frame), make((sb[0], sb[1] + 9.0, sb[2], sb[3]), frame)  # apart
+    # apart: B moved past the widest reach of any turned shape (the L spans 3, the star 1.6)
+    a, b = make(sa, frame), make((sb[0], sb[1] + 20.0, sb[2], sb[3]), frame)
     (xa, sta), (xb, stb) = a.packed, b.packed
     gap, ax, ay, bx, by, side, v, f = kg.closest_features(xa, sta, xb, stb)
     # bodies that touch (gap 0 for GEOS) may be a few float spacings apart here
@@ -165,3 +170,73 @@ def test_the_depth_segment_takes_its_vertex_onto_its_edge(sa, sb, frame):
     loop = int(np.searchsorted(st_, f, side="right")) - 1
     g = f + 1 if f + 1 < st_[loop + 1] else st_[loop]
     assert shapely.LineString([x[f], x[g]]).distance(shapely.Point(p)) <= 8 * r.tolerance
+
+
+def shrunk(shape: pc.Shape, f: float) -> pc.Shape:
+    """The shape scaled by f about its centroid."""
+    c = shape.centroid
+    return pc.Shape(c + (shape.exterior - c) * f, [c + (h - c) * f for h in shape.holes])
+
+
+def tables(shape: pc.Shape):
+    """A body as the pair kernels take it: rows, loop starts, edge table, successors,
+    box."""
+    x, st_ = shape.packed
+    e, nxt = np.empty((len(x), 7)), np.empty(len(x), np.int64)
+    edge_rows(x, st_, e, nxt)
+    return x, st_, e, nxt, (x[:, 0].min(), x[:, 0].max(), x[:, 1].min(), x[:, 1].max())
+
+
+@examples(150)
+@given(placed, placed, frames, st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.booleans(),
+       st.floats(0.0, 1.0), st.sampled_from([(1.0, 1.0), (0.1, 1.0), (1.0, 0.1)]))
+def test_a_moved_body_gets_the_state_kernels_verdict_and_a_witness_that_holds(
+        sa, sb, frame, fx, fy, onto, back, shrink):
+    """The state of A moved, from its edge table, is the state kernel's on A's rows moved
+    (touches, a vertex brought exactly onto an edge, included); a penetration's witness
+    (two edges crossing, a vertex inside; one body shrunk, so that it may lie inside the
+    other) holds there, and wherever it holds the state kernel finds a penetration."""
+    a, b = (shrunk(make(spec, frame), f) for spec, f in ((sa, shrink[0]), (sb, shrink[1])))
+    ta, tb = tables(a), tables(b)
+    (xa, sta), (xb, stb) = a.packed, b.packed
+    eps = pc.default_tolerance(xa, xb)
+    if onto:  # A's vertex 0 onto the middle of B's edge 0
+        d = 0.5 * (xb[0] + xb[1]) - xa[0]
+    else:
+        d = np.array([fx, fy]) * frame[0]
+    moved = np.empty_like(xa)
+    scratch = np.empty(scratch_floats(len(xa) + len(xb)))
+    got, witness, i, j = moved_state(ta, tb, d[0], d[1], eps, moved, scratch)
+    assert got == (relate_state(xa + d, sta, xb, stb, eps) == 2)
+    if witness == NO_WITNESS:
+        return
+    touch = np.empty(len(xa) + len(xb), np.bool_)
+    assert witness_holds(ta, tb, d[0], d[1], eps, witness, i, j, moved, touch)
+    d2 = d * back
+    if witness_holds(ta, tb, d2[0], d2[1], eps, witness, i, j, moved, touch):
+        assert relate_state(xa + d2, sta, xb, stb, eps) == 2
+
+
+@examples(150)
+@given(placed, placed, frames, st.floats(0.0, 1.0), st.floats(0.0, 2 * math.pi))
+def test_a_known_witness_leaves_the_depth_as_it_was(sa, sb, frame, reach, turn):
+    """The depth's search given the witness of a penetration found at another
+    translation (tried before the state kernel at each point) finds what it finds
+    without: the same depth, escape, status and carrying features, to the bit."""
+    a, b = make(sa, frame), make(sb, frame)
+    (xa, sta), (xb, stb) = a.packed, b.packed
+    if len(xa) + len(xb) > 64:
+        return
+    eps = pc.default_tolerance(xa, xb)
+    ta, tb = tables(a), tables(b)
+    bound, bdx, bdy = box_escape(xa, xb)
+    d = reach * bound * np.array([math.cos(turn), math.sin(turn)])
+    moved = np.empty_like(xa)
+    scratch = np.empty(scratch_floats(len(xa) + len(xb)))
+    got, witness, i, j = moved_state(ta, tb, d[0], d[1], eps, moved, scratch)
+    if not got or relate_state(xa, sta, xb, stb, eps) != 2:
+        return
+    runs = [contact_depth_of(ta, tb, bound, bdx, bdy, eps, 0.0, known,
+                             depth_buffers(len(xa), len(xb)))
+            for known in ((NO_WITNESS, -1, -1), (witness, i, j))]
+    assert runs[0] == runs[1] or (runs[0][1] != runs[0][1] and runs[0][3:] == runs[1][3:])

@@ -62,3 +62,29 @@ def test_box_pairs_equal_all_pairs_of_overlapping_boxes(n_boxes, n_bodies, seed)
                 want.add((int(owner[a]), int(owner[b])))
     got = box_pairs(boxes, owner, n_bodies)
     assert got.tolist() == sorted(map(list, want))
+
+
+@examples(150)
+@given(st.integers(1, 60), st.integers(1, 12), st.integers(0, 2**32 - 1))
+def test_box_pairs_of_boxes_of_every_size_equal_all_pairs(n_boxes, n_bodies, seed):
+    """Boxes from a thousandth to a thousand times the crowd's spacing, and some that
+    reach infinity, swept in strips: every pair, once."""
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(0.0, 20.0, (n_boxes, 3))
+    size = 10.0 ** rng.uniform(-3.0, 3.0, (n_boxes, 3))
+    size[rng.random(n_boxes) < 0.05, rng.integers(0, 2)] = np.inf
+    boxes = np.empty((n_boxes, 6))
+    boxes[:, 0::2] = lo
+    boxes[:, 1::2] = lo + size
+    boxes[rng.random(n_boxes) < 0.05, 2] = -np.inf
+    owner = rng.integers(0, n_bodies, n_boxes).astype(np.int64)
+    want = set()
+    for a in range(n_boxes):
+        for b in range(n_boxes):
+            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
+            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
+            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
+                want.add((int(owner[a]), int(owner[b])))
+    with np.errstate(invalid="ignore"):  # (infinite boxes' centres, run as Python)
+        got = box_pairs(boxes, owner, n_bodies)
+    assert got.tolist() == sorted(map(list, want))

@@ -39,7 +39,7 @@ from .depth import box_escape
 from .overlap import overlap_moments, overlap_of_tables, overlap_scratch
 from .packs import scratch_floats
 from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next, loop_prev
-from .relation import moved_state
+from .relation import NO_WITNESS, moved_state
 from .world import body_view
 
 SEPARATE = 0
@@ -196,7 +196,7 @@ def _penetrating(ya, sa, yb, sb, e, buffers):
     state kernel (:func:`polycontact._kernels.relation.moved_state`), the usual case of
     a corner pressed into a side. Otherwise the contact segments
     (:func:`polycontact._kernels.convolution.contact_depth_of`) search for it, from
-    that lower bound."""
+    that lower bound, with the witness of the penetration that check found."""
     na = ya.shape[0]
     nb = yb.shape[0]
     depth_buf, scratch, (moved, state_buf) = buffers
@@ -223,19 +223,22 @@ def _penetrating(ya, sa, yb, sb, e, buffers):
             deep, side, v, f = dv, s, vv, fv
             dx = qx - xv[vv, 0] if s == 0 else xv[vv, 0] - qx
             dy = qy - xv[vv, 1] if s == 0 else xv[vv, 1] - qy
+    known = (NO_WITNESS, -1, -1)
     if deep > 0.0:
         g = 1.0 + 2.0 * e / deep
-        if not moved_state(a, b, dx * g, dy * g, e, moved[:na], state_buf)[0]:
+        got, w, i, j = moved_state(a, b, dx * g, dy * g, e, moved[:na], state_buf)
+        if not got:
             xv = ya if side == 0 else yb
             return GEOMETRY_DONE, deep, -dx / deep + 0.0, -dy / deep + 0.0, xv[v, 0], \
                 xv[v, 1], area, cx, cy, side, v, f
+        known = (w, i, j)
     if na + nb > FEW_VERTICES:
         return GEOMETRY_DONE, nan, nan, nan, nan, nan, area, cx, cy, -1, -1, -1
     bound, bdx, bdy = box_escape(ya, yb)
     # A vertex inside the other body by more than a length keeps the bodies penetrating
     # through any translation shorter than it (less the tolerance): no test there.
     d, dx, dy, status, side, v, f = contact_depth_of(a, b, bound, bdx, bdy, e, deep - 2.0 * e,
-                                                     depth_buf)
+                                                     known, depth_buf)
     if status == DEPTH_MORE_ROWS:
         return GEOMETRY_MORE_PIECES, nan, nan, nan, nan, nan, nan, nan, nan, -1, -1, -1
     if status == DEPTH_UNDECIDED:

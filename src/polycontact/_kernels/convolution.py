@@ -42,7 +42,7 @@ from .jit import njit
 from .packs import scratch_floats, state_scratch_views
 from .primitives import (bbox, edge_rows, grow_rows, loop_prev, norm, origin_distance_sq,
                          origin_foot)
-from .relation import PENETRATING, moved_state, state_in, witness_holds
+from .relation import NO_WITNESS, PENETRATING, moved_state, state_in, witness_holds
 
 
 #: Up to this many vertices in both bodies the contact segments are tried (O(m n)
@@ -58,6 +58,11 @@ _SIN_PARALLEL = 1.0 / 64.0
 #: Generous slack (a sine) in the kept-segment test: a near-tie is kept (a segment
 #: kept in excess only costs time).
 _SIN_SLACK = 1e-6
+
+#: Relative room (of a segment's terms) for the rounding of its distance from the
+#: origin when an edge's box says it lies beyond ``bound``: a segment kept in excess
+#: only costs time.
+_FAR_SLACK = 1e-12
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -110,6 +115,12 @@ def _add_segments(v, o, sign, bound, slack, seg, n, near):
         for t in range(m):
             j = near[t]
             gx, gy, lg = ee[j, 0], ee[j, 1], ee[j, 2]
+            # the segment is as far from the origin as p from the edge, so at least
+            # as far as p from the edge's box (with room for the rounding of its
+            # distance, a few units of its terms): the far ones are passed over
+            gap = max(ee[j, 3] - px, px - ee[j, 4], ee[j, 5] - py, py - ee[j, 6])
+            if gap > bound + _FAR_SLACK * (gap + lg):
+                continue
             jj = ne[j]
             x0 = sign * (px - xe[j, 0])
             y0 = sign * (py - xe[j, 1])
@@ -213,26 +224,41 @@ def penetrates(xa, sa, xb, sb, dx, dy, eps, moved, scratch):
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _escapes(a, b, px, py, d, eps, moved, scratch):
+def _escapes(a, b, px, py, d, eps, moved, scratch, known):
     """Whether A moved by p = (px, py), a point at distance d of a contact segment, ends
     the overlap, up to the tolerance: first tried 2 ``eps`` further along p (the bodies
     apart there by about ``eps`` where p makes them touch: the state kernel's cheaper
     case, no touch to look into), then at p itself. Every translation nearer than p
     having been found to penetrate, either makes p the depth within 2 ``eps``. ``a``,
-    ``b``: the bodies as :func:`contact_depth_of` takes them.
+    ``b``: the bodies as :func:`contact_depth_of` takes them. Returns ``(escapes,
+    known)``.
 
-    A penetration found 2 ``eps`` further whose witness (two edges crossing, a vertex
-    inside) holds at p too (:func:`polycontact._kernels.relation.witness_holds`) makes
-    p penetrate: the state kernel is not asked again there."""
+    A witness of a penetration (two edges crossing, a vertex inside;
+    :func:`polycontact._kernels.relation.witness_holds`) that holds both 2 ``eps``
+    further and at p makes p penetrate, as the state kernel would say at both: ``known``
+    = ``(witness, i, j)``, one found at another translation (``NO_WITNESS``: none), is
+    tried first, and the last one the state kernel gives is returned in its place. A
+    penetration found 2 ``eps`` further whose witness holds at p too makes p penetrate:
+    the state kernel is not asked again there."""
+    touch = state_scratch_views(scratch, a[0].shape[0] + b[0].shape[0])[2]
     if d > 0.0:
         f = 1.0 + 2.0 * eps / d
-        got, witness, i, j = moved_state(a, b, px * f, py * f, eps, moved, scratch)
+        w, i, j = known
+        if (w != NO_WITNESS
+                and witness_holds(a, b, px * f, py * f, eps, w, i, j, moved, touch)
+                and witness_holds(a, b, px, py, eps, w, i, j, moved, touch)):
+            return False, known
+        got, w, i, j = moved_state(a, b, px * f, py * f, eps, moved, scratch)
         if not got:
-            return True
-        touch = state_scratch_views(scratch, a[0].shape[0] + b[0].shape[0])[2]
-        if witness_holds(a, b, px, py, eps, witness, i, j, moved, touch):
-            return False
-    return not moved_state(a, b, px, py, eps, moved, scratch)[0]
+            return True, known
+        if w != NO_WITNESS:
+            known = (w, i, j)
+            if witness_holds(a, b, px, py, eps, w, i, j, moved, touch):
+                return False, known
+    got, w, i, j = moved_state(a, b, px, py, eps, moved, scratch)
+    if got and w != NO_WITNESS:
+        known = (w, i, j)
+    return not got, known
 
 
 @njit(cache=True, nogil=True)
@@ -308,21 +334,25 @@ def contact_depth_into(xa, sa, xb, sb, bound, bdx, bdy, eps, low, buffers):
     a = (xa, sa, ea[:m], nxa[:m], bbox(xa, m))
     b = (xb, sb, eb[:nb], nxb[:nb], bbox(xb, nb))
     while True:
-        got = contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers)
+        got = contact_depth_of(a, b, bound, bdx, bdy, eps, low, (NO_WITNESS, -1, -1),
+                               buffers)
         if got[3] != DEPTH_MORE_ROWS:
             return got[0], got[1], got[2], got[3] == DEPTH_FOUND, got[4], got[5], got[6]
         buffers = (buffers[0], grow_rows(buffers[1])) + buffers[2:]
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers):
+def contact_depth_of(a, b, bound, bdx, bdy, eps, low, known, buffers):
     """:func:`contact_depth_into` of the bodies ``a`` = ``(xa, sa, ea, nxa, box)``
     (packed loops, :func:`polycontact._kernels.primitives.edge_rows` table and
     successors, bounding box ``(xmin, xmax, ymin, ymax)``) and ``b`` likewise, their
     tables already built: ``(depth, dx, dy, status, side, vertex, edge)``, ``status``
     :data:`DEPTH_FOUND`, :data:`DEPTH_UNDECIDED` or :data:`DEPTH_MORE_ROWS` (the buffer
     of pieces, ``buffers[1]``, too short: nothing found, to be called again with a
-    longer one). Allocates nothing."""
+    longer one); ``known`` = ``(witness, i, j)``: a witness of a penetration the caller
+    found (:func:`polycontact._kernels.relation.moved_state`), tried before the state
+    kernel at each point (:func:`_escapes`), or ``(NO_WITNESS, -1, -1)``. Allocates
+    nothing."""
     seg, pts, ts, moved, scratch, _, _, _, _, near = buffers
     xa = a[0]
     tol = 4.0 * eps
@@ -346,7 +376,8 @@ def contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers):
             s = q
     if s >= 0 and low <= seg[s, 4] < bound:
         px, py, d = origin_foot(seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3])
-        if _escapes(a, b, px, py, d, eps, moved, scratch):
+        escaped, known = _escapes(a, b, px, py, d, eps, moved, scratch, known)
+        if escaped:
             return d, px, py, DEPTH_FOUND, int(seg[s, 5]), int(seg[s, 6]), int(seg[s, 7])
         pts[0, 0] = d
         pts[0, 1] = px
@@ -378,7 +409,8 @@ def contact_depth_of(a, b, bound, bdx, bdy, eps, low, buffers):
         pts[r, 3] = 1.0
         if d < low or _tried(pts, c, r):
             continue  # (known to penetrate; an end shared by several pieces is tried once)
-        if _escapes(a, b, px, py, d, eps, moved, scratch):
+        escaped, known = _escapes(a, b, px, py, d, eps, moved, scratch, known)
+        if escaped:
             q = int(pts[r, 4])
             return d, px, py, DEPTH_FOUND, int(seg[q, 5]), int(seg[q, 6]), int(seg[q, 7])
     if moved_state(a, b, bdx, bdy, eps, moved, scratch)[0]:

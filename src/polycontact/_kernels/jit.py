@@ -62,8 +62,8 @@ LOGGER = logging.getLogger("polycontact")
 COMPILE_NOTICE = ("polycontact is compiling the kernels this call needs, once: {estimate} "
                   "(then cached in {where}; `polycontact warmup` compiles them all ahead)")
 
-#: The compile time of a first call, measured on a 2-core machine: about 10 s for a
-#: classification, 40 s for a time of impact, 50 s for a no-fit polygon.
+#: The compile time of a first call, as the notice states it (a classification
+#: compiles the fewest kernels, a no-fit polygon the most).
 COMPILE_ESTIMATE = "10 s to a minute, depending on the call"
 
 #: A path into an argument: tuple indices from the argument down to an array.

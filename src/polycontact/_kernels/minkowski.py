@@ -522,7 +522,9 @@ def _cut(ax, ay, bx, by, xy, fr, starts, q, p, eps, parts, n1, n0):
     return n1, n0
 
 
-@njit(cache=True, nogil=True, inline="always")
+# Compiled once and called (not inlined) by the no-fit polygon's outline and the depth's
+# escape search; it allocates nothing, so its callers' arrays pass without reference counts.
+@njit(cache=True, nogil=True, _nrt=False)
 def clip_edge(sums, index, p, ax, ay, bx, by, t0, t1, eps, hint):
     """Clip the part [t0, t1] of edge (a, b) of sum p by the other ``sums`` (``(xy,
     starts, boxes, frames)``: see :func:`sum_index`), until nothing is left. Returns

@@ -1,8 +1,8 @@
 """Kernels: classify many pairs at once.
 
-The state kernels are serial: for small pairs (about a microsecond each) a ``prange``
-version measured 2-3 times slower on a 2-core machine; the caller splits the pairs over
-threads instead (the kernels release the GIL). The signed distances use ``prange``;
+The state kernels are serial: a pair of small bodies takes about a microsecond, too
+little for a ``prange`` loop's scheduling per pair; the caller splits the pairs over
+threads in chunks instead (the kernels release the GIL). The signed distances use ``prange``;
 penetration depths are left to the caller (:func:`polycontact._depth.penetrations`).
 
 A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
@@ -102,8 +102,8 @@ def _finish_undecided(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb
 
 # Compiled without Numba's reference counting (``_nrt=False``): the pass creates a view
 # of every ring and passes arrays down several calls, and the atomic reference-count
-# updates of those cost about as much as classifying a pair of 12-gons (measured 0.27
-# against 0.16 us per pair). Nothing in it may allocate (the compiler refuses if it does).
+# updates of those would cost about as much as classifying a pair of 12-gons. Nothing in
+# it may allocate (the compiler refuses if it does).
 @njit(cache=True, nogil=True, _nrt=False)
 def _raw_states_into(xa, xb, tol, rel, ulps, limit, floor, out, scratch, sa, sb):
     """:func:`raw_states`' pass over the pairs, into its arrays ``out``; a pair with a
@@ -216,8 +216,8 @@ def oriented(y, s, f):
 
 #: Up to this many vertices of A times vertices of B, the gap of a separate pair is
 #: found by trying every vertex against every edge of the other body, pruned by boxes,
-#: with no allocation (measured 2.8 times faster than :func:`closest_pair`'s sorted
-#: sweep on separate 12-gon pairs); above it, the sweep.
+#: with no allocation (for small bodies quicker than :func:`closest_pair`'s sorted
+#: sweep, which sorts and allocates); above it, the sweep.
 _BRUTE_GAP = 1024
 
 

@@ -279,8 +279,9 @@ CLASSIFIED = 2
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): per pair it makes four
-# views and passes a dozen arrays to the state kernel, and their atomic reference counts
-# cost ~25 ns per pair. Nothing in it may allocate: the buffers are passed in.
+# views and passes a dozen arrays to the state kernel, whose atomic reference-count
+# updates would cost a large part of a pair's classification. Nothing in it may
+# allocate: the buffers are passed in.
 @njit(cache=True, nogil=True, _nrt=False)
 def _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers):
     """The pairs that the live bodies ``alive[k0:k1]`` find in the broad phase, with
