@@ -5,9 +5,10 @@ overruns shows as ``> limit``, not as a stuck run), after a warm-up call on smal
 in that process (compiled kernels loaded from the cache, not timed). The bodies are
 built before the clock starts (a Shape checks its rings once); each repetition calls on
 fresh copies of the arrays, so no decomposition cache is reused. Printed: the bound, the
-median of ``--repeat`` calls with the smallest and largest, and the outcome: the answer's
-gist, or the error's class when the call refuses (a refusal names its estimate and the
-limit it passes, see :mod:`polycontact.limits`).
+median of ``--repeat`` calls with the smallest and largest, the median CPU time of the
+process (all its threads: on a loaded machine it shows the work apart from the waiting),
+and the outcome: the answer's gist, or the error's class when the call refuses (a
+refusal names its estimate and the limit it passes, see :mod:`polycontact.limits`).
 
 Cases:
 
@@ -169,16 +170,18 @@ def one_row(case: str, repeat: int) -> dict[str, Any]:
     warm, call = setup(case)
     warm()
     times = []
+    cpu = []
     outcome = ""
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             outcome = str(call())
         except Exception as err:  # noqa: BLE001 - a refusal is an outcome
             outcome = f"refused: {type(err).__name__}"
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
     return {"case": case, "median": float(np.median(times)), "min": min(times),
-            "max": max(times), "outcome": outcome}
+            "max": max(times), "cpu": float(np.median(cpu)), "outcome": outcome}
 
 
 def main() -> None:
@@ -191,7 +194,7 @@ def main() -> None:
     if args.row:
         print(json.dumps(one_row(args.row, args.repeat)))
         return
-    print(f"{'case':18} {'bound s':>8} {'median s':>9} {'min..max s':>15}  outcome")
+    print(f"{'case':18} {'bound s':>8} {'median s':>9} {'min..max s':>15} {'CPU s':>8}  outcome")
     for case in args.case or list(BOUNDS):
         bound = BOUNDS[case]
         # the limit: each repetition within three times its bound, plus the set-up
@@ -202,8 +205,8 @@ def main() -> None:
             print(f"{case:18} {bound:8.0f} {row:>9}", flush=True)
             continue
         spread = f"{row['min']:.3f}..{row['max']:.3f}"
-        print(f"{case:18} {bound:8.0f} {row['median']:9.3f} {spread:>15}  {row['outcome']}",
-              flush=True)
+        print(f"{case:18} {bound:8.0f} {row['median']:9.3f} {spread:>15} {row['cpu']:8.3f}  "
+              f"{row['outcome']}", flush=True)
 
 
 if __name__ == "__main__":

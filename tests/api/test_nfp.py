@@ -408,6 +408,41 @@ def test_inner_fit_against_brute_force(a, container):
             assert inside == shapely.intersects_xy(ifp, x, y), (x, y)
 
 
+# Grid shapes whose straight sides hold several vertices: the sums along one line mix
+# edges on and off the reduced convolution; the outline there is kept once, by the kernel.
+GRID_INNER_FITS = [
+    ([(0, 0), (1, 0), (2, 0), (2, 1), (1, 1), (0, 1)],
+     [(1, 1), (2, 1), (2, 0), (3, 0), (3, 1), (4, 1), (4, 0), (5, 0), (5, 1), (5, 2), (5, 3),
+      (5, 4), (5, 5), (4, 5), (3, 5), (2, 5), (1, 5), (0, 5), (0, 4), (0, 3), (0, 2), (1, 2)],
+     shapely.Polygon([(0, 4), (3, 4), (3, 1), (1, 1), (1, 2), (0, 2)])),
+    ([(0, 1), (0, 0), (1, 0), (2, 0), (3, 0), (3, 1), (3, 2), (3, 3), (2, 3), (1, 3), (0, 3),
+      (0, 2)],
+     [(0, 2), (0, 1), (0, 0), (1, 0), (2, 0), (3, 0), (4, 0), (4, 1), (5, 1), (5, 2), (4, 2),
+      (4, 3), (5, 3), (5, 4), (4, 4), (3, 4), (2, 4), (2, 5), (1, 5), (0, 5), (0, 4), (0, 3)],
+     shapely.box(0, 0, 1, 1)),
+]
+
+
+@pytest.mark.parametrize("a, container, want", GRID_INNER_FITS)
+def test_inner_fit_of_grid_shapes_is_assembled_by_the_kernel(a, container, want):
+    before = nfp_module.fallback_count()
+    ifp = pc.inner_fit_polygon(a, container, reference="origin")
+    assert nfp_module.fallback_count() == before
+    assert shapely.equals(ifp, want), ifp.wkt
+    # no vertex that changes nothing (none on the segment of its neighbours)
+    ring = np.asarray(ifp.exterior.coords)[:-1]
+    u = ring - np.roll(ring, 1, axis=0)
+    v = np.roll(ring, -1, axis=0) - ring
+    turn = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    assert np.all(turn != 0), ifp.wkt
+    c = shapely.Polygon(container)
+    ap = shapely.Polygon(a)
+    for x in np.arange(-1, 5, 0.25):
+        for y in np.arange(-1, 5, 0.25):
+            inside = shapely.affinity.translate(ap, x, y).difference(c).area < 1e-12
+            assert inside == shapely.intersects_xy(ifp, x, y), (x, y)
+
+
 # -- no crash at any finite input --------------------------------------------------------
 
 HUGE = [1e105, 1e120, 1e140, 1e154]

@@ -176,12 +176,62 @@ def frames(xy, starts):
 
 
 @njit(cache=True, nogil=True)
-def mark_inner(fr, keep):
-    """Mark in the frames ``fr`` (:func:`frames`, in place) the edges off the reduced
-    convolution (``keep`` False, see :func:`convex_sums`) as ``INNER_EDGE``."""
-    for i in range(fr.shape[0]):
-        if fr[i, 3] != ZERO_LENGTH and not keep[i]:
-            fr[i, 3] = INNER_EDGE
+def mark_inner(xy, starts, fr, keep, eps):
+    """Mark in the frames ``fr`` (:func:`frames`, in place) of the packed sums ``(xy,
+    starts)`` the edges off the reduced convolution (``keep`` False, see
+    :func:`convex_sums`) as ``INNER_EDGE``, unless another edge of their sum on the same
+    line (consecutive edges whose shorter one ends within ``eps`` of the other's line,
+    zero-length ones between them skipped) is on it.
+
+    :func:`_clip` sees a sum's edges along a line as one: the outline along it is kept
+    once, by the first sum whose edge there is an ``EDGE``; a line of mixed edges would
+    keep the outline there twice, or not at all.
+
+    >>> import numpy as np
+    >>> sq = np.array([(0, 0), (1, 0), (2, 0), (2, 2), (0, 2)], float)
+    >>> st = np.array([0, 5])
+    >>> fr = frames(sq, st)
+    >>> mark_inner(sq, st, fr, np.array([True, False, False, True, False]), 1e-12)
+    >>> fr[:, 3].tolist()
+    [1.0, 1.0, 2.0, 1.0, 2.0]
+    """
+    for k in range(starts.shape[0] - 1):
+        s = starts[k]
+        e = starts[k + 1]
+        edges = np.empty(e - s, np.int64)  # (the sum's edges of non-zero length)
+        length = np.empty(e - s)
+        m = 0
+        for i in range(s, e):
+            if fr[i, 3] != ZERO_LENGTH:
+                j = i + 1 if i + 1 < e else s
+                edges[m] = i
+                length[m] = np.hypot(xy[j, 0] - xy[i, 0], xy[j, 1] - xy[i, 1])
+                m += 1
+        kept = np.empty(m, np.bool_)
+        on_line = np.empty(m, np.bool_)  # (edge t and the next on one line)
+        for t in range(m):
+            u = (t + 1) % m
+            kept[t] = keep[edges[t]]
+            on_line[t] = _one_line(fr, edges[t], edges[u], min(length[t], length[u]), eps)
+        for t in range(2 * m):  # (twice round: a line may wrap past the first edge)
+            if on_line[t % m] and kept[t % m]:
+                kept[(t + 1) % m] = True
+        for t in range(2 * m - 1, -1, -1):
+            if on_line[t % m] and kept[(t + 1) % m]:
+                kept[t % m] = True
+        for t in range(m):
+            if not kept[t]:
+                fr[edges[t], 3] = INNER_EDGE
+
+
+@njit(cache=True, nogil=True)
+def _one_line(fr, i, j, shorter, eps):
+    """Whether edges i and j (frames ``fr``, non-zero length, the shorter ``shorter``
+    long) run the same way on one line: the shorter one's far end is within ``eps`` of
+    the other's line."""
+    if fr[i, 0] * fr[j, 0] + fr[i, 1] * fr[j, 1] <= 0.0:
+        return False
+    return abs(fr[i, 0] * fr[j, 1] - fr[i, 1] * fr[j, 0]) * shorter <= eps
 
 
 @njit(cache=True, nogil=True)

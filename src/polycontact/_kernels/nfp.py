@@ -70,7 +70,8 @@ def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, max_tests
                 np.empty((0, 4)), meta)
     bb = boxes(sums, starts)
     fr = frames(sums, starts)
-    mark_inner(fr, keep)  # (edges off the reduced convolution: none of the outline)
+    # (edges off the reduced convolution: none of the outline)
+    mark_inner(sums, starts, fr, keep, eps)
     index = outline_index(sums, starts, bb, fr, eps)
     meta[3] = clip_tests((sums, starts, bb, fr), index, eps)
     if meta[3] > max_tests:
