@@ -781,7 +781,7 @@ def _spawn_reruns_caller() -> bool:
     number of functions) from the top-level code of the ``__main__`` module outside an
     ``if __name__ == "__main__":`` block, and ``multiprocessing`` runs that module again
     in a spawned process (a script run by path or ``python -m module``; not a package's
-    ``__main__.py``, nor an interactive session)."""
+    ``__main__.py``, nor the interactive interpreter)."""
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None)
     name = getattr(getattr(main, "__spec__", None), "name", None)
