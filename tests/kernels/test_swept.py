@@ -43,6 +43,19 @@ def test_swept_boxes_of_a_path_that_overflows_are_the_whole_plane():
     assert boxes[0, :4].tolist() == [-np.inf, np.inf, -np.inf, np.inf]
 
 
+def _all_pairs(boxes: np.ndarray, owner: np.ndarray) -> list[list[int]]:
+    """The oracle of ``box_pairs``: every pair of owners (lower first) with boxes that
+    overlap or touch, by testing every pair of boxes."""
+    want = set()
+    for a in range(len(boxes)):
+        for b in range(len(boxes)):
+            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
+            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
+            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
+                want.add((int(owner[a]), int(owner[b])))
+    return sorted(map(list, want))
+
+
 @examples(200)
 @given(st.integers(1, 40), st.integers(1, 12), st.integers(0, 2**32 - 1))
 def test_box_pairs_equal_all_pairs_of_overlapping_boxes(n_boxes, n_bodies, seed):
@@ -53,15 +66,9 @@ def test_box_pairs_equal_all_pairs_of_overlapping_boxes(n_boxes, n_bodies, seed)
     boxes[:, 0::2] = lo
     boxes[:, 1::2] = lo + size
     owner = rng.integers(0, n_bodies, n_boxes).astype(np.int64)
-    want = set()
-    for a in range(n_boxes):
-        for b in range(n_boxes):
-            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
-            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
-            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
-                want.add((int(owner[a]), int(owner[b])))
+    want = _all_pairs(boxes, owner)
     got = box_pairs(boxes, owner, n_bodies)
-    assert got.tolist() == sorted(map(list, want))
+    assert got.tolist() == want
 
 
 @examples(150)
@@ -78,13 +85,7 @@ def test_box_pairs_of_boxes_of_every_size_equal_all_pairs(n_boxes, n_bodies, see
     boxes[:, 1::2] = lo + size
     boxes[rng.random(n_boxes) < 0.05, 2] = -np.inf
     owner = rng.integers(0, n_bodies, n_boxes).astype(np.int64)
-    want = set()
-    for a in range(n_boxes):
-        for b in range(n_boxes):
-            lo_a, hi_a = boxes[a, 0::2], boxes[a, 1::2]
-            lo_b, hi_b = boxes[b, 0::2], boxes[b, 1::2]
-            if owner[a] < owner[b] and np.all(lo_a <= hi_b) and np.all(lo_b <= hi_a):
-                want.add((int(owner[a]), int(owner[b])))
+    want = _all_pairs(boxes, owner)
     with np.errstate(invalid="ignore"):  # (infinite boxes' centres, run as Python)
         got = box_pairs(boxes, owner, n_bodies)
-    assert got.tolist() == sorted(map(list, want))
+    assert got.tolist() == want
