@@ -155,7 +155,7 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
         p = pairs[one[bad[0]]]
         raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
                          int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]), "more")
-    return cast("np.ndarray", out[group])
+    return out[group]
 
 
 def _too_large(m: int, n: int, estimate: str) -> DepthTooLargeError:
