@@ -69,6 +69,8 @@ PARALLEL = [
     ("polycontact._kernels.world", "contact_pairs"),
     ("polycontact._kernels.world", "container_states"),
     ("polycontact._kernels.world", "left_cells"),
+    ("polycontact._kernels.world", "regrid"),
+    ("polycontact._kernels.packs", "unpack_shapes"),
     ("polycontact._kernels.poses", "pose_rows"),
     ("polycontact._kernels.poses", "pose_checks"),
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
