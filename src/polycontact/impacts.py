@@ -25,6 +25,7 @@ import operator
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field
+from itertools import chain
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -233,11 +234,15 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
             for k, m in enumerate(motions)]
 
 
-def _rows(motions: Motions) -> np.ndarray:
-    """The kernel vectors of ``motions``, (N, 6)."""
-    if isinstance(motions, MotionRows):
-        return motions.rows
-    return np.frombuffer(b"".join(map(_BYTES, motions)), np.float64).reshape(-1, 6)
+def _rows(*groups: Motions) -> np.ndarray:
+    """The kernel vectors of the motions of ``groups``, one group after another, (N, 6)
+    (Motions' bytes joined at once)."""
+    if len(groups) == 1 and isinstance(groups[0], MotionRows):
+        return groups[0].rows
+    if any(isinstance(g, MotionRows) for g in groups):
+        return np.concatenate([_rows(g) for g in groups])
+    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(groups))),
+                         np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -508,7 +513,7 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
         side, q = ("a", k) if k < p_count else ("b", k - p_count)
         return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
-    bodies = _bodies(a + b, np.concatenate([_rows(ma), _rows(mb)]),
+    bodies = _bodies(a + b, _rows(ma, mb),
                      lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
                      threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
