@@ -239,9 +239,10 @@ def _rows(*groups: Motions) -> np.ndarray:
     (Motions' bytes joined at once)."""
     if len(groups) == 1 and isinstance(groups[0], MotionRows):
         return groups[0].rows
-    if any(isinstance(g, MotionRows) for g in groups):
+    lists = [g for g in groups if not isinstance(g, MotionRows)]
+    if len(lists) < len(groups):
         return np.concatenate([_rows(g) for g in groups])
-    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(groups))),
+    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(lists))),
                          np.float64).reshape(-1, 6)
 
 

@@ -112,11 +112,7 @@ def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
         keys[h] = key
         heads[h] = -1
         made = 1
-    nxt[b] = heads[h]
-    prv[b] = -1
-    if heads[h] >= 0:
-        prv[heads[h]] = b
-    heads[h] = b
+    _link(heads, nxt, prv, h, b)
     slot[b] = h
     level[b] = idx
     lvl_count[idx] += 1
@@ -124,15 +120,30 @@ def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
 
 
 @njit(cache=True, nogil=True)
-def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
-    """Take body ``b`` out of its cell list."""
-    h = slot[b]
+def _link(heads, nxt, prv, h, b):
+    """Put body ``b`` at the head of the cell list of slot ``h``."""
+    nxt[b] = heads[h]
+    prv[b] = -1
+    if heads[h] >= 0:
+        prv[heads[h]] = b
+    heads[h] = b
+
+
+@njit(cache=True, nogil=True)
+def _unlink(heads, nxt, prv, h, b):
+    """Take body ``b`` out of the cell list of slot ``h``."""
     if prv[b] >= 0:
         nxt[prv[b]] = nxt[b]
     else:
         heads[h] = nxt[b]
     if nxt[b] >= 0:
         prv[nxt[b]] = prv[b]
+
+
+@njit(cache=True, nogil=True)
+def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
+    """Take body ``b`` out of its cell list."""
+    _unlink(heads, nxt, prv, slot[b], b)
     slot[b] = -1
     lvl_count[level[b]] -= 1
     level[b] = -1
@@ -191,20 +202,11 @@ def _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, insert):
             continue
         b = ids[k]
         if insert:
-            nxt[b] = heads[h]
-            prv[b] = -1
-            if heads[h] >= 0:
-                prv[heads[h]] = b
-            heads[h] = b
+            _link(heads, nxt, prv, h, b)
             slot[b] = h
             level[b] = moves[k, 2]
         else:
-            if prv[b] >= 0:
-                nxt[prv[b]] = nxt[b]
-            else:
-                heads[h] = nxt[b]
-            if nxt[b] >= 0:
-                prv[nxt[b]] = prv[b]
+            _unlink(heads, nxt, prv, h, b)
 
 
 @njit(cache=True, nogil=True, parallel=True)
