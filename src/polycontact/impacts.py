@@ -227,6 +227,11 @@ class PairImpacts(Sequence[PairImpact]):
 
     __hash__ = None  # type: ignore[assignment]
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # pickled with its records built (their maker is local to the call)
+        impacts = [event.impact for event in self]
+        return PairImpacts, (self.pairs, self.times, self.statuses, impacts.__getitem__)
+
     def __repr__(self) -> str:
         return f"<PairImpacts: {len(self)} events>"
 

@@ -11,6 +11,7 @@ ever left out, at any scale, offset, speed and acceleration.
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -299,6 +300,8 @@ def test_first_impacts_is_a_read_only_sequence_of_records_with_arrays():
     for array in (events.pairs, events.times, events.statuses):
         with pytest.raises(ValueError, match="read-only"):
             array[0] = 0
+    again = pickle.loads(pickle.dumps(events))
+    assert again == events and again.times.tolist() == events.times.tolist()
     empty = first_impacts([SQ], [Motion()], t_max=5)
     assert not empty and empty.pairs.shape == (0, 2) and list(empty) == []
     # a World numbers them by its ids
