@@ -53,6 +53,7 @@ _LAZY = {
     "first_impacts": "impacts",
     "first_impact": "impacts",
     "PairImpact": "impacts",
+    "PairImpacts": "impacts",
     "Scene": "scene",
     "SceneBody": "scene",
     "load_scene": "scene",
