@@ -279,9 +279,7 @@ class FirstImpacts(Path):
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
         ev = pc.first_impacts(self.shapes, self.motions, t_max=0.5, threads=threads)
-        return (np.array([(e.i, e.j) for e in ev]).reshape(-1, 2),
-                np.array([e.impact.status.value == "hit" for e in ev]),
-                np.array([np.nan if e.impact.time is None else e.impact.time for e in ev]))
+        return ev.pairs, ev.statuses, ev.times
 
 
 def jakobs1(orientations: int) -> tuple[Any, list[float]]:

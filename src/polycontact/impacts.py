@@ -26,7 +26,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field
 from itertools import chain
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, overload
 
 import numpy as np
 
@@ -43,7 +43,7 @@ from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
 from ._threads import as_done, numba_threads, requested, useful
 
-__all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
+__all__ = ["ImpactBatch", "PairImpact", "PairImpacts", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
 
 
@@ -153,6 +153,88 @@ class PairImpact(NamedTuple):
     i: int
     j: int
     impact: Impact
+
+
+class PairImpacts(Sequence[PairImpact]):
+    """The events of :func:`first_impacts`, sorted by time: a sequence of
+    :class:`PairImpact` records, each built when it is read, and the arrays of all of
+    them at once (what one filters and counts over many events, without a Python
+    object per event).
+
+    Attributes
+    ----------
+    pairs : ndarray of shape (K, 2), int64
+        ``(i, j)`` of each event, ``i < j`` in the caller's numbering.
+    times : ndarray of shape (K,), float64
+        Each event's :func:`event_time`, ascending (ties by ``(i, j)``).
+    statuses : ndarray of shape (K,), int8
+        The codes of :attr:`ImpactBatch.statuses`: 0 the pair only touches, 1 it
+        collides, 2 it penetrates at the start, 3 its search ran out of iterations.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> events = first_impacts([sq, sq.moved((3, 0)), sq.moved((1.5, 1))],
+    ...                        [Motion(velocity=(1, 0)), Motion(), Motion()], t_max=5)
+    >>> events.pairs.tolist(), events.times.round(3).tolist(), events.statuses.tolist()
+    ([[0, 2], [0, 1]], [0.5, 2.0], [0, 1])
+    >>> i, j, impact = events[1]
+    >>> i, j, impact.status.value, len(events)
+    (0, 1, 'hit', 2)
+    """
+
+    __slots__ = ("pairs", "times", "statuses", "_make")
+
+    def __init__(self, pairs: np.ndarray, times: np.ndarray, statuses: np.ndarray,
+                 make: Callable[[int], Impact]) -> None:
+        for array in (pairs, times, statuses):
+            array.flags.writeable = False  # a result cannot be changed
+        self.pairs = pairs
+        self.times = times
+        self.statuses = statuses
+        self._make = make
+
+    def renumbered(self, numbers: np.ndarray) -> PairImpacts:
+        """The same events with body ``k`` called ``numbers[k]`` (increasing, so that
+        ``i < j`` still holds)."""
+        return PairImpacts(numbers[self.pairs], self.times, self.statuses, self._make)
+
+    def __len__(self) -> int:
+        return int(self.times.shape[0])
+
+    @overload
+    def __getitem__(self, k: int) -> PairImpact: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> list[PairImpact]: ...
+
+    def __getitem__(self, k: int | slice) -> PairImpact | list[PairImpact]:
+        if isinstance(k, slice):
+            return [self[q] for q in range(*k.indices(len(self)))]
+        n = len(self)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
+            raise IndexError(f"expected an event index in [0, {n}), got {k!r}")
+        q = int(k) % n
+        return PairImpact(int(self.pairs[q, 0]), int(self.pairs[q, 1]), self._make(q))
+
+    def __iter__(self) -> Iterator[PairImpact]:
+        return (self[q] for q in range(len(self)))
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (PairImpacts, list, tuple)):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # pickled with its records built (their maker is local to the call)
+        impacts = [event.impact for event in self]
+        return PairImpacts, (self.pairs, self.times, self.statuses, impacts.__getitem__)
+
+    def __repr__(self) -> str:
+        return f"<PairImpacts: {len(self)} events>"
 
 
 # -- validation ------------------------------------------------------------------------
@@ -748,7 +830,7 @@ def first_impacts(
     samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
-) -> list[PairImpact]:
+) -> PairImpacts:
     """Every pair of moving bodies that meets within ``[0, t_max]``, sorted by time.
 
     A pair meets when its bodies touch or penetrate at some time of the window (an
@@ -789,8 +871,9 @@ def first_impacts(
 
     Returns
     -------
-    list of PairImpact
-        ``(i, j, impact)`` records.
+    PairImpacts
+        A sequence of ``(i, j, impact)`` records (:class:`PairImpact`), each built when
+        read, with the arrays ``pairs``, ``times`` and ``statuses`` of all of them.
 
     Raises
     ------
@@ -817,7 +900,7 @@ def first_impacts(
     bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
     pairs = _candidates(bodies, t_max)
     if len(pairs) == 0:
-        return []
+        return _no_events()
     # only the shapes of candidate pairs are packed and searched
     i, j = pairs[:, 0], pairs[:, 1]
     oi, oj = bodies.owner[i], bodies.owner[j]
@@ -828,22 +911,27 @@ def first_impacts(
                        inverse[: len(i)], inverse[len(i):], bodies.motions[i],
                        bodies.motions[j], eps_rel, t_max, method, tol, samples,
                        max_iterations, threads)
-    code, _, _, contact, *_ = raw
+    code, t_hi, _, contact, _, reached, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
-    events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
-              for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
-    events.sort(key=lambda e: (event_time(e.impact), e.i, e.j))
-    return events
+    met = np.flatnonzero((code != 0) | (contact >= 0.0))
+    # event_time of each, from the arrays (tested equal)
+    when = np.select([code[met] == 2, code[met] == 1, code[met] == 3],
+                     [0.0, t_hi[met], reached[met]],
+                     np.where(contact[met] >= 0.0, contact[met], math.inf))
+    order = np.lexsort((j[met], i[met], when))
+    chosen = met[order]
+    return PairImpacts(np.ascontiguousarray(pairs[chosen], dtype=np.int64), when[order],
+                       code[chosen].astype(np.int8), lambda k: make(int(chosen[k])))
 
 
-def _first_order(event: PairImpact) -> tuple[Any, ...]:
-    """:meth:`polycontact.Scene.first_impact`'s order: collisions (penetrating at the
-    start, hits, searches without a verdict) by time before any touch."""
-    imp = event.impact
-    touch_only = imp.status is ImpactStatus.NO_HIT
-    return (math.inf if touch_only else event_time(imp),
-            event_time(imp) if touch_only else 0.0, event.i, event.j)
+def _no_events() -> PairImpacts:
+    """The answer of :func:`first_impacts` when no pair can meet."""
+
+    def never(k: int) -> Impact:  # (no index reaches it)
+        raise IndexError(k)
+
+    return PairImpacts(np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int8), never)
 
 
 def first_impact(
@@ -892,4 +980,12 @@ def first_impact(
     events = first_impacts(shapes, motions, t_max=t_max, method=method,
                            time_tolerance=time_tolerance, samples=samples,
                            max_iterations=max_iterations, threads=threads)
-    return min(events, key=_first_order) if events else None
+    if not len(events):
+        return None
+    # collisions (penetrating at the start, hits, searches without a verdict) by time
+    # before any touch, then by (i, j)
+    touch = events.statuses == 0
+    first = np.lexsort((events.pairs[:, 1], events.pairs[:, 0],
+                        np.where(touch, events.times, 0.0),
+                        np.where(touch, math.inf, events.times)))[0]
+    return events[int(first)]

@@ -708,6 +708,22 @@ def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any
     return arr.reshape(-1, 2), ls, np.arange(0, 2 * p_count + 1, 2, dtype=np.int64), sign
 
 
+def _pack_ring_array(arr: np.ndarray, what: str) -> tuple[Any, ...]:
+    """:func:`pack_bodies` of a (P, N, 2) ring array: a float64 copy, its rings checked
+    in one kernel pass (as :func:`_classify_arrays` checks them), packed as they are;
+    when a ring is not certified valid, every ring goes through ``pack_bodies``, whose
+    errors name it (``shapes_a[3]: ...``)."""
+    from ._kernels import relation_many as km
+
+    copy = np.array(arr, dtype=np.float64, order="C")
+    p_count, n = copy.shape[0], copy.shape[1]
+    used, sign = km.check_rings(copy.reshape(-1, 2), np.arange(p_count, dtype=np.int64) * n,
+                                np.full(p_count, n, dtype=np.int64), *_RING_ARGS)
+    if (used < 0).any():
+        return pack_bodies(list(copy), what)
+    return _ring_pack(copy, used, sign)
+
+
 def _classify_arrays(
     arr_a: np.ndarray, arr_b: np.ndarray, tol: float, threads: int
 ) -> RelationBatch | None:
@@ -1008,8 +1024,10 @@ def classify_many(
         batch = _classify_arrays(arr_a, arr_b, tol, n_threads)
         if batch is not None:
             return batch
-    pa = pack_bodies(shapes_a, "shapes_a")
-    pb = pack_bodies(shapes_b, "shapes_b")
+    pa = _pack_ring_array(arr_a, "shapes_a") if arr_a is not None else pack_bodies(
+        shapes_a, "shapes_a")
+    pb = _pack_ring_array(arr_b, "shapes_b") if arr_b is not None else pack_bodies(
+        shapes_b, "shapes_b")
     if len(pa[3]) != len(pb[3]):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"

@@ -713,13 +713,18 @@ class Shape:
             raise InvalidShapeError(f"expected one Polygon, got a {geom.geom_type}")
         if geom.is_empty:
             raise InvalidShapeError("the polygon is empty")
-        holes = [np.asarray(r.coords)[:, :2] for r in geom.interiors]
-        kept = [k for k, h in enumerate(holes) if len(h)]
-        shape = cls(np.asarray(geom.exterior.coords)[:, :2], [holes[k] for k in kept],
-                    repair=repair)
+        return cls._from_rings(np.asarray(geom.exterior.coords)[:, :2],
+                               [np.asarray(r.coords)[:, :2] for r in geom.interiors], repair)
+
+    @classmethod
+    def _from_rings(cls, exterior: Any, holes: list[Any], repair: bool) -> Shape:
+        """Shape of an interchange format's rings. An empty interior ring (WKT's
+        ``POLYGON ((...), EMPTY)``, GeoJSON's ``[]``) holds nothing (GEOS calls the
+        polygon valid): it is left out, and the holes after it keep their numbers."""
+        kept = [k for k, h in enumerate(holes)
+                if not (isinstance(h, (list, tuple, np.ndarray)) and len(h) == 0)]
+        shape = cls(exterior, [holes[k] for k in kept], repair=repair)
         if len(kept) < len(holes):
-            # An empty interior ring (``POLYGON ((...), EMPTY)``) holds nothing (GEOS calls
-            # the polygon valid): it is left out, and the holes after it keep their numbers.
             number = np.array([0] + [k + 1 for k in kept])
             loops = shape._input[0]
             object.__setattr__(shape, "_input", (
@@ -753,7 +758,8 @@ class Shape:
 
     @classmethod
     def from_geojson(cls, data: str | dict[str, Any], *, repair: bool = False) -> Shape:
-        """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
+        """Shape from a GeoJSON Polygon (a mapping, its rings lists or tuples as Python's
+        geo interface gives them, or JSON text); a Feature is unwrapped."""
         if isinstance(data, str):
             try:
                 data = load_json(data)
@@ -768,9 +774,9 @@ class Shape:
         if data.get("type") != "Polygon":
             raise InvalidShapeError(f"GeoJSON: expected a Polygon, got {data.get('type')!r}")
         rings = data.get("coordinates")
-        if not isinstance(rings, list) or not rings:
+        if not isinstance(rings, (list, tuple)) or not rings:
             raise InvalidShapeError("GeoJSON: 'coordinates' must be a non-empty list of rings")
-        return cls(rings[0], rings[1:], repair=repair)
+        return cls._from_rings(rings[0], list(rings[1:]), repair)
 
     @property
     def __geo_interface__(self) -> dict[str, Any]:

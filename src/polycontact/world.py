@@ -42,7 +42,7 @@ from ._checks import finite_number, one_value, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .impacts import PairImpact, first_impact, first_impacts
+from .impacts import PairImpact, PairImpacts, first_impact, first_impacts
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
                      MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, SWEPT_ROUNDING_ULPS,
                      TIME_TOLERANCE)
@@ -1742,7 +1742,7 @@ class World:
     def first_impacts(self, *, t_max: float, method: str = "exact",
                       time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
                       max_iterations: int = MAX_ITERATIONS,
-                      threads: int | None = None) -> list[PairImpact]:
+                      threads: int | None = None) -> PairImpacts:
         """Every pair of bodies that meets within ``[0, t_max]`` as they follow their
         motions, sorted by time.
 
@@ -1760,10 +1760,10 @@ class World:
 
         Returns
         -------
-        list of PairImpact
-            ``(id_a, id_b, impact)`` with ``id_a < id_b`` the bodies' ids and ``impact``
-            what :func:`polycontact.time_of_impact` answers for the two bodies as placed
-            now.
+        PairImpacts
+            ``(id_a, id_b, impact)`` records with ``id_a < id_b`` the bodies' ids and
+            ``impact`` what :func:`polycontact.time_of_impact` answers for the two bodies
+            as placed now (``pairs`` holds the ids too).
 
         Examples
         --------
@@ -1776,10 +1776,10 @@ class World:
         [(0, 1, 2.0)]
         """
         ids, shapes, motions = self._moving()
-        return [PairImpact(ids[e.i], ids[e.j], e.impact)
-                for e in first_impacts(shapes, motions, t_max=t_max, method=method,
-                                       time_tolerance=time_tolerance, samples=samples,
-                                       max_iterations=max_iterations, threads=threads)]
+        return first_impacts(shapes, motions, t_max=t_max, method=method,
+                             time_tolerance=time_tolerance, samples=samples,
+                             max_iterations=max_iterations,
+                             threads=threads).renumbered(np.asarray(ids, dtype=np.int64))
 
     def first_impact(self, *, t_max: float, method: str = "exact",
                      time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,

@@ -5,6 +5,9 @@ share here)."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import numba
 import numpy as np
@@ -342,3 +345,16 @@ def test_nfp_table_on_two_threads_equals_one_thread_and_single_nfps(share_everyt
         single = pc.no_fit_polygon(one._shape(one._slot(i, ai, "i")),
                                    one._shape(one._slot(j, aj, "j")), reference)
         assert entries_equal(one[key], single), key
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "PASSIVE"), ("active", "active")])
+def test_numba_threads_sleep_between_calls_unless_the_environment_says(given, expected):
+    # the policy is read when Numba starts its OpenMP threads: set on import, before any
+    # kernel runs
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = "import os, polycontact; print(os.environ['OMP_WAIT_POLICY'])"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, check=True).stdout
+    assert out.strip() == expected
