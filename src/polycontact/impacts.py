@@ -25,6 +25,7 @@ import operator
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field
+from itertools import chain
 from typing import Any, NamedTuple, overload
 
 import numpy as np
@@ -315,11 +316,16 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
             for k, m in enumerate(motions)]
 
 
-def _rows(motions: Motions) -> np.ndarray:
-    """The kernel vectors of ``motions``, (N, 6)."""
-    if isinstance(motions, MotionRows):
-        return motions.rows
-    return np.frombuffer(b"".join(map(_BYTES, motions)), np.float64).reshape(-1, 6)
+def _rows(*groups: Motions) -> np.ndarray:
+    """The kernel vectors of the motions of ``groups``, one group after another, (N, 6)
+    (Motions' bytes joined at once)."""
+    if len(groups) == 1 and isinstance(groups[0], MotionRows):
+        return groups[0].rows
+    lists = [g for g in groups if not isinstance(g, MotionRows)]
+    if len(lists) < len(groups):
+        return np.concatenate([_rows(g) for g in groups])
+    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(lists))),
+                         np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -332,28 +338,22 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
 
 
 # -- the batched search ----------------------------------------------------------------
-def pack_shapes(shapes: Sequence[Any], sizes: np.ndarray | None = None
-                ) -> tuple[np.ndarray, ...]:
+def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
-    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, and
-    each shape's stored centroid and bounding radius, from ``sizes``, their
-    :func:`shape_sizes` if already read)."""
-    sizes = shape_sizes(shapes) if sizes is None else sizes
-    return (*shapes_packed(shapes), np.ascontiguousarray(sizes[:, :2]),
-            np.ascontiguousarray(sizes[:, 2]))
+    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, each
+    shape's stored centroid and bounding radius read from its kernel pack)."""
+    return _for_batch(shapes_packed(shapes))[0]
 
 
-def shape_sizes(shapes: Sequence[Any]) -> np.ndarray:
-    """Each shape's stored centroid, bounding radius and extent, ``(N, 4)`` (read-only).
-
-    >>> shape_sizes([Shape([(0, 0), (2, 0), (2, 2), (0, 2)])]).round(6).tolist()
-    [[1.0, 1.0, 1.414214, 2.0]]
-    """
-    return np.frombuffer(b"".join(map(_SIZES, shapes)), np.float64).reshape(-1, 4)
+def _for_batch(unpacked: tuple[np.ndarray, ...]) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+    """Unpacked kernel packs ``(xy, rows, starts, st_off, sizes)`` as :func:`pack_shapes`
+    gives them, and the shapes' extents."""
+    xy, rows, starts, st_off, sizes = unpacked
+    return ((xy, rows, starts, st_off, np.ascontiguousarray(sizes[:, :2]),
+             np.ascontiguousarray(sizes[:, 2])), sizes[:, 3])
 
 
 _KERNEL = operator.attrgetter("_kernel")
-_SIZES = operator.attrgetter("_sizes")
 
 
 def empty_result(count: int) -> tuple[np.ndarray, ...]:
@@ -459,10 +459,9 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     count = len(shapes)
     ids = np.fromiter(map(id, shapes), np.int64, count)
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
-    uniq = [shapes[k] for k in first.tolist()]
+    uniq = list(map(shapes.__getitem__, first.tolist()))
     owner = owner.reshape(-1).astype(np.int64)
-    sizes = shape_sizes(uniq)
-    packed = pack_shapes(uniq, sizes)
+    packed, extents = _for_batch(shapes_packed(uniq))
     xy, vrows, _, _, centroids, radii = packed
     with numba_threads(useful(threads, count * _TABLE_SECONDS)) as n:
         suspect = suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
@@ -475,7 +474,7 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
             sh, m = shapes[k], motion_of(k)
             if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
                 check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
-    return _Bodies(uniq, packed, owner, rows, centroids, radii, sizes[:, 3])
+    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
 
 
 _BYTES = operator.attrgetter("_bytes")
@@ -597,7 +596,7 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
         side, q = ("a", k) if k < p_count else ("b", k - p_count)
         return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
-    bodies = _bodies(a + b, np.concatenate([_rows(ma), _rows(mb)]),
+    bodies = _bodies(a + b, _rows(ma, mb),
                      lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
                      threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
@@ -692,13 +691,13 @@ def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, metho
 
 
 class _ShapePack:
-    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates
-    and loop starts, see :func:`polycontact.relation.shapes_packed`), centroids and
-    bounding radii.
+    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates,
+    loop starts, centroid and bounding radius, see
+    :func:`polycontact.relation.shapes_packed`).
 
     A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
     shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
-    send against 1 s of work); bytes objects and two arrays travel as one message. The
+    send against 1 s of work); bytes objects travel as one message. The
     receiving task packs the shapes it needs for the search with :meth:`packed`.
 
     Examples
@@ -714,9 +713,6 @@ class _ShapePack:
 
     def __init__(self, shapes: Sequence[Any]) -> None:
         self.kernels = list(map(_KERNEL, shapes))
-        sizes = shape_sizes(shapes)
-        self.centroids = np.ascontiguousarray(sizes[:, :2])
-        self.radii = np.ascontiguousarray(sizes[:, 2])
 
     def __len__(self) -> int:
         return len(self.kernels)
@@ -728,12 +724,9 @@ class _ShapePack:
         from ._kernels.packs import unpack_shapes
 
         kernels = [k for p in packs for k in p.kernels]
-        centroids = np.concatenate([p.centroids for p in packs])
-        radii = np.concatenate([p.radii for p in packs])
-        picked = np.asarray(chosen, np.int64)
-        return (*unpack_shapes(np.frombuffer(b"".join(kernels[k] for k in picked.tolist()),
-                                             np.float64), len(picked)),
-                centroids[picked], radii[picked])
+        picked = [kernels[k] for k in np.asarray(chosen, np.int64).tolist()]
+        return _for_batch(unpack_shapes(np.frombuffer(b"".join(picked), np.float64),
+                                        len(picked), 1))[0]
 
 
 # -- many moving bodies ----------------------------------------------------------------

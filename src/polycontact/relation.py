@@ -817,7 +817,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
     if set(map(type, items)) <= {Shape}:  # (every body a Shape: packed without a loop)
         if made is not None:
             made[:] = items
-        xy, rows, starts, st_off = shapes_packed(list(items))
+        xy, rows, starts, st_off, _ = shapes_packed(list(items))
         return xy, starts + np.repeat(rows[:-1], np.diff(st_off)), st_off, np.ones(len(items))
     bodies: list[Any] = []
     raw: list[int] = []
@@ -867,20 +867,31 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
 
 def shapes_packed(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     """The stored coordinates of many shapes one after another, ``(xy, rows, starts,
-    st_off)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]`` and its loop starts
-    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]``. Each shape's kernel
-    pack (the bytes ``classify`` hands the kernels) is joined with the others and read
-    in compiled code: per shape, only the few tens of nanoseconds of the join.
+    st_off, sizes)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]``, its loop starts
+    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]`` and ``sizes[k]`` its
+    area centroid, bounding radius and extent. Each shape's kernel pack (the bytes
+    ``classify`` hands the kernels) is joined with the others and read in compiled code,
+    in parallel: per shape, only the few tens of nanoseconds of the join.
 
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> [a.tolist() for a in shapes_packed([sq, sq])[1:]]
+    >>> [a.tolist() for a in shapes_packed([sq, sq])[1:4]]
     [[0, 4, 8], [0, 4, 0, 4], [0, 2, 4]]
+    >>> shapes_packed([sq])[4].round(6).tolist()
+    [[0.5, 0.5, 0.707107, 1.0]]
     """
     from ._kernels.packs import unpack_shapes
+    from ._threads import chunks
 
+    count = len(shapes)
     out: tuple[np.ndarray, ...] = unpack_shapes(
-        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), len(shapes))
+        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), count,
+        chunks(count, _UNPACK_WORK))
     return out
+
+
+#: Copying a shape's kernel pack (a 12-gon's) in pair classifications (see
+#: :func:`polycontact._threads.chunks`).
+_UNPACK_WORK = 0.1
 
 
 _KERNEL = operator.attrgetter("_kernel")

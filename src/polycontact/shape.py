@@ -323,8 +323,7 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel",
-                 "_sizes")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -442,10 +441,8 @@ class Shape:
         # default_tolerance of this shape alone; of a pair, the larger of the two (the
         # rule is a max of terms that grow with the extent and the magnitude)
         self._tolerance = tolerance_for(extent, magnitude)
-        self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
-        # the centroid, the bounding radius and the extent as the bytes of four float64:
-        # what a batch of moving bodies reads of each shape, joined with the others'
-        self._sizes = np.array([*centroid, self._radius, extent], np.float64).tobytes()
+        self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance,
+                                    (*centroid, self._radius, extent))
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],
@@ -984,16 +981,19 @@ def _fmt(v: float) -> str:
 
 
 def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                 tolerance: float) -> bytes:
+                 tolerance: float, sizes: tuple[float, ...]) -> bytes:
     """The shape as the bytes of one float64 array, the layout of
     :data:`polycontact._kernels.packs.PACK_HEAD`: loop count, bounding box ``(xmin,
     ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the shape's
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
-    patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
+    patterns, ``xy`` row by row, then ``sizes``: the area centroid, the bounding radius
+    and the extent (:data:`polycontact._kernels.packs.PACK_TAIL`, what a batch of
+    moving bodies reads of each shape). :func:`polycontact.classify` passes it to the
     state kernel: one object to unbox per shape, immutable and holding its data in
     itself."""
     return np.concatenate(
-        ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
+        ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1),
+         sizes)
     ).tobytes()
 
 

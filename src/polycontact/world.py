@@ -89,6 +89,7 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 #: The work of one item of the passes that are not classifications, in units of one
 #: pair's classification (see :func:`polycontact._threads.chunks`).
 _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
+_GRID_WORK = 0.3  # moving a body to another cell of the grid (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
 _BODY_WORK = 6.0  # a body's broad-phase query and the classification of its pairs
 
@@ -1224,7 +1225,7 @@ class World:
         left = _k().left_cells(idx, self._keys, self._slot, self._box, self._origin, chunks)
         made, done = _k().regrid(left, self._keys, self._heads, self._nxt, self._prv,
                                  self._slot, self._level, self._lvl_count, self._box,
-                                 self._origin, self._filled)
+                                 self._origin, self._filled, _chunks(len(left), _GRID_WORK))
         self._filled += made
         if done < len(left):  # the table would be more than half full: a new one, with
             self._rebuild(extra=int(left[0]))  # every body in the cell of its new box
