@@ -132,7 +132,7 @@ def main() -> None:
     ratios_scene = [r[2] / r[0] for r in rounds]
     ratios_brute = [r[3] / r[0] for r in rounds]
     r_scene, r_brute = np.median(ratios_scene), np.median(ratios_brute)
-    hits = sum(e.impact.collides for e in events)
+    hits = int((events.statuses == 1).sum())
     print(f"first_impacts: {1e3 * t_fast:9.1f} ms  (swept bounds alone {1e3 * t_cand:.1f} ms: "
           f"{len(cand)} candidate pairs; {len(events)} pairs meet, {hits} collide)")
     print(f"first_impact:  {1e3 * t_one:9.1f} ms  -> bodies {first.i}, {first.j} at "

@@ -29,8 +29,9 @@ Paths (size, then the ``--quick`` size):
 For each thread count, ``numba.set_num_threads(t)`` and ``threads=t`` where the call
 takes it; the time is the median of ``--repeat`` calls (the fastest and slowest in
 brackets), and every answer is compared, entry by entry, with the one-thread answer
-(``same``). The serial fraction is measured at one thread: the time outside the
-parallel regions over the total, where the parallel regions are the calls of the
+(``same``). The serial fraction is measured at one thread, the median of ``--repeat``
+calls (the smallest and largest in brackets): the time outside the parallel regions
+over the total, where the parallel regions are the calls of the
 compiled parallel kernels and of the thread pool's chunk maps (timed by wrappers
 installed for the measurement only); Amdahl's prediction for 16 cores is
 ``1 / (s + (1 - s) / 16)``. On a machine shared with other jobs the speed-ups are noisy;
@@ -69,6 +70,8 @@ PARALLEL = [
     ("polycontact._kernels.world", "contact_pairs"),
     ("polycontact._kernels.world", "container_states"),
     ("polycontact._kernels.world", "left_cells"),
+    ("polycontact._kernels.world", "regrid"),
+    ("polycontact._kernels.packs", "unpack_shapes"),
     ("polycontact._kernels.poses", "pose_rows"),
     ("polycontact._kernels.poses", "pose_checks"),
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
@@ -276,9 +279,7 @@ class FirstImpacts(Path):
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
         ev = pc.first_impacts(self.shapes, self.motions, t_max=0.5, threads=threads)
-        return (np.array([(e.i, e.j) for e in ev]).reshape(-1, 2),
-                np.array([e.impact.status.value == "hit" for e in ev]),
-                np.array([np.nan if e.impact.time is None else e.impact.time for e in ev]))
+        return ev.pairs, ev.statuses, ev.times
 
 
 def jakobs1(orientations: int) -> tuple[Any, list[float]]:
@@ -367,6 +368,7 @@ def measure(path: Path, threads: list[int], repeat: int) -> dict[str, Any]:
                 total = time.perf_counter() - t0
                 serial.append((total - regions.seconds) / total)
         s = row["serial_fraction"] = statistics.median(serial)
+        row["serial_spread"] = [min(serial), max(serial)]
         row["amdahl16"] = 1.0 / (s + (1.0 - s) / 16.0)
     for t in threads:
         numba.set_num_threads(t if unit == "threads" else 1)
@@ -455,8 +457,10 @@ def show(row: dict[str, Any]) -> None:
         print(f"  {t:>8} {r['median']:>10.4f} [{r['min']:.4f}, {r['max']:.4f}]".ljust(45)
               + f"{up:>9} {str(r['same']):>5}")
     if row["serial_fraction"] is not None:
-        print(f"  serial fraction at one thread: {100 * row['serial_fraction']:.1f} %; "
-              f"Amdahl for 16 cores: {row['amdahl16']:.1f}×")
+        low, high = row["serial_spread"]
+        print(f"  serial fraction at one thread: {100 * row['serial_fraction']:.1f} % "
+              f"[{100 * low:.1f}, {100 * high:.1f}]; Amdahl for 16 cores: "
+              f"{row['amdahl16']:.1f}×")
 
 
 def main() -> None:

@@ -16,7 +16,13 @@ Examples
 from __future__ import annotations
 
 import importlib
+import os
 from typing import Any
+
+# Numba's OpenMP threads sleep between parallel calls unless the environment says
+# otherwise (read when Numba starts them): spinning threads take the cores the calling
+# thread needs on a busy machine (the threading policy, :mod:`polycontact._threads`).
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 from .errors import (DepthTooLargeError, EntranceBlockTooLargeError, InvalidSceneError,
                      InvalidShapeError, NfpTooLargeError, PolycontactError, WorkLimitError)
@@ -53,6 +59,7 @@ _LAZY = {
     "first_impacts": "impacts",
     "first_impact": "impacts",
     "PairImpact": "impacts",
+    "PairImpacts": "impacts",
     "Scene": "scene",
     "SceneBody": "scene",
     "load_scene": "scene",

@@ -8,6 +8,9 @@
 - **No more threads than the work can use.** A call estimates its work and takes one
   thread per :data:`~polycontact.limits.THREAD_WORK` seconds of it, at most the number
   above; work below that runs on the calling thread and starts no thread.
+- **Idle threads sleep.** ``import polycontact`` sets ``OMP_WAIT_POLICY=PASSIVE``
+  unless the environment sets it, so that Numba's OpenMP threads do not spin between
+  parallel calls, taking the cores the calling thread needs on a busy machine.
 - **Where the threads come from.** The compiled loops use Numba's pool; the calls that
   share kernels releasing the GIL among Python threads (:func:`map_chunks`) use one pool
   per process, started on first use and grown when a call asks for more threads, whose

@@ -25,7 +25,8 @@ import operator
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from itertools import chain
+from typing import Any, NamedTuple, overload
 
 import numpy as np
 
@@ -42,7 +43,7 @@ from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
 from ._threads import as_done, map_work, requested, useful
 
-__all__ = ["ImpactBatch", "PairImpact", "time_of_impact_many", "first_impacts", "first_impact",
+__all__ = ["ImpactBatch", "PairImpact", "PairImpacts", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
 
 
@@ -154,6 +155,88 @@ class PairImpact(NamedTuple):
     impact: Impact
 
 
+class PairImpacts(Sequence[PairImpact]):
+    """The events of :func:`first_impacts`, sorted by time: a sequence of
+    :class:`PairImpact` records, each built when it is read, and the arrays of all of
+    them at once (what one filters and counts over many events, without a Python
+    object per event).
+
+    Attributes
+    ----------
+    pairs : ndarray of shape (K, 2), int64
+        ``(i, j)`` of each event, ``i < j`` in the caller's numbering.
+    times : ndarray of shape (K,), float64
+        Each event's :func:`event_time`, ascending (ties by ``(i, j)``).
+    statuses : ndarray of shape (K,), int8
+        The codes of :attr:`ImpactBatch.statuses`: 0 the pair only touches, 1 it
+        collides, 2 it penetrates at the start, 3 its search ran out of iterations.
+
+    Examples
+    --------
+    >>> from polycontact import Motion, Shape
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> events = first_impacts([sq, sq.moved((3, 0)), sq.moved((1.5, 1))],
+    ...                        [Motion(velocity=(1, 0)), Motion(), Motion()], t_max=5)
+    >>> events.pairs.tolist(), events.times.round(3).tolist(), events.statuses.tolist()
+    ([[0, 2], [0, 1]], [0.5, 2.0], [0, 1])
+    >>> i, j, impact = events[1]
+    >>> i, j, impact.status.value, len(events)
+    (0, 1, 'hit', 2)
+    """
+
+    __slots__ = ("pairs", "times", "statuses", "_make")
+
+    def __init__(self, pairs: np.ndarray, times: np.ndarray, statuses: np.ndarray,
+                 make: Callable[[int], Impact]) -> None:
+        for array in (pairs, times, statuses):
+            array.flags.writeable = False  # a result cannot be changed
+        self.pairs = pairs
+        self.times = times
+        self.statuses = statuses
+        self._make = make
+
+    def renumbered(self, numbers: np.ndarray) -> PairImpacts:
+        """The same events with body ``k`` called ``numbers[k]`` (increasing, so that
+        ``i < j`` still holds)."""
+        return PairImpacts(numbers[self.pairs], self.times, self.statuses, self._make)
+
+    def __len__(self) -> int:
+        return int(self.times.shape[0])
+
+    @overload
+    def __getitem__(self, k: int) -> PairImpact: ...
+
+    @overload
+    def __getitem__(self, k: slice) -> list[PairImpact]: ...
+
+    def __getitem__(self, k: int | slice) -> PairImpact | list[PairImpact]:
+        if isinstance(k, slice):
+            return [self[q] for q in range(*k.indices(len(self)))]
+        n = len(self)
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not -n <= k < n:
+            raise IndexError(f"expected an event index in [0, {n}), got {k!r}")
+        q = int(k) % n
+        return PairImpact(int(self.pairs[q, 0]), int(self.pairs[q, 1]), self._make(q))
+
+    def __iter__(self) -> Iterator[PairImpact]:
+        return (self[q] for q in range(len(self)))
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (PairImpacts, list, tuple)):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # pickled with its records built (their maker is local to the call)
+        impacts = [event.impact for event in self]
+        return PairImpacts, (self.pairs, self.times, self.statuses, impacts.__getitem__)
+
+    def __repr__(self) -> str:
+        return f"<PairImpacts: {len(self)} events>"
+
+
 # -- validation ------------------------------------------------------------------------
 def _sequence(items: Any, what: str) -> list[Any]:
     if isinstance(items, (str, bytes, dict)) or not isinstance(items, (Sequence, np.ndarray)):
@@ -233,11 +316,16 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
             for k, m in enumerate(motions)]
 
 
-def _rows(motions: Motions) -> np.ndarray:
-    """The kernel vectors of ``motions``, (N, 6)."""
-    if isinstance(motions, MotionRows):
-        return motions.rows
-    return np.frombuffer(b"".join(map(_BYTES, motions)), np.float64).reshape(-1, 6)
+def _rows(*groups: Motions) -> np.ndarray:
+    """The kernel vectors of the motions of ``groups``, one group after another, (N, 6)
+    (Motions' bytes joined at once)."""
+    if len(groups) == 1 and isinstance(groups[0], MotionRows):
+        return groups[0].rows
+    lists = [g for g in groups if not isinstance(g, MotionRows)]
+    if len(lists) < len(groups):
+        return np.concatenate([_rows(g) for g in groups])
+    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(lists))),
+                         np.float64).reshape(-1, 6)
 
 
 def check_many_options(t_max: float, method: str, time_tolerance: float, samples: int,
@@ -250,28 +338,22 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
 
 
 # -- the batched search ----------------------------------------------------------------
-def pack_shapes(shapes: Sequence[Any], sizes: np.ndarray | None = None
-                ) -> tuple[np.ndarray, ...]:
+def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
-    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, and
-    each shape's stored centroid and bounding radius, from ``sizes``, their
-    :func:`shape_sizes` if already read)."""
-    sizes = shape_sizes(shapes) if sizes is None else sizes
-    return (*shapes_packed(shapes), np.ascontiguousarray(sizes[:, :2]),
-            np.ascontiguousarray(sizes[:, 2]))
+    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, each
+    shape's stored centroid and bounding radius read from its kernel pack)."""
+    return _for_batch(shapes_packed(shapes))[0]
 
 
-def shape_sizes(shapes: Sequence[Any]) -> np.ndarray:
-    """Each shape's stored centroid, bounding radius and extent, ``(N, 4)`` (read-only).
-
-    >>> shape_sizes([Shape([(0, 0), (2, 0), (2, 2), (0, 2)])]).round(6).tolist()
-    [[1.0, 1.0, 1.414214, 2.0]]
-    """
-    return np.frombuffer(b"".join(map(_SIZES, shapes)), np.float64).reshape(-1, 4)
+def _for_batch(unpacked: tuple[np.ndarray, ...]) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+    """Unpacked kernel packs ``(xy, rows, starts, st_off, sizes)`` as :func:`pack_shapes`
+    gives them, and the shapes' extents."""
+    xy, rows, starts, st_off, sizes = unpacked
+    return ((xy, rows, starts, st_off, np.ascontiguousarray(sizes[:, :2]),
+             np.ascontiguousarray(sizes[:, 2])), sizes[:, 3])
 
 
 _KERNEL = operator.attrgetter("_kernel")
-_SIZES = operator.attrgetter("_sizes")
 
 
 def empty_result(count: int) -> tuple[np.ndarray, ...]:
@@ -380,10 +462,9 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     count = len(shapes)
     ids = np.fromiter(map(id, shapes), np.int64, count)
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
-    uniq = [shapes[k] for k in first.tolist()]
+    uniq = list(map(shapes.__getitem__, first.tolist()))
     owner = owner.reshape(-1).astype(np.int64)
-    sizes = shape_sizes(uniq)
-    packed = pack_shapes(uniq, sizes)
+    packed, extents = _for_batch(shapes_packed(uniq))
     xy, vrows, _, _, centroids, radii = packed
     suspect = np.zeros(count, np.bool_)
     map_work(lambda k0, k1: suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
@@ -397,7 +478,7 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
             sh, m = shapes[k], motion_of(k)
             if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
                 check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
-    return _Bodies(uniq, packed, owner, rows, centroids, radii, sizes[:, 3])
+    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
 
 
 _BYTES = operator.attrgetter("_bytes")
@@ -519,7 +600,7 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
         side, q = ("a", k) if k < p_count else ("b", k - p_count)
         return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
-    bodies = _bodies(a + b, np.concatenate([_rows(ma), _rows(mb)]),
+    bodies = _bodies(a + b, _rows(ma, mb),
                      lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
                      threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
@@ -614,13 +695,13 @@ def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, metho
 
 
 class _ShapePack:
-    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates
-    and loop starts, see :func:`polycontact.relation.shapes_packed`), centroids and
-    bounding radii.
+    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates,
+    loop starts, centroid and bounding radius, see
+    :func:`polycontact.relation.shapes_packed`).
 
     A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
     shape, which Dask sends one by one (10 000 pairs of small polygons took 12-16 s to
-    send against 1 s of work); bytes objects and two arrays travel as one message. The
+    send against 1 s of work); bytes objects travel as one message. The
     receiving task packs the shapes it needs for the search with :meth:`packed`.
 
     Examples
@@ -636,9 +717,6 @@ class _ShapePack:
 
     def __init__(self, shapes: Sequence[Any]) -> None:
         self.kernels = list(map(_KERNEL, shapes))
-        sizes = shape_sizes(shapes)
-        self.centroids = np.ascontiguousarray(sizes[:, :2])
-        self.radii = np.ascontiguousarray(sizes[:, 2])
 
     def __len__(self) -> int:
         return len(self.kernels)
@@ -650,12 +728,9 @@ class _ShapePack:
         from ._kernels.packs import unpack_shapes
 
         kernels = [k for p in packs for k in p.kernels]
-        centroids = np.concatenate([p.centroids for p in packs])
-        radii = np.concatenate([p.radii for p in packs])
-        picked = np.asarray(chosen, np.int64)
-        return (*unpack_shapes(np.frombuffer(b"".join(kernels[k] for k in picked.tolist()),
-                                             np.float64), len(picked)),
-                centroids[picked], radii[picked])
+        picked = [kernels[k] for k in np.asarray(chosen, np.int64).tolist()]
+        return _for_batch(unpack_shapes(np.frombuffer(b"".join(picked), np.float64),
+                                        len(picked), 1))[0]
 
 
 # -- many moving bodies ----------------------------------------------------------------
@@ -759,7 +834,7 @@ def first_impacts(
     samples: int = SAMPLES,
     max_iterations: int = MAX_ITERATIONS,
     threads: int | None = None,
-) -> list[PairImpact]:
+) -> PairImpacts:
     """Every pair of moving bodies that meets within ``[0, t_max]``, sorted by time.
 
     A pair meets when its bodies touch or penetrate at some time of the window (an
@@ -800,8 +875,9 @@ def first_impacts(
 
     Returns
     -------
-    list of PairImpact
-        ``(i, j, impact)`` records.
+    PairImpacts
+        A sequence of ``(i, j, impact)`` records (:class:`PairImpact`), each built when
+        read, with the arrays ``pairs``, ``times`` and ``statuses`` of all of them.
 
     Raises
     ------
@@ -828,7 +904,7 @@ def first_impacts(
     bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
     pairs = _candidates(bodies, t_max)
     if len(pairs) == 0:
-        return []
+        return _no_events()
     # only the shapes of candidate pairs are packed and searched
     i, j = pairs[:, 0], pairs[:, 1]
     oi, oj = bodies.owner[i], bodies.owner[j]
@@ -839,22 +915,27 @@ def first_impacts(
                        inverse[: len(i)], inverse[len(i):], bodies.motions[i],
                        bodies.motions[j], eps_rel, t_max, method, tol, samples,
                        max_iterations, threads)
-    code, _, _, contact, *_ = raw
+    code, t_hi, _, contact, _, reached, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
-    events = [PairImpact(int(i[p]), int(j[p]), make(int(p)))
-              for p in np.flatnonzero((code != 0) | (contact >= 0.0))]
-    events.sort(key=lambda e: (event_time(e.impact), e.i, e.j))
-    return events
+    met = np.flatnonzero((code != 0) | (contact >= 0.0))
+    # event_time of each, from the arrays (tested equal)
+    when = np.select([code[met] == 2, code[met] == 1, code[met] == 3],
+                     [0.0, t_hi[met], reached[met]],
+                     np.where(contact[met] >= 0.0, contact[met], math.inf))
+    order = np.lexsort((j[met], i[met], when))
+    chosen = met[order]
+    return PairImpacts(np.ascontiguousarray(pairs[chosen], dtype=np.int64), when[order],
+                       code[chosen].astype(np.int8), lambda k: make(int(chosen[k])))
 
 
-def _first_order(event: PairImpact) -> tuple[Any, ...]:
-    """:meth:`polycontact.Scene.first_impact`'s order: collisions (penetrating at the
-    start, hits, searches without a verdict) by time before any touch."""
-    imp = event.impact
-    touch_only = imp.status is ImpactStatus.NO_HIT
-    return (math.inf if touch_only else event_time(imp),
-            event_time(imp) if touch_only else 0.0, event.i, event.j)
+def _no_events() -> PairImpacts:
+    """The answer of :func:`first_impacts` when no pair can meet."""
+
+    def never(k: int) -> Impact:  # (no index reaches it)
+        raise IndexError(k)
+
+    return PairImpacts(np.empty((0, 2), np.int64), np.empty(0), np.empty(0, np.int8), never)
 
 
 def first_impact(
@@ -903,4 +984,12 @@ def first_impact(
     events = first_impacts(shapes, motions, t_max=t_max, method=method,
                            time_tolerance=time_tolerance, samples=samples,
                            max_iterations=max_iterations, threads=threads)
-    return min(events, key=_first_order) if events else None
+    if not len(events):
+        return None
+    # collisions (penetrating at the start, hits, searches without a verdict) by time
+    # before any touch, then by (i, j)
+    touch = events.statuses == 0
+    first = np.lexsort((events.pairs[:, 1], events.pairs[:, 0],
+                        np.where(touch, events.times, 0.0),
+                        np.where(touch, math.inf, events.times)))[0]
+    return events[int(first)]

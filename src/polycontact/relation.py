@@ -711,6 +711,22 @@ def _ring_pack(arr: np.ndarray, used: np.ndarray, sign: np.ndarray) -> tuple[Any
     return arr.reshape(-1, 2), ls, np.arange(0, 2 * p_count + 1, 2, dtype=np.int64), sign
 
 
+def _pack_ring_array(arr: np.ndarray, what: str) -> tuple[Any, ...]:
+    """:func:`pack_bodies` of a (P, N, 2) ring array: a float64 copy, its rings checked
+    in one kernel pass (as :func:`_classify_arrays` checks them), packed as they are;
+    when a ring is not certified valid, every ring goes through ``pack_bodies``, whose
+    errors name it (``shapes_a[3]: ...``)."""
+    from ._kernels import relation_many as km
+
+    copy = np.array(arr, dtype=np.float64, order="C")
+    p_count, n = copy.shape[0], copy.shape[1]
+    used, sign = km.check_rings(copy.reshape(-1, 2), np.arange(p_count, dtype=np.int64) * n,
+                                np.full(p_count, n, dtype=np.int64), *_RING_ARGS)
+    if (used < 0).any():
+        return pack_bodies(list(copy), what)
+    return _ring_pack(copy, used, sign)
+
+
 def _classify_arrays(
     arr_a: np.ndarray, arr_b: np.ndarray, tol: float, threads: int
 ) -> RelationBatch | None:
@@ -804,7 +820,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
     if set(map(type, items)) <= {Shape}:  # (every body a Shape: packed without a loop)
         if made is not None:
             made[:] = items
-        xy, rows, starts, st_off = shapes_packed(list(items))
+        xy, rows, starts, st_off, _ = shapes_packed(list(items))
         return xy, starts + np.repeat(rows[:-1], np.diff(st_off)), st_off, np.ones(len(items))
     bodies: list[Any] = []
     raw: list[int] = []
@@ -854,20 +870,31 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
 
 def shapes_packed(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     """The stored coordinates of many shapes one after another, ``(xy, rows, starts,
-    st_off)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]`` and its loop starts
-    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]``. Each shape's kernel
-    pack (the bytes ``classify`` hands the kernels) is joined with the others and read
-    in compiled code: per shape, only the few tens of nanoseconds of the join.
+    st_off, sizes)``: shape k's rows are ``xy[rows[k]:rows[k + 1]]``, its loop starts
+    (relative to its first row) ``starts[st_off[k]:st_off[k + 1]]`` and ``sizes[k]`` its
+    area centroid, bounding radius and extent. Each shape's kernel pack (the bytes
+    ``classify`` hands the kernels) is joined with the others and read in compiled code,
+    in parallel: per shape, only the few tens of nanoseconds of the join.
 
     >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    >>> [a.tolist() for a in shapes_packed([sq, sq])[1:]]
+    >>> [a.tolist() for a in shapes_packed([sq, sq])[1:4]]
     [[0, 4, 8], [0, 4, 0, 4], [0, 2, 4]]
+    >>> shapes_packed([sq])[4].round(6).tolist()
+    [[0.5, 0.5, 0.707107, 1.0]]
     """
     from ._kernels.packs import unpack_shapes
+    from ._threads import chunks
 
+    count = len(shapes)
     out: tuple[np.ndarray, ...] = unpack_shapes(
-        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), len(shapes))
+        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), count,
+        chunks(count, _UNPACK_WORK))
     return out
+
+
+#: Copying a shape's kernel pack (a 12-gon's) in pair classifications (see
+#: :func:`polycontact._threads.chunks`).
+_UNPACK_WORK = 0.1
 
 
 _KERNEL = operator.attrgetter("_kernel")
@@ -1000,8 +1027,10 @@ def classify_many(
         batch = _classify_arrays(arr_a, arr_b, tol, n_threads)
         if batch is not None:
             return batch
-    pa = pack_bodies(shapes_a, "shapes_a")
-    pb = pack_bodies(shapes_b, "shapes_b")
+    pa = _pack_ring_array(arr_a, "shapes_a") if arr_a is not None else pack_bodies(
+        shapes_a, "shapes_a")
+    pb = _pack_ring_array(arr_b, "shapes_b") if arr_b is not None else pack_bodies(
+        shapes_b, "shapes_b")
     if len(pa[3]) != len(pb[3]):
         raise ValueError(
             f"shapes_a and shapes_b differ in length ({len(pa[3])} and {len(pb[3])})"

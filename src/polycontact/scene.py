@@ -28,7 +28,7 @@ from ._json import load_json
 from .broad_phase import check_reach
 from .errors import InvalidSceneError, InvalidShapeError
 from .impact import time_of_impact
-from .impacts import PairImpact, first_impact, first_impacts
+from .impacts import PairImpact, PairImpacts, first_impact, first_impacts
 from .limits import MAX_ITERATIONS, SAMPLES, TIME_TOLERANCE
 from .motion import Motion
 from .shape import Shape, as_shape
@@ -216,7 +216,7 @@ class Scene:
         samples: int = SAMPLES,
         max_iterations: int = MAX_ITERATIONS,
         threads: int | None = None,
-    ) -> list[PairImpact]:
+    ) -> PairImpacts:
         """Every pair that meets within ``[0, t_max]`` (touches, penetrates, or has no
         verdict), sorted by time: what ``polycontact collide --all`` lists.
 
@@ -227,8 +227,8 @@ class Scene:
 
         Returns
         -------
-        list of PairImpact
-            ``(i, j, impact)``, ``i < j`` indices into :attr:`bodies`, as
+        PairImpacts
+            ``(i, j, impact)`` records, ``i < j`` indices into :attr:`bodies`, as
             :func:`polycontact.first_impacts` gives them.
 
         Examples

@@ -323,8 +323,7 @@ class Shape:
     """
 
     __slots__ = ("_loops", "_xy", "_starts", "_area", "_centroid", "_radius", "repairs",
-                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel",
-                 "_sizes")
+                 "_frame", "_extent", "_magnitude", "_tolerance", "_input", "_kernel")
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Each slot is bound once, at construction; only the time-of-impact search's
@@ -442,10 +441,8 @@ class Shape:
         # default_tolerance of this shape alone; of a pair, the larger of the two (the
         # rule is a max of terms that grow with the extent and the magnitude)
         self._tolerance = tolerance_for(extent, magnitude)
-        self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance)
-        # the centroid, the bounding radius and the extent as the bytes of four float64:
-        # what a batch of moving bodies reads of each shape, joined with the others'
-        self._sizes = np.array([*centroid, self._radius, extent], np.float64).tobytes()
+        self._kernel = _kernel_pack(xy, starts, lo, hi, self._tolerance,
+                                    (*centroid, self._radius, extent))
         self.repairs = repairs
 
     def _init_from_loops(self, loops: list[np.ndarray], repairs: tuple[str, ...],
@@ -716,13 +713,18 @@ class Shape:
             raise InvalidShapeError(f"expected one Polygon, got a {geom.geom_type}")
         if geom.is_empty:
             raise InvalidShapeError("the polygon is empty")
-        holes = [np.asarray(r.coords)[:, :2] for r in geom.interiors]
-        kept = [k for k, h in enumerate(holes) if len(h)]
-        shape = cls(np.asarray(geom.exterior.coords)[:, :2], [holes[k] for k in kept],
-                    repair=repair)
+        return cls._from_rings(np.asarray(geom.exterior.coords)[:, :2],
+                               [np.asarray(r.coords)[:, :2] for r in geom.interiors], repair)
+
+    @classmethod
+    def _from_rings(cls, exterior: Any, holes: list[Any], repair: bool) -> Shape:
+        """Shape of an interchange format's rings. An empty interior ring (WKT's
+        ``POLYGON ((...), EMPTY)``, GeoJSON's ``[]``) holds nothing (GEOS calls the
+        polygon valid): it is left out, and the holes after it keep their numbers."""
+        kept = [k for k, h in enumerate(holes)
+                if not (isinstance(h, (list, tuple, np.ndarray)) and len(h) == 0)]
+        shape = cls(exterior, [holes[k] for k in kept], repair=repair)
         if len(kept) < len(holes):
-            # An empty interior ring (``POLYGON ((...), EMPTY)``) holds nothing (GEOS calls
-            # the polygon valid): it is left out, and the holes after it keep their numbers.
             number = np.array([0] + [k + 1 for k in kept])
             loops = shape._input[0]
             object.__setattr__(shape, "_input", (
@@ -756,7 +758,8 @@ class Shape:
 
     @classmethod
     def from_geojson(cls, data: str | dict[str, Any], *, repair: bool = False) -> Shape:
-        """Shape from a GeoJSON Polygon (dict or text); a Feature is unwrapped."""
+        """Shape from a GeoJSON Polygon (a mapping, its rings lists or tuples as Python's
+        geo interface gives them, or JSON text); a Feature is unwrapped."""
         if isinstance(data, str):
             try:
                 data = load_json(data)
@@ -771,9 +774,9 @@ class Shape:
         if data.get("type") != "Polygon":
             raise InvalidShapeError(f"GeoJSON: expected a Polygon, got {data.get('type')!r}")
         rings = data.get("coordinates")
-        if not isinstance(rings, list) or not rings:
+        if not isinstance(rings, (list, tuple)) or not rings:
             raise InvalidShapeError("GeoJSON: 'coordinates' must be a non-empty list of rings")
-        return cls(rings[0], rings[1:], repair=repair)
+        return cls._from_rings(rings[0], list(rings[1:]), repair)
 
     @property
     def __geo_interface__(self) -> dict[str, Any]:
@@ -978,16 +981,19 @@ def _fmt(v: float) -> str:
 
 
 def _kernel_pack(xy: np.ndarray, starts: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                 tolerance: float) -> bytes:
+                 tolerance: float, sizes: tuple[float, ...]) -> bytes:
     """The shape as the bytes of one float64 array, the layout of
     :data:`polycontact._kernels.packs.PACK_HEAD`: loop count, bounding box ``(xmin,
     ymin, xmax, ymax)`` (``lo``, ``hi``: the minima and maxima of ``xy``), the shape's
     default-tolerance term (``Shape._tolerance``), the loop ``starts`` as int64 bit
-    patterns, then ``xy`` row by row. :func:`polycontact.classify` passes it to the
+    patterns, ``xy`` row by row, then ``sizes``: the area centroid, the bounding radius
+    and the extent (:data:`polycontact._kernels.packs.PACK_TAIL`, what a batch of
+    moving bodies reads of each shape). :func:`polycontact.classify` passes it to the
     state kernel: one object to unbox per shape, immutable and holding its data in
     itself."""
     return np.concatenate(
-        ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1))
+        ((len(starts) - 1.0,), lo, hi, (tolerance,), starts.view(np.float64), xy.reshape(-1),
+         sizes)
     ).tobytes()
 
 

@@ -42,7 +42,7 @@ from ._checks import finite_number, one_value, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .impacts import PairImpact, first_impact, first_impacts
+from .impacts import PairImpact, PairImpacts, first_impact, first_impacts
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
                      MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, SWEPT_ROUNDING_ULPS,
                      TIME_TOLERANCE)
@@ -89,6 +89,7 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 #: The work of one item of the passes that are not classifications, in units of one
 #: pair's classification (see :func:`polycontact._threads.chunks`).
 _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
+_GRID_WORK = 0.3  # moving a body to another cell of the grid (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
 _BODY_WORK = 6.0  # a body's broad-phase query and the classification of its pairs
 
@@ -1224,7 +1225,7 @@ class World:
         left = _k().left_cells(idx, self._keys, self._slot, self._box, self._origin, chunks)
         made, done = _k().regrid(left, self._keys, self._heads, self._nxt, self._prv,
                                  self._slot, self._level, self._lvl_count, self._box,
-                                 self._origin, self._filled)
+                                 self._origin, self._filled, _chunks(len(left), _GRID_WORK))
         self._filled += made
         if done < len(left):  # the table would be more than half full: a new one, with
             self._rebuild(extra=int(left[0]))  # every body in the cell of its new box
@@ -1741,7 +1742,7 @@ class World:
     def first_impacts(self, *, t_max: float, method: str = "exact",
                       time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,
                       max_iterations: int = MAX_ITERATIONS,
-                      threads: int | None = None) -> list[PairImpact]:
+                      threads: int | None = None) -> PairImpacts:
         """Every pair of bodies that meets within ``[0, t_max]`` as they follow their
         motions, sorted by time.
 
@@ -1759,10 +1760,10 @@ class World:
 
         Returns
         -------
-        list of PairImpact
-            ``(id_a, id_b, impact)`` with ``id_a < id_b`` the bodies' ids and ``impact``
-            what :func:`polycontact.time_of_impact` answers for the two bodies as placed
-            now.
+        PairImpacts
+            ``(id_a, id_b, impact)`` records with ``id_a < id_b`` the bodies' ids and
+            ``impact`` what :func:`polycontact.time_of_impact` answers for the two bodies
+            as placed now (``pairs`` holds the ids too).
 
         Examples
         --------
@@ -1775,10 +1776,10 @@ class World:
         [(0, 1, 2.0)]
         """
         ids, shapes, motions = self._moving()
-        return [PairImpact(ids[e.i], ids[e.j], e.impact)
-                for e in first_impacts(shapes, motions, t_max=t_max, method=method,
-                                       time_tolerance=time_tolerance, samples=samples,
-                                       max_iterations=max_iterations, threads=threads)]
+        return first_impacts(shapes, motions, t_max=t_max, method=method,
+                             time_tolerance=time_tolerance, samples=samples,
+                             max_iterations=max_iterations,
+                             threads=threads).renumbered(np.asarray(ids, dtype=np.int64))
 
     def first_impact(self, *, t_max: float, method: str = "exact",
                      time_tolerance: float = TIME_TOLERANCE, samples: int = SAMPLES,

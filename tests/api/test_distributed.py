@@ -108,6 +108,24 @@ def test_classify_many_on_the_cluster_is_identical(client):
     assert np.array_equal(listed.states, local.states[:50])
 
 
+def test_ring_arrays_on_the_cluster_are_checked_and_copied_at_the_call(client):
+    # packed in one kernel pass (not ring by ring in Python), refused as locally when a
+    # ring is invalid, and never read after the call
+    a = np.array([SQUARE] * 6, dtype=float) + np.arange(6)[:, None, None] * 3.0
+    b = a + 0.5
+    bad = a.copy()
+    bad[4] = [(0, 0), (1, 1), (1, 0), (0, 1)]  # a bowtie
+    with pytest.raises(pc.InvalidShapeError, match=r"shapes_a\[4\]") as there:
+        pc.classify_many(bad, b, client=client)
+    with pytest.raises(pc.InvalidShapeError) as here_:
+        pc.classify_many(bad, b)
+    assert str(there.value) == str(here_.value)
+    batch = pc.classify_many(a, b, client=client)
+    a += 100.0  # the caller reuses its array before reading the distances
+    assert batch.states.tolist() == [2] * 6
+    assert batch.distances.tolist() == pytest.approx([-0.5] * 6)
+
+
 def impact_pairs(count: int, seed: int) -> tuple[list, list, list, list]:
     """Pairs that hit, touch, miss, penetrate at the start, in and around a body with a
     hole, then ``count`` random ones (some bodies shared by many pairs, some not)."""

@@ -11,6 +11,7 @@ ever left out, at any scale, offset, speed and acceleration.
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -232,6 +233,11 @@ def test_first_impacts_equals_brute_force_over_all_pairs(scene, method):
     assert same_events({(e.i, e.j): e.impact for e in events}, want)
     keys = [(event_time(e.impact), e.i, e.j) for e in events]
     assert keys == sorted(keys)
+    # the arrays say what the records say
+    assert events.times.tolist() == [k[0] for k in keys]
+    assert events.pairs.tolist() == [[e.i, e.j] for e in events]
+    assert [pc.ImpactStatus(("no-hit", "hit", "penetrating-at-start", "out-of-iterations")[c])
+            for c in events.statuses.tolist()] == [e.impact.status for e in events]
     if method == "sampled":
         return
     first = first_impact(bodies, moves, t_max=t_max, max_iterations=BUDGET)
@@ -278,6 +284,34 @@ def test_first_impacts_reports_hits_touches_and_start_overlaps_in_time_order():
     assert first_impact(shapes[:3], moves[:3], t_max=5)[:2] == (0, 1)
     assert first_impact(shapes[:1] + shapes[3:4], moves[:2], t_max=5) is None
     assert first_impacts([SQ], [Motion()], t_max=5) == [] and first_impacts([], [], t_max=5) == []
+
+
+def test_first_impacts_is_a_read_only_sequence_of_records_with_arrays():
+    shapes = [SQ, SQ.moved((3, 0)), SQ.moved((1.5, 1))]
+    moves = [Motion(velocity=(1, 0)), Motion(), Motion()]
+    events = first_impacts(shapes, moves, t_max=5)
+    assert isinstance(events, pc.PairImpacts) and len(events) == 2
+    assert events == list(events) == events[:] and events != list(events)[:1]
+    assert events[-1] == events[1] and (events[1].i, events[1].j) == (0, 1)
+    assert [e.i for e in reversed(events)] == [0, 0]
+    for bad in (2, -3, 1.0, True):
+        with pytest.raises(IndexError, match="event index"):
+            events[bad]
+    for array in (events.pairs, events.times, events.statuses):
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = 0
+    again = pickle.loads(pickle.dumps(events))
+    assert again == events and again.times.tolist() == events.times.tolist()
+    empty = first_impacts([SQ], [Motion()], t_max=5)
+    assert not empty and empty.pairs.shape == (0, 2) and list(empty) == []
+    # a World numbers them by its ids
+    world = pc.World()
+    world.add(SQ.moved((50, 50)))
+    ids = [world.add(s, motion=m) for s, m in zip(shapes, moves)]
+    world.remove(0)
+    got = world.first_impacts(t_max=5)
+    assert got.pairs.tolist() == [[ids[0], ids[2]], [ids[0], ids[1]]]
+    assert [(e.i, e.j) for e in got] == [tuple(p) for p in got.pairs.tolist()]
 
 
 # -- the swept bounds -------------------------------------------------------------------

@@ -299,3 +299,24 @@ def test_integer_and_decimal_coordinates_are_accepted():
 
     assert Shape(np.array([(0, 0), (2, 0), (0, 2)], dtype=np.int16)).area == 2.0
     assert Shape([(Decimal(0), 0), (Fraction(2), 0), (0, 2)]).area == 2.0
+
+
+def test_a_python_geo_interface_mapping_of_tuples_is_read():
+    """``shapely.geometry.mapping`` (and the geo interface of other libraries) gives
+    tuples, not lists."""
+    polygon = shapely.Polygon(SQUARE, [HOLE])
+    mapping = shapely.geometry.mapping(polygon)
+    assert isinstance(mapping["coordinates"], tuple)
+    for got in (Shape.from_geojson(mapping), Shape(mapping)):
+        assert got.to_shapely().equals(polygon)
+
+
+def test_an_empty_interior_ring_is_left_out_in_every_form():
+    polygon = shapely.Polygon(SQUARE, [[], HOLE])
+    expected = Shape(SQUARE, [HOLE])
+    for got in (Shape.from_shapely(polygon), Shape.from_wkt(polygon.wkt),
+                Shape.from_geojson(shapely.geometry.mapping(polygon)),
+                Shape.from_geojson(json.dumps(shapely.geometry.mapping(polygon)))):
+        assert len(got.holes) == 1
+        assert np.array_equal(got.holes[0], expected.holes[0])
+        assert got.input_loop(1) == 2

@@ -179,17 +179,37 @@ def test_state_of_a_pair_beyond_the_stack_scratch_is_refused_or_separate():
 @given(pairs(holes=None))
 def test_kernel_pack_is_the_shape(pair):
     """A shape's kernel pack unpacks to its packed arrays, its bounding box and its
-    tolerance term (what relate_shapes_into reads instead of computing them), cannot be
-    written, and its numbers are aligned."""
+    tolerance term (what relate_shapes_into reads instead of computing them) and ends
+    with its centroid, bounding radius and extent; it cannot be written, and its numbers
+    are aligned."""
     for shape in pair[:2]:
         xy, starts, box, tol = kpack.unpack_shape(shape._kernel)
         assert np.array_equal(xy, shape.packed[0]) and np.array_equal(starts, shape.packed[1])
         assert box == kprim.bbox(shape.packed[0], shape.n_vertices)
         assert tol == shape._tolerance
+        tail = np.frombuffer(shape._kernel, np.float64)[-kpack.PACK_TAIL:]
+        assert tail.tolist() == [*shape.centroid.tolist(), shape.bounding_radius,
+                                 shape._extent]
         assert type(shape._kernel) is bytes  # immutable by its type
         # the kernel reads float64 and int64 from the bytes' own storage: 8-byte aligned
         assert np.frombuffer(shape._kernel, np.uint8).ctypes.data % 8 == 0
         assert not xy.flags.writeable and not starts.flags.writeable
+
+
+@examples(20)
+@given(st.lists(shapes(holes=None), min_size=1, max_size=12), st.integers(2, 5))
+def test_kernel_packs_unpack_in_chunks_as_in_one(items, chunks):
+    """Many kernel packs unpacked in parallel chunks: the arrays of one serial pass, each
+    shape's coordinates, loop starts and sizes where its offsets say."""
+    blob = np.frombuffer(b"".join(s._kernel for s in items), np.float64)
+    one = kpack.unpack_shapes(blob, len(items), 1)
+    got = kpack.unpack_shapes(blob, len(items), chunks)
+    assert all(np.array_equal(x, y) for x, y in zip(one, got))
+    xy, rows, starts, st_off, sizes = got
+    for k, s in enumerate(items):
+        assert np.array_equal(xy[rows[k] : rows[k + 1]], s.packed[0])
+        assert np.array_equal(starts[st_off[k] : st_off[k + 1]], s.packed[1])
+        assert sizes[k].tolist() == [*s.centroid.tolist(), s.bounding_radius, s._extent]
 
 
 def test_scratch_views_do_not_overlap():

@@ -5,6 +5,9 @@ share here)."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import numba
 import numpy as np
@@ -163,6 +166,50 @@ def test_set_poses_on_two_threads_equal_one_thread(share_everything):
     assert same(on(1, one.contacts).pairs, on(2, two.contacts).pairs)
 
 
+GRID = ("_keys", "_heads", "_nxt", "_prv", "_slot", "_level", "_lvl_count")
+
+
+def regrid_one_by_one(left, grid, box, origin, filled):
+    """Each body of ``left`` taken out of its cell and put in the cell of its box, in
+    turn, stopping before the table would be more than half full: (cells made, bodies
+    done)."""
+    keys, heads, nxt, prv, slot, level, lvl_count = grid
+    made = 0
+    for k, b in enumerate(left.tolist()):
+        if filled + made + 1 > len(keys) // 2:
+            return made, k
+        kw.grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
+        made += kw.grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
+    return made, len(left)
+
+
+def test_regrid_in_chunks_equals_moving_each_body_in_turn():
+    """The grid after the bodies that left their cells are moved in parallel chunks: the
+    same table, cell lists (in the same order), slots, levels and level counts as moving
+    them one by one; and the same stop when the table would be more than half full."""
+    rng = np.random.default_rng(8)
+    w = pc.World()
+    ids = w.add_many(stars(rng, 400))
+    box = w._box.copy()
+    box[ids[::2]] += 0.37  # half move, many leaving their cell
+    grown = ids[1::7]  # some grow: another level
+    box[grown, 1] += 3.0
+    box[grown, 3] += 3.0
+    left = kw.left_cells(ids, w._keys, w._slot, box, w._origin, 1)
+    assert 50 < len(left) < 400
+    for filled in (w._filled, len(w._keys) // 2 - 3):
+        want_grid = [getattr(w, name).copy() for name in GRID]
+        want = regrid_one_by_one(left, want_grid, box, w._origin, filled)
+        for chunks in (1, 3, 8):
+            grid = [getattr(w, name).copy() for name in GRID]
+            got = kw.regrid(left, *grid, box, w._origin, filled, chunks)
+            assert tuple(int(x) for x in got) == want
+            if want[1] == len(left):  # (a stop leaves the table to be rebuilt)
+                for name, x, y in zip(GRID, want_grid, grid):
+                    assert same(x, y), name
+    assert want[1] < len(left)
+
+
 def test_set_poses_in_parallel_chunks_refuses_an_id_listed_twice(share_everything):
     w = pc.World()
     ids = w.add_many(np.stack([SQ + 2 * k for k in range(200)]))
@@ -298,3 +345,16 @@ def test_nfp_table_on_two_threads_equals_one_thread_and_single_nfps(share_everyt
         single = pc.no_fit_polygon(one._shape(one._slot(i, ai, "i")),
                                    one._shape(one._slot(j, aj, "j")), reference)
         assert entries_equal(one[key], single), key
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "PASSIVE"), ("active", "active")])
+def test_numba_threads_sleep_between_calls_unless_the_environment_says(given, expected):
+    # the policy is read when Numba starts its OpenMP threads: set on import, before any
+    # kernel runs
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = "import os, polycontact; print(os.environ['OMP_WAIT_POLICY'])"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, check=True).stdout
+    assert out.strip() == expected

@@ -30,7 +30,7 @@ Examples
 from __future__ import annotations
 
 import numpy as np
-from numba import types
+from numba import prange, types
 from numba.core import cgutils, config
 from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
@@ -181,11 +181,16 @@ def state_scratch_views(buf, size):
 #: the loop count, the bounding box as ``(xmin, ymin, xmax, ymax)``, the shape's
 #: default-tolerance term (``Shape._tolerance``: the kernel takes the larger of the two
 #: shapes', so the caller reads no float object), the loop starts (int64 bit patterns,
-#: L + 1 of them) and then the packed coordinates row by row. A
+#: L + 1 of them), the packed coordinates row by row, and last the :data:`PACK_TAIL`
+#: sizes (what a batch of moving bodies reads of each shape). A
 #: ``bytes`` object holds its data in itself: unboxing it reads one object, where an
 #: ndarray's header, shape and data are three (which counts when other code has evicted
 #: the caches).
 PACK_HEAD = 6
+
+#: The floats after a kernel pack's coordinates: the shape's area centroid ``(x, y)``,
+#: its bounding radius about it and its extent (the larger side of its box).
+PACK_TAIL = 4
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -213,11 +218,29 @@ STACK_FLOATS = getattr(scratch_floats, "py_func", scratch_floats)(STACK_VERTICES
 
 
 @njit(cache=True, nogil=True)
-def unpack_shapes(blob, count):
+def _unpack_into(blob, bits, at, rows, st_off, k0, k1, xy, starts, sizes):
+    """Shapes ``k0..k1`` of :func:`unpack_shapes` (their packs at ``blob[at[k]:]``)
+    copied into ``xy``, ``starts`` and ``sizes``."""
+    for k in range(k0, k1):
+        o = at[k]
+        m = st_off[k + 1] - st_off[k]
+        starts[st_off[k] : st_off[k + 1]] = bits[o + PACK_HEAD : o + PACK_HEAD + m]
+        first = o + PACK_HEAD + m
+        n = rows[k + 1] - rows[k]
+        for i in range(n):
+            xy[rows[k] + i, 0] = blob[first + 2 * i]
+            xy[rows[k] + i, 1] = blob[first + 2 * i + 1]
+        for i in range(PACK_TAIL):
+            sizes[k, i] = blob[first + 2 * n + i]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def unpack_shapes(blob, count, chunks):
     """The shapes of ``count`` kernel packs (the layout of :data:`PACK_HEAD`) one after
-    another in ``blob`` (float64), as ``(xy, rows, starts, st_off)``: shape k's rows
-    ``xy[rows[k]:rows[k + 1]]`` and its loop starts (from 0)
-    ``starts[st_off[k]:st_off[k + 1]]``."""
+    another in ``blob`` (float64), as ``(xy, rows, starts, st_off, sizes)``: shape k's
+    rows ``xy[rows[k]:rows[k + 1]]``, its loop starts (from 0)
+    ``starts[st_off[k]:st_off[k + 1]]`` and its :data:`PACK_TAIL` sizes ``sizes[k]``;
+    copied in ``chunks`` parallel chunks (1: serial, no thread start)."""
     bits = blob.view(np.int64)
     rows = np.zeros(count + 1, np.int64)
     st_off = np.zeros(count + 1, np.int64)
@@ -229,15 +252,14 @@ def unpack_shapes(blob, count):
         at[k] = o
         rows[k + 1] = rows[k] + n
         st_off[k + 1] = st_off[k] + nl + 1
-        o += PACK_HEAD + nl + 1 + 2 * n
+        o += PACK_HEAD + nl + 1 + 2 * n + PACK_TAIL
     xy = np.empty((rows[count], 2))
     starts = np.empty(st_off[count], np.int64)
-    for k in range(count):
-        o = at[k]
-        m = st_off[k + 1] - st_off[k]
-        starts[st_off[k] : st_off[k + 1]] = bits[o + PACK_HEAD : o + PACK_HEAD + m]
-        first = o + PACK_HEAD + m
-        for i in range(rows[k + 1] - rows[k]):
-            xy[rows[k] + i, 0] = blob[first + 2 * i]
-            xy[rows[k] + i, 1] = blob[first + 2 * i + 1]
-    return xy, rows, starts, st_off
+    sizes = np.empty((count, PACK_TAIL))
+    if chunks == 1:
+        _unpack_into(blob, bits, at, rows, st_off, 0, count, xy, starts, sizes)
+        return xy, rows, starts, st_off, sizes
+    for c in prange(chunks):
+        _unpack_into(blob, bits, at, rows, st_off, count * c // chunks,
+                     count * (c + 1) // chunks, xy, starts, sizes)
+    return xy, rows, starts, st_off, sizes

@@ -112,11 +112,7 @@ def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
         keys[h] = key
         heads[h] = -1
         made = 1
-    nxt[b] = heads[h]
-    prv[b] = -1
-    if heads[h] >= 0:
-        prv[heads[h]] = b
-    heads[h] = b
+    _link(heads, nxt, prv, h, b)
     slot[b] = h
     level[b] = idx
     lvl_count[idx] += 1
@@ -124,15 +120,30 @@ def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
 
 
 @njit(cache=True, nogil=True)
-def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
-    """Take body ``b`` out of its cell list."""
-    h = slot[b]
+def _link(heads, nxt, prv, h, b):
+    """Put body ``b`` at the head of the cell list of slot ``h``."""
+    nxt[b] = heads[h]
+    prv[b] = -1
+    if heads[h] >= 0:
+        prv[heads[h]] = b
+    heads[h] = b
+
+
+@njit(cache=True, nogil=True)
+def _unlink(heads, nxt, prv, h, b):
+    """Take body ``b`` out of the cell list of slot ``h``."""
     if prv[b] >= 0:
         nxt[prv[b]] = nxt[b]
     else:
         heads[h] = nxt[b]
     if nxt[b] >= 0:
         prv[nxt[b]] = prv[b]
+
+
+@njit(cache=True, nogil=True)
+def grid_remove(heads, nxt, prv, slot, level, lvl_count, b):
+    """Take body ``b`` out of its cell list."""
+    _unlink(heads, nxt, prv, slot[b], b)
     slot[b] = -1
     lvl_count[level[b]] -= 1
     level[b] = -1
@@ -166,19 +177,82 @@ def grid_rebuild(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, ali
 
 
 @njit(cache=True, nogil=True)
-def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled):
+def _regrid_probe(ids, keys, slot, level, box, origin, k0, k1, moves):
+    """For each body of ``ids[k0:k1]``: its old slot and level, the level and cell key of
+    its box, and the slot of that key (or the empty slot where it would go), into the
+    rows of ``moves`` (see :func:`regrid`)."""
+    for k in range(k0, k1):
+        b = ids[k]
+        idx, key = _cell_key(box, b, origin)
+        moves[k, 0] = slot[b]
+        moves[k, 1] = level[b]
+        moves[k, 2] = idx
+        moves[k, 3] = key
+        moves[k, 4] = _slot(keys, key)
+
+
+@njit(cache=True, nogil=True)
+def _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, insert):
+    """Take out of their old cell lists (``insert`` False), or put at the head of their
+    new ones, the bodies of ``ids`` whose slot (old or new) is ``c`` modulo
+    ``chunks``, in the order of ``ids``."""
+    for k in range(ids.shape[0]):
+        h = moves[k, 4] if insert else moves[k, 0]
+        if h < 0 or h % chunks != c:
+            continue
+        b = ids[k]
+        if insert:
+            _link(heads, nxt, prv, h, b)
+            slot[b] = h
+            level[b] = moves[k, 2]
+        else:
+            _unlink(heads, nxt, prv, h, b)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled, chunks):
     """Move each body of ``ids`` (boxes already set, and each out of its cell: see
     :func:`left_cells`) to the cell of its box, in a table holding ``filled`` cells;
-    stops before it would be more than half full. Returns (cells made, bodies done)."""
+    stops before it would be more than half full. Returns (cells made, bodies done).
+
+    The same table and lists as :func:`grid_remove` then :func:`grid_insert` of each
+    body in turn, in ``chunks`` parallel chunks: the cells' keys and slots are looked up
+    in parallel, the missing cells made in the order of ``ids``, then each chunk takes
+    the bodies out of, and then puts them into, the cell lists of its own slots (a
+    list's order depends only on the order of its insertions)."""
+    n = ids.shape[0]
+    moves = np.empty((n, 5), np.int64)  # old slot, old level, level, key, slot
+    if chunks == 1:
+        _regrid_probe(ids, keys, slot, level, box, origin, 0, n, moves)
+    else:
+        for c in prange(chunks):
+            _regrid_probe(ids, keys, slot, level, box, origin, n * c // chunks,
+                          n * (c + 1) // chunks, moves)
     made = 0
     limit = keys.shape[0] // 2
-    for k in range(ids.shape[0]):
-        b = ids[k]
+    for k in range(n):
         if filled + made + 1 > limit:
             return made, k
-        grid_remove(heads, nxt, prv, slot, level, lvl_count, b)
-        made += grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b)
-    return made, ids.shape[0]
+        key = moves[k, 3]
+        if keys[moves[k, 4]] != key:  # (the cell was missing when looked up)
+            h = _slot(keys, key)
+            if keys[h] == -1:
+                keys[h] = key
+                heads[h] = -1
+                made += 1
+            moves[k, 4] = h
+        if moves[k, 0] >= 0:
+            lvl_count[moves[k, 1]] -= 1
+        lvl_count[moves[k, 2]] += 1
+    if chunks == 1:
+        _regrid_lists(ids, moves, heads, nxt, prv, slot, level, 0, 1, False)
+        _regrid_lists(ids, moves, heads, nxt, prv, slot, level, 0, 1, True)
+        return made, n
+    for c in prange(chunks):
+        _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, False)
+    for c in prange(chunks):
+        _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, True)
+    return made, n
 
 
 @njit(cache=True, nogil=True)
