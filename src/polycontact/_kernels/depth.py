@@ -30,7 +30,7 @@ fits).
 
 Many pairs (for ``classify_many(...).distances``): :func:`contact_depths` and
 :func:`depths_of_pairs` compute a run of pairs, :func:`pieces_of_bodies` decomposes a
-run of bodies, without the GIL (the caller runs runs on several threads),
+run of bodies, without the GIL (the caller splits the work over threads),
 :func:`distinct_bodies` finds the bodies to decompose once (see
 :func:`polycontact._depth.penetrations`).
 """

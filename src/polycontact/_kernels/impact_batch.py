@@ -61,7 +61,7 @@ def body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, u0, u1
     """The :func:`polycontact._kernels.impact.pack_body` arrays of bodies ``u0`` to
     ``u1 - 1``, written into ``floats`` and ``ints`` (body u's at ``floats[f_off[u]:f_off[u
     + 1]]`` and ``ints[i_off[u]:i_off[u + 1]]``, the offsets of :func:`table_sizes`), as
-    ``impacts_chunk`` reads them; the caller runs runs of bodies on several threads.
+    ``impacts_chunk`` reads them; the caller splits the bodies over threads.
     ``centroids`` (U, 2) and ``radii`` (U,): each body's area centroid and bounding
     radius."""
     for u in range(u0, u1):
@@ -110,7 +110,7 @@ def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, flo
     may lie beyond ``limit`` or its extent below ``floor``, or when within ``[0, t_max]``
     its coordinates, its points' speeds or accelerations or its angular speed may exceed
     ``limit`` (the bounds of ``polycontact.broad_phase.reach_excess``, with a margin of
-    1e-9 of the limit for the rounding); the caller runs runs of bodies on several
+    1e-9 of the limit for the rounding); the caller splits the bodies over
     threads."""
     for k in range(k0, k1):
         out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k)
