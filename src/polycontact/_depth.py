@@ -25,11 +25,17 @@ from typing import Any, cast
 import numpy as np
 
 from ._pieces import pieces_packed
+from ._threads import map_work
 from .errors import DepthTooLargeError
 from . import limits
 from .limits import EAR_CLIPPING_MAX, RELATIVE_TOLERANCE, ROUNDING_ULPS
 
 __all__ = ["penetration", "penetrations"]
+
+#: The work of one pair's depth, and of one body's convex pieces (seconds, 12-gons):
+#: the unit by which the pairs and bodies are split over threads.
+DEPTH_SECONDS = 10e-6
+PIECES_SECONDS = 5e-6
 
 
 def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
@@ -107,7 +113,8 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     Each distinct pair (the same two bodies and tolerance) is computed once: by
     :func:`polycontact._kernels.depth.contact_depths`, then the pairs it leaves by
     :func:`polycontact._kernels.depth.depths_of_pairs`, each distinct body among those
-    decomposed once, in parallel.
+    decomposed once, in parallel (on the threads of
+    :func:`polycontact._threads.map_work`).
 
     Raises
     ------
@@ -136,7 +143,10 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     one = order[new]  # the first of each group of equal pairs
     group = np.empty(len(pairs), np.int64)
     group[order] = np.cumsum(new) - 1
-    out = contact_depths(batch, pairs[one], eps[one])
+    todo, todo_eps = pairs[one], eps[one]
+    out = _joined_rows(map_work(lambda p0, p1: contact_depths(batch, todo[p0:p1],
+                                                              todo_eps[p0:p1]),
+                                len(todo), DEPTH_SECONDS))
     rest = np.flatnonzero(np.isnan(out[:, 0]))  # (large bodies, or undecided)
     if rest.size:
         out[rest] = _depths_by_pieces(batch, pairs[one[rest]], eps[one[rest]])
@@ -145,7 +155,7 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
         p = pairs[one[bad[0]]]
         raise _too_large(int(lsa[bsa[p + 1] - 1] - lsa[bsa[p]]),
                          int(lsb[bsb[p + 1] - 1] - lsb[bsb[p]]), "more")
-    return cast("np.ndarray", out[group])
+    return out[group]
 
 
 def _too_large(m: int, n: int, estimate: str) -> DepthTooLargeError:
@@ -167,9 +177,11 @@ def _batch_pieces(x: np.ndarray, ls: np.ndarray, bs: np.ndarray, f: np.ndarray,
     from ._kernels.depth import pieces_of_bodies
     from ._kernels.relation_many import body
 
-    xy, st, first, count, ok = pieces_of_bodies(x, ls, bs, f, ids, negate,
-                                                RELATIVE_TOLERANCE, ROUNDING_ULPS,
-                                                EAR_CLIPPING_MAX)
+    parts = map_work(lambda p0, p1: pieces_of_bodies(x, ls, bs, f, ids[p0:p1], negate,
+                                                     RELATIVE_TOLERANCE, ROUNDING_ULPS,
+                                                     EAR_CLIPPING_MAX),
+                     len(ids), PIECES_SECONDS)
+    xy, st, first, count, ok = _joined_pieces(parts)
     if ok.all():
         return xy, st, first, count
     more_xy, more_st = [xy], [st]
@@ -199,4 +211,27 @@ def _depths_by_pieces(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
     ra = _batch_pieces(xa, lsa, bsa, fa, ua, True)
     rb = _batch_pieces(xb, lsb, bsb, fb, ub, False)
-    return depths_of_pairs(batch, pairs, eps, slot_a, ra, slot_b, rb, limits.MAX_SUM_VERTICES)
+    return _joined_rows(map_work(
+        lambda p0, p1: depths_of_pairs(batch, pairs[p0:p1], eps[p0:p1], slot_a[p0:p1], ra,
+                                       slot_b[p0:p1], rb, limits.MAX_SUM_VERTICES),
+        len(pairs), DEPTH_SECONDS))
+
+
+def _joined_rows(parts: list[np.ndarray]) -> np.ndarray:
+    """The depth rows of consecutive runs of pairs, as one array."""
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+def _joined_pieces(parts: list[tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
+    """The pieces ``(xy, starts, first, count, ok)`` of consecutive runs of bodies
+    (:func:`polycontact._kernels.depth.pieces_of_bodies` of each), as those of all the
+    bodies: each run's starts shifted by the rows, and its firsts by the starts, before
+    it."""
+    if len(parts) == 1:
+        return parts[0]
+    rows = np.cumsum([0] + [len(p[0]) for p in parts])
+    at = np.cumsum([0] + [len(p[1]) for p in parts])
+    return (np.concatenate([p[0] for p in parts]),
+            np.concatenate([p[1] + r for p, r in zip(parts, rows)]),
+            np.concatenate([p[2] + a for p, a in zip(parts, at)]),
+            np.concatenate([p[3] for p in parts]), np.concatenate([p[4] for p in parts]))

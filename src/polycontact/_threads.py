@@ -39,8 +39,8 @@ import numpy as np
 
 from .limits import THREAD_WORK
 
-__all__ = ["requested", "useful", "chunks", "numba_threads", "map_chunks", "as_done",
-           "PAIR_SECONDS"]
+__all__ = ["requested", "useful", "chunks", "numba_threads", "map_chunks", "map_work",
+           "as_done", "PAIR_SECONDS"]
 
 _T = TypeVar("_T")
 
@@ -147,6 +147,15 @@ def map_chunks(fn: Callable[[int, int], _T], count: int, threads: int,
     for f in futures:
         f.result()  # (the first error, once every thread has stopped)
     return out
+
+
+def map_work(fn: Callable[[int, int], _T], count: int, seconds: float,
+             threads: int | None = None) -> list[_T]:
+    """:func:`map_chunks` of ``count`` items of ``seconds`` of work each, on the threads
+    that work can use (:func:`useful`, at most :func:`requested` ``(threads)``): in
+    one chunk, here, when one thread is enough."""
+    n = useful(requested(threads), count * seconds)
+    return map_chunks(fn, count, n, chunks=1 if n == 1 else None)
 
 
 def as_done(fn: Callable[[Any], _T], tasks: Sequence[Any],

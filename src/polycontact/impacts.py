@@ -41,7 +41,7 @@ from .relation import shapes_packed
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
-from ._threads import as_done, numba_threads, requested, useful
+from ._threads import as_done, map_work, requested, useful
 
 __all__ = ["ImpactBatch", "PairImpact", "PairImpacts", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
@@ -376,14 +376,17 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     term of pair p's distance tolerance, see :func:`prepare_pairs`); the raw result
     arrays. The bodies' tables are built in parallel first
     (:func:`polycontact._kernels.impact_batch.body_tables`)."""
-    from ._kernels.impact_batch import body_tables
+    from ._kernels.impact_batch import body_tables, table_sizes
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
     xy, rows, starts, st_off, centroids, radii = packed
-    with numba_threads(useful(threads, len(radii) * _TABLE_SECONDS)) as n:
-        tables = body_tables(xy, rows, starts, st_off, centroids, radii,
-                             1 if n == 1 else 4 * n)
+    f_off, i_off = table_sizes(rows, st_off)
+    floats, ints = np.empty(f_off[-1]), np.empty(i_off[-1], np.int64)
+    map_work(lambda u0, u1: body_tables(xy, rows, starts, st_off, centroids, radii, f_off,
+                                        i_off, u0, u1, floats, ints),
+             len(radii), _TABLE_SECONDS, threads)
+    tables = (floats, f_off, ints, i_off)
     p_count = len(sa)
     out = empty_result(p_count)
     pairs = (sa, sb, ma, mb, eps_rel)
@@ -463,9 +466,10 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     owner = owner.reshape(-1).astype(np.int64)
     packed, extents = _for_batch(shapes_packed(uniq))
     xy, vrows, _, _, centroids, radii = packed
-    with numba_threads(useful(threads, count * _TABLE_SECONDS)) as n:
-        suspect = suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
-                                 COORDINATE_LIMIT, EXTENT_FLOOR, 1 if n == 1 else 4 * n)
+    suspect = np.zeros(count, np.bool_)
+    map_work(lambda k0, k1: suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
+                                           COORDINATE_LIMIT, EXTENT_FLOOR, k0, k1, suspect),
+             count, _TABLE_SECONDS, threads)
     if suspect.any():
         marked = np.flatnonzero(suspect).tolist()
         for k in marked:

@@ -671,8 +671,12 @@ class RelationBatch:
         from ._threads import numba_threads
 
         pack = self._pack()
+        xa, lsa, bsa, fa, xb, lsb, bsb, fb = pack
+        states, eps = self.states, self.tolerances
+        out = np.concatenate(_split(len(states), lambda p0, p1: km.many_distances(
+            xa, lsa, bsa[p0 : p1 + 1], fa[p0:p1], xb, lsb, bsb[p0 : p1 + 1], fb[p0:p1],
+            states[p0:p1], eps[p0:p1]), self._threads))
         with numba_threads(self._threads):
-            out = km.many_distances(*pack, self.states, self.tolerances)
             pen = np.flatnonzero(self.states == _STATES.index(State.PENETRATING))
             if pen.size:
                 out[pen] = -penetrations(pack, pen, self.tolerances[pen])[:, 0]
@@ -683,10 +687,9 @@ def _split(count: int, fn: Any, threads: int) -> list[Any]:
     """Run ``fn(p0, p1)`` over chunks of range(count) on at most ``threads`` threads (the
     kernels release the GIL), no more than the work can use (a pair costs about
     :data:`polycontact._threads.PAIR_SECONDS`); returns the results in order."""
-    from ._threads import PAIR_SECONDS, map_chunks, useful
+    from ._threads import PAIR_SECONDS, map_work
 
-    n = useful(threads, count * PAIR_SECONDS)
-    return map_chunks(fn, count, n, chunks=1 if n == 1 else None)
+    return map_work(fn, count, PAIR_SECONDS, threads)
 
 
 def _raw_array(arr: Any) -> np.ndarray | None:

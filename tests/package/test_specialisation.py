@@ -5,6 +5,8 @@ relaxed form does not compile. (Compiled code: skipped with ``NUMBA_DISABLE_JIT=
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pytest
 from numba import config, types
@@ -46,6 +48,11 @@ def _zero_tail(x):
     t = _tail(x)
     t[0] = 0.0
     return x[0]
+
+
+@njit
+def _sum_first_two(x):
+    return x[0] + x[1]
 
 
 def test_read_only_and_writable_arrays_share_one_compile():
@@ -95,6 +102,34 @@ def test_a_write_the_reading_misses_compiles_for_the_exact_types(monkeypatch):
     assert out.tolist() == [7.0, 0.0]
     (args,) = fill.overloads
     assert args[0].mutable
+
+
+def test_a_kernel_first_called_by_two_threads_at_once_is_then_called_directly(monkeypatch):
+    # threads that first call a kernel at the same time each ask for its compile (with
+    # writable arrays: the specialisation takes them read-only); every later call must
+    # still go straight to the compiled code, not through the dispatcher's Python path
+    x = np.arange(3.0)
+    start = threading.Barrier(2)
+
+    def first_call() -> None:
+        start.wait()
+        _sum_first_two(x)
+
+    threads = [threading.Thread(target=first_call) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    slow: list[object] = []
+    real = _sum_first_two._compile_for_args
+
+    def counted(*args: object, **kws: object) -> object:
+        slow.append(args)
+        return real(*args, **kws)
+
+    monkeypatch.setattr(_sum_first_two, "_compile_for_args", counted)
+    assert [_sum_first_two(x) for _ in range(3)] == [1.0, 1.0, 1.0]
+    assert slow == []
 
 
 def test_the_pairwise_kernels_compile_once_for_shapes_and_batches():

@@ -29,14 +29,15 @@ fallback when that kernel cannot decide (segments that run together: slides, exa
 fits).
 
 Many pairs (for ``classify_many(...).distances``): :func:`contact_depths` and
-:func:`depths_of_pairs` compute pairs in parallel, :func:`distinct_bodies` finds the
-bodies to decompose once (see :func:`polycontact._depth.penetrations`).
+:func:`depths_of_pairs` compute a run of pairs, :func:`pieces_of_bodies` decomposes a
+run of bodies, without the GIL (the caller splits the work over threads),
+:func:`distinct_bodies` finds the bodies to decompose once (see
+:func:`polycontact._depth.penetrations`).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
 from .jit import njit
 from .cells import segment_grid
@@ -580,7 +581,7 @@ def distinct_bodies(x, ls, bs, f, ids):
     return first[:m].copy(), slot
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
     """Convex CCW pieces of bodies ``ids`` of a packed batch (oriented: interior on the
     left), by :func:`polycontact._kernels.decompose.ring_pieces`, negated (the pieces
@@ -602,7 +603,7 @@ def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
     starts = np.empty(first[n], np.int64)
     count = np.zeros(n, np.int64)
     ok = np.zeros(n, np.bool_)
-    for k in prange(n):
+    for k in range(n):
         p = ids[k]
         if bs[p + 1] - bs[p] != 2:
             continue
@@ -623,12 +624,12 @@ def pieces_of_bodies(x, ls, bs, f, ids, negate, rel, ulps, max_ear):
     return xy, starts, first[:n].copy(), count, ok
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def depths_of_pairs(batch, pairs, eps, slot_a, pieces_a, slot_b, pieces_b, max_vertices):
     """Penetration depths ``(P, 3)`` (depth, dx, dy; NaNs as in
     :func:`depth_from_pieces`) of the pairs ``pairs`` of two packed batches, ``batch`` =
     ``(xa, lsa, bsa, fa, xb, lsb, bsb, fb)`` (the form of
-    :mod:`polycontact._kernels.relation_many`), in parallel: pair k's A has the pieces
+    :mod:`polycontact._kernels.relation_many`): pair k's A has the pieces
     of −A number ``slot_a[k]`` of ``pieces_a`` = ``(rxy, rst, rfirst, rcount)`` (see
     :func:`pieces_of_bodies`), its B those number ``slot_b[k]`` of ``pieces_b``;
     ``eps`` per pair."""
@@ -637,7 +638,7 @@ def depths_of_pairs(batch, pairs, eps, slot_a, pieces_a, slot_b, pieces_b, max_v
     bxy, bst, bfirst, bcount = pieces_b
     n = pairs.shape[0]
     out = np.empty((n, 3))
-    for k in prange(n):
+    for k in range(n):
         p = pairs[k]
         ya, sa = body(xa, lsa, bsa, p)
         yb, sb = body(xb, lsb, bsb, p)
@@ -652,18 +653,18 @@ def depths_of_pairs(batch, pairs, eps, slot_a, pieces_a, slot_b, pieces_b, max_v
     return out
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def contact_depths(batch, pairs, eps):
     """Penetration depths ``(P, 3)`` of the pairs ``pairs`` of two packed batches
     (``batch``: as for :func:`depths_of_pairs`) by
     :func:`polycontact._kernels.convolution.contact_depth` from :func:`box_escape` (its
-    segments are split lazily: a nearer start saves less than it costs), in parallel; a
+    segments are split lazily: a nearer start saves less than it costs); a
     row of NaNs where that kernel does not decide (the caller takes
     :func:`depths_of_pairs`); ``eps`` per pair."""
     xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     n = pairs.shape[0]
     out = np.full((n, 3), np.nan)
-    for k in prange(n):
+    for k in range(n):
         p = pairs[k]
         if (lsa[bsa[p + 1] - 1] - lsa[bsa[p]] + lsb[bsb[p + 1] - 1] - lsb[bsb[p]]
                 > FEW_VERTICES):

@@ -1,4 +1,5 @@
-"""Kernels: the bodies of many time-of-impact pairs prepared at once, in parallel.
+"""Kernels: the bodies of many time-of-impact pairs prepared at once, without the GIL
+(the caller splits the bodies over threads).
 
 :func:`body_tables` builds every distinct body's arguments of the exact search (its
 vertices about its centroid, circle tree and lengths: what
@@ -18,7 +19,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
 from .jit import njit
 from .advance import edge_table
@@ -55,27 +55,18 @@ def _body_into(xy, rows, starts, st_off, centroids, radii, u, f_out, i_out):
     i_out[:] = ints
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def body_tables(xy, rows, starts, st_off, centroids, radii, chunks):
-    """Every body's :func:`polycontact._kernels.impact.pack_body` arrays, one after
-    another: ``(floats, f_off, ints, i_off)`` (body u's at ``floats[f_off[u]:f_off[u +
-    1]]`` and ``ints[i_off[u]:i_off[u + 1]]``), as ``impacts_chunk`` reads them; in
-    ``chunks`` parallel chunks (1: serial, no thread start). ``centroids`` (U, 2) and
-    ``radii`` (U,): each body's area centroid and bounding radius."""
-    u_count = rows.shape[0] - 1
-    f_off, i_off = table_sizes(rows, st_off)
-    floats = np.empty(f_off[u_count])
-    ints = np.empty(i_off[u_count], np.int64)
-    if chunks == 1:
-        for u in range(u_count):
-            _body_into(xy, rows, starts, st_off, centroids, radii, u,
-                       floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
-        return floats, f_off, ints, i_off
-    for c in prange(chunks):
-        for u in range(u_count * c // chunks, u_count * (c + 1) // chunks):
-            _body_into(xy, rows, starts, st_off, centroids, radii, u,
-                       floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
-    return floats, f_off, ints, i_off
+@njit(cache=True, nogil=True)
+def body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, u0, u1, floats,
+                ints):
+    """The :func:`polycontact._kernels.impact.pack_body` arrays of bodies ``u0`` to
+    ``u1 - 1``, written into ``floats`` and ``ints`` (body u's at ``floats[f_off[u]:f_off[u
+    + 1]]`` and ``ints[i_off[u]:i_off[u + 1]]``, the offsets of :func:`table_sizes`), as
+    ``impacts_chunk`` reads them; the caller splits the bodies over threads.
+    ``centroids`` (U, 2) and ``radii`` (U,): each body's area centroid and bounding
+    radius."""
+    for u in range(u0, u1):
+        _body_into(xy, rows, starts, st_off, centroids, radii, u,
+                   floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
 
 
 @njit(cache=True, nogil=True)
@@ -111,18 +102,15 @@ def _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k)
     return not (reach <= bound and speed <= bound and accel <= bound and w_max <= bound)
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, chunks):
-    """For each body k (shape ``owner[k]`` of the packing, moving with the kernel vector
-    ``motions[k]``): True when its coordinates may lie beyond ``limit`` or its extent
-    below ``floor``, or when within ``[0, t_max]`` its coordinates, its points' speeds
-    or accelerations or its angular speed may exceed ``limit`` (the bounds of
-    ``polycontact.broad_phase.reach_excess``, with a margin of 1e-9 of the limit for the
-    rounding); in ``chunks`` parallel chunks."""
-    k_count = owner.shape[0]
-    out = np.zeros(k_count, np.bool_)
-    for c in prange(chunks):
-        for k in range(k_count * c // chunks, k_count * (c + 1) // chunks):
-            out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit,
-                              floor, k)
-    return out
+@njit(cache=True, nogil=True)
+def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k0, k1,
+                   out):
+    """For each body k from ``k0`` to ``k1 - 1`` (shape ``owner[k]`` of the packing,
+    moving with the kernel vector ``motions[k]``), ``out[k]``: True when its coordinates
+    may lie beyond ``limit`` or its extent below ``floor``, or when within ``[0, t_max]``
+    its coordinates, its points' speeds or accelerations or its angular speed may exceed
+    ``limit`` (the bounds of ``polycontact.broad_phase.reach_excess``, with a margin of
+    1e-9 of the limit for the rounding); the caller splits the bodies over
+    threads."""
+    for k in range(k0, k1):
+        out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k)

@@ -143,8 +143,14 @@ class Kernel(CPUDispatcher):  # type: ignore[misc]
                 if not guessed:
                     raise
                 return super().compile(args)  # a write the reading missed: exact types
-            # Python calls with these types go straight to it from now on
-            self._insert([a._code for a in args], entry, False)
+            # Python calls with these types go straight to it from now on: once (threads
+            # that first call at once all come here; a second entry for the same types
+            # would make Numba's lookup ambiguous, and every later call slow)
+            codes = tuple(a._code for a in args)
+            direct = self.__dict__.setdefault("_direct", set())
+            if codes not in direct:
+                direct.add(codes)
+                self._insert(list(codes), entry, False)
             return entry
 
     def _compiled_relative(self, args: tuple[Any, ...]) -> tuple[Any, ...] | None:

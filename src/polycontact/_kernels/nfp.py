@@ -51,9 +51,13 @@ def _finite(xy):
     return True
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _entrance(bxy, bstarts, rxy, rstarts, eps, rel_tol, ulps, ang_tol, max_tests):
-    """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``."""
+    """:func:`entrance_region`'s answer preceded by the sums ``(xy, starts)``.
+
+    Inlined in each of its callers (one each) rather than compiled on its own: linked
+    into them, its compiled code would be optimised and emitted once more for each
+    (a compile several seconds longer, for no faster code)."""
     sums, starts, keep = convex_sums(bxy, bstarts, rxy, rstarts)
     if not _finite(sums):
         # error code, not a crash: the caller refuses the input

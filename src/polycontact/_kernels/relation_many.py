@@ -2,7 +2,7 @@
 
 The state kernels are serial: a pair of small bodies takes about a microsecond, too
 little for a ``prange`` loop's scheduling per pair; the caller splits the pairs over
-threads in chunks instead (the kernels release the GIL). The signed distances use ``prange``;
+threads in chunks instead (the kernels release the GIL), and so for the signed distances;
 penetration depths are left to the caller (:func:`polycontact._depth.penetrations`).
 
 A batch of bodies is packed as ``xy`` (V, 2) float64 (every body's loops stacked, body
@@ -15,7 +15,6 @@ the right (a clockwise raw ring, classified without a copy).
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
 from .jit import njit
 from .distance import closest_pair
@@ -284,14 +283,14 @@ def _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p):
     return np.sqrt(best)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def many_distances(xa, lsa, bsa, fa, xb, lsb, bsb, fb, states, eps):
     """Signed distances of P classified pairs: the boundary gap, or 0; NaN for the
     penetrating pairs, whose depth the caller computes (it needs convex pieces, see
     :func:`polycontact._depth.penetrations`)."""
     p_count = bsa.shape[0] - 1
     out = np.empty(p_count)
-    for p in prange(p_count):
+    for p in range(p_count):
         if states[p] == SEPARATE:
             out[p] = _separate_gap(xa, lsa, bsa, xb, lsb, bsb, p)
         elif states[p] == CONTACT:
