@@ -28,8 +28,9 @@ This module is the top of the package: :func:`warmup` calls every public functio
 Examples
 --------
 >>> from polycontact import compiling
->>> sorted(compiling.FAMILIES)
-['classification', 'entrance block', 'many moving bodies', 'no-fit polygon', 'time of impact']
+>>> sorted(compiling.FAMILIES)  # doctest: +NORMALIZE_WHITESPACE
+['classification', 'entrance block', 'many moving bodies', 'no-fit polygon',
+ 'no-fit polygon table', 'time of impact']
 >>> compiling.cache_directory().is_absolute()
 True
 """
@@ -53,10 +54,11 @@ FAMILIES: dict[str, tuple[str, ...]] = {
                        "rings.classify_raw", "depth.contact_depths"),
     "time of impact": ("impact.exact_call", "impact.sampled_query"),
     "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
-                       "fits.select_contacts", "nfp_batch.nfp_pairs"),
+                       "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk",
                            "impact_batch.body_tables", "impact_batch.suspect_bodies"),
+    "no-fit polygon table": ("nfp_batch.nfp_pairs",),
 }
 
 
@@ -92,6 +94,9 @@ def _run(family: str) -> None:
     from .shape import Shape
 
     sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    ell = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    # a slot as wide as the square: a slide, whose candidates are verified apart
+    slot = [(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)]
     if family == "classification":
         from .relation import classify, classify_many
 
@@ -118,16 +123,14 @@ def _run(family: str) -> None:
     elif family == "no-fit polygon":
         from .nfp import inner_fit_polygon, no_fit_polygon
 
-        ell = Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
-        no_fit_polygon(ell, Shape(sq)).region  # noqa: B018
-        # a slot as wide as the square: a slide, whose candidates are verified apart
-        slot = Shape([(0, 0), (3, 0), (3, 3), (2, 3), (2, 1), (1, 1), (1, 3), (0, 3)])
-        no_fit_polygon(Shape(sq), slot).region  # noqa: B018
+        no_fit_polygon(Shape(ell), Shape(sq)).region  # noqa: B018
+        no_fit_polygon(Shape(sq), Shape(slot)).region  # noqa: B018
         inner_fit_polygon(Shape(sq), Shape(sq * 4.0))
         inner_fit_polygon(Shape(sq), Shape(sq))  # an exact fit
+    elif family == "no-fit polygon table":
         from .nfp_tables import nfp_table
 
-        nfp_table([ell, slot], progress=False, threads=1)  # the table's batch kernel
+        nfp_table([Shape(ell), Shape(slot)], progress=False, threads=1)  # the batch kernel
     elif family == "entrance block":
         from .entrance import entrance_block
 

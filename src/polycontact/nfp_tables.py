@@ -725,7 +725,7 @@ def _compute_missing(
                 return pieces, [pairs[p0:p1] for p0, p1 in spans]
 
             results = run_spans(client, _compute_chunk, count, tasks_of, table.reference,
-                                chunk_size=chunk_size, family="no-fit polygon")
+                                chunk_size=chunk_size, family="no-fit polygon table")
         else:
             results = _local(pieces, pairs, table.reference, workers, threads, chunk_size)
         with closing(results):

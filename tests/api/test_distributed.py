@@ -31,7 +31,7 @@ ANGLES = [[0, 90, 180, 270], [0, 90, 180, 270], [0, 180]]
 @pytest.fixture(scope="module")
 def client():
     # the kernels compiled here first, so the workers load them from Numba's cache
-    pc.warmup(["classification", "no-fit polygon", "many moving bodies"])
+    pc.warmup(["classification", "no-fit polygon", "no-fit polygon table", "many moving bodies"])
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
         with distributed.Client(cluster) as c:
@@ -69,15 +69,16 @@ def test_the_default_client_is_used(client):
                          progress=lambda d, n: seen.append(d))
     assert pd.current_client() is client
     assert len(seen) == 4 and table.computed == 16  # four tasks of 4 entries, on the cluster
-    assert all(pd.plugin_name("no-fit polygon") in p for p in client.run(pd.worker_plugins).values())
+    assert all(pd.plugin_name("no-fit polygon table") in p
+               for p in client.run(pd.worker_plugins).values())
 
 
 def test_kernels_are_warmed_once_per_worker(client):
     pc.nfp_table(PIECES[:1], progress=False, client=client)
-    name = pd.plugin_name("no-fit polygon")
+    name = pd.plugin_name("no-fit polygon table")
     assert all(name in p for p in client.run(pd.worker_plugins).values())
     before = client.run(_setup_id, name)
-    pd.ensure_warm(client, ["no-fit polygon"])
+    pd.ensure_warm(client, ["no-fit polygon table"])
     pc.nfp_table(PIECES[:2], progress=False, client=client)
     assert client.run(_setup_id, name) == before  # no new registration, no warm-up per task
     # a batch warms only its own family
