@@ -64,8 +64,9 @@ import numpy as np
 
 import polycontact as pc
 
-#: The calls whose time counts as parallel work: the compiled parallel kernels, and the
-#: thread pool's chunk maps (module, name).
+#: The calls whose time counts as parallel work (module, name): the compiled parallel
+#: kernels, the kernels that the thread pool shares among threads in chunks (timed when
+#: the calling thread runs them itself), and the thread pool's chunk maps.
 PARALLEL = [
     ("polycontact._kernels.world", "contact_pairs"),
     ("polycontact._kernels.world", "container_states"),
