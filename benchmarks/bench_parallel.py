@@ -80,7 +80,6 @@ PARALLEL = [
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
     ("polycontact._kernels.contact_geometry", "boundary_gaps"),
     ("polycontact._kernels.relation_many", "many_distances"),
-    ("polycontact._depth", "penetrations"),
     ("polycontact._kernels.impact_batch", "body_tables"),
     ("polycontact._kernels.impact_batch", "suspect_bodies"),
     ("polycontact._threads", "map_chunks"),
