@@ -115,9 +115,10 @@ def test_depth_without_the_grid_equals_the_depth_with_it(seed, na, nb, cx, cy):
     assert pc.classify(xa + grid[1:], xb).state is not pc.State.PENETRATING
 
 
-def test_distinct_bodies_tells_apart_bodies_of_equal_key():
-    # Vertex 0 moved by (1.25, -1): the weighted sum of the coordinates that groups the
-    # bodies is the same (weights 1 and 1.25 on vertex 0), exactly; they still differ.
+def _bodies_of_equal_key():
+    """A packed batch of four squares: bodies 0 and 2 equal; body 1 with vertex 0 moved
+    by (1.25, -1), which leaves the weighted sum of the coordinates that groups the
+    bodies the same (weights 1 and 1.25 on vertex 0), exactly; body 3 that one reversed."""
     sq = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
     moved = sq.copy()
     moved[0] = [1.25, -1.0]
@@ -125,21 +126,19 @@ def test_distinct_bodies_tells_apart_bodies_of_equal_key():
     ls = np.array([0, 4, 4, 8, 8, 12, 12, 16])
     bs = np.array([0, 2, 4, 6, 8])
     f = np.array([1.0, 1.0, 1.0, -1.0])
+    return x, ls, bs, f
+
+
+def test_distinct_bodies_tells_apart_bodies_of_equal_key():
+    x, ls, bs, f = _bodies_of_equal_key()
     first, slot = kd.distinct_bodies(x, ls, bs, f, np.array([0, 1, 2, 3, 1]))
     assert first.tolist() == [0, 1, 3]
     assert slot.tolist() == [0, 1, 0, 2, 1]
 
 
 def test_distinct_pairs_groups_equal_bodies_and_tolerances_only():
-    # Bodies 0 and 2 equal; body 1 of the same key as 0 (vertex 0 moved by (1.25, -1));
-    # body 3 that one reversed. Pairs k: (A, B) = (p, p) with tolerances eps[k].
-    sq = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
-    moved = sq.copy()
-    moved[0] = [1.25, -1.0]
-    x = np.concatenate([sq, moved, sq, moved[::-1]])
-    ls = np.array([0, 4, 4, 8, 8, 12, 12, 16])
-    bs = np.array([0, 2, 4, 6, 8])
-    f = np.array([1.0, 1.0, 1.0, -1.0])
+    # pairs k: (A, B) = (bodies p, p) of _bodies_of_equal_key with tolerances eps[k]
+    x, ls, bs, f = _bodies_of_equal_key()
     batch = (x, ls, bs, f, x, ls, bs, f)
     pairs = np.array([0, 1, 2, 3, 2, 0])
     eps = np.array([1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 2e-9])
