@@ -26,14 +26,19 @@ from .impact import pack_body
 
 
 @njit(cache=True, nogil=True)
-def table_sizes(rows, st_off):
+def table_sizes(rows, st_off, wanted):
     """Offsets of each body's floats and ints in :func:`body_tables`' arrays: a body of
     n vertices and k loop starts takes ``11 n - 1`` floats and ``7 n + k`` ints (those
-    of ``pack_body`` with its tree of ``2 n - 1`` nodes)."""
+    of ``pack_body`` with its tree of ``2 n - 1`` nodes); a body not ``wanted`` (bool,
+    (U,)) takes none, and gets no table."""
     u_count = rows.shape[0] - 1
     f_off = np.zeros(u_count + 1, np.int64)
     i_off = np.zeros(u_count + 1, np.int64)
     for u in range(u_count):
+        if not wanted[u]:
+            f_off[u + 1] = f_off[u]
+            i_off[u + 1] = i_off[u]
+            continue
         n = rows[u + 1] - rows[u]
         f_off[u + 1] = f_off[u] + 11 * n - 1
         i_off[u + 1] = i_off[u] + 7 * n + st_off[u + 1] - st_off[u]
@@ -63,8 +68,10 @@ def body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, u0, u1
     + 1]]`` and ``ints[i_off[u]:i_off[u + 1]]``, the offsets of :func:`table_sizes`), as
     ``impacts_chunk`` reads them; the caller splits the bodies over threads.
     ``centroids`` (U, 2) and ``radii`` (U,): each body's area centroid and bounding
-    radius."""
+    radius. Bodies given no room (not wanted by :func:`table_sizes`) are skipped."""
     for u in range(u0, u1):
+        if f_off[u + 1] == f_off[u]:
+            continue
         _body_into(xy, rows, starts, st_off, centroids, radii, u,
                    floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
 
