@@ -397,7 +397,8 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     tables = (floats, f_off, ints, i_off)
     p_count = len(sa)
     out = empty_result(p_count)
-    ka, kb = (np.arange(p_count),) * 2 if motion_rows is None else motion_rows
+    order = np.arange(p_count, dtype=np.int64)
+    ka, kb = (order, order) if motion_rows is None else motion_rows
     pairs = (sa, sb, ma, mb, ka, kb, eps_rel)
     settings = (t_max, BROAD_PHASE_INFLATION, tol, ROUNDING_FACTOR, CONTACT_RESOLUTION,
                 max_iterations, exact, samples)
@@ -407,10 +408,10 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
-    order = np.arange(p_count, dtype=np.int64)
     n = useful(threads, p_count * _PAIR_SECONDS)
     n_chunks = 1 if n == 1 else min(p_count // 16, 16 * n)
-    for _ in as_done(run, [order[c::n_chunks].copy() for c in range(n_chunks)], n):
+    todo = [order] if n_chunks == 1 else [order[c::n_chunks].copy() for c in range(n_chunks)]
+    for _ in as_done(run, todo, n):
         pass
     return out
 
@@ -419,6 +420,10 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 #: 12-gon's), for the threads the work can use (see :mod:`polycontact._threads`).
 _TABLE_SECONDS = 2e-6
 _PAIR_SECONDS = 2e-6
+
+#: Setting up one body pair of ``first_impacts`` for the search, in pair
+#: classifications (see :func:`polycontact._threads.chunks`).
+_SETUP_WORK = 0.05
 
 
 def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
@@ -905,6 +910,8 @@ def first_impacts(
     0 2 no-hit contact 0.5
     0 1 hit penetrating 2.0
     """
+    from ._kernels.impact_batch import pair_bodies
+
     shapes = check_shapes(shapes, "shapes")
     moves = check_motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = check_many_options(
@@ -915,12 +922,10 @@ def first_impacts(
     if len(pairs) == 0:
         return _no_events()
     # only the shapes of candidate pairs get tables and are searched
-    i, j = np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1])
-    oi, oj = bodies.owner[i], bodies.owner[j]
-    wanted = np.zeros(len(bodies.kernels), np.bool_)
-    wanted[oi] = True
-    wanted[oj] = True
-    eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[oi], bodies.extents[oj])
+    with numba_threads(threads):
+        i, j, oi, oj, eps_rel, wanted = pair_bodies(pairs, bodies.owner, bodies.extents,
+                                                    RELATIVE_TOLERANCE,
+                                                    chunks(len(pairs), _SETUP_WORK))
     raw = search_pairs(bodies.packed, oi, oj, bodies.motions, bodies.motions, eps_rel, t_max,
                        method, tol, samples, max_iterations, threads, wanted, (i, j))
     code, t_hi, _, contact, _, reached, *_ = raw

@@ -6,7 +6,8 @@ vertices about its centroid, circle tree and lengths: what
 :func:`polycontact._kernels.impact.pack_body` packs for one body, the same arrays bit
 for bit) into two flat arrays, each body at offsets known beforehand;
 :func:`suspect_bodies` marks the bodies whose coordinates or motion may be beyond the
-range the kernels take, for the caller to check exactly and refuse.
+range the kernels take, for the caller to check exactly and refuse; :func:`pair_bodies`
+gives the shapes and tolerances of many body pairs.
 
 Bodies are packed as ``xy`` (V, 2) float64, every body's loops one after another,
 ``rows`` (U + 1,) the first row of each body, and ``starts`` with ``st_off`` (U + 1,):
@@ -19,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
 from .jit import njit
 from .advance import edge_table
@@ -121,3 +123,43 @@ def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, flo
     threads."""
     for k in range(k0, k1):
         out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k)
+
+
+@njit(cache=True, nogil=True)
+def _pairs_range(pairs, owner, extents, rel, k0, k1, out):
+    """:func:`pair_bodies` for the pairs ``k0`` to ``k1 - 1``, into ``out``."""
+    i, j, oi, oj, eps_rel, wanted = out
+    for k in range(k0, k1):
+        a = pairs[k, 0]
+        b = pairs[k, 1]
+        i[k] = a
+        j[k] = b
+        ua = owner[a]
+        ub = owner[b]
+        oi[k] = ua
+        oj[k] = ub
+        eps_rel[k] = rel * max(extents[ua], extents[ub])
+        wanted[ua] = True  # (chunks may write the same True: no order matters)
+        wanted[ub] = True
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pair_bodies(pairs, owner, extents, rel, chunks):
+    """What the search of the body pairs ``pairs`` (K, 2) needs, in ``chunks`` parallel
+    chunks (1: serial, no thread start): ``(i, j, oi, oj, eps_rel, wanted)``, the two
+    bodies of each pair, their shapes ``owner[i]`` and ``owner[j]``, the size term of
+    the pair's distance tolerance ``rel * max(extents[oi], extents[oj])``, and for each
+    of the U = ``extents.shape[0]`` shapes whether a pair has it."""
+    n = pairs.shape[0]
+    u_count = extents.shape[0]
+    wanted = np.empty(u_count, np.bool_)
+    for u in range(u_count):
+        wanted[u] = False
+    out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
+           np.empty(n, np.int64), np.empty(n), wanted)
+    if chunks == 1:
+        _pairs_range(pairs, owner, extents, rel, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _pairs_range(pairs, owner, extents, rel, n * c // chunks, n * (c + 1) // chunks, out)
+    return out

@@ -108,9 +108,10 @@ def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
     return boxes, owner
 
 
-#: Boxes below which :func:`box_pairs` runs on the calling thread (no thread start);
-#: above, it works in :data:`PARALLEL_CHUNKS` chunks that Numba's threads share.
-PARALLEL_BOXES = 4096
+#: Boxes below which :func:`box_pairs` runs on the calling thread (no thread start: less
+#: than about 2 ms of work); above, it works in :data:`PARALLEL_CHUNKS` chunks that
+#: Numba's threads share.
+PARALLEL_BOXES = 8192
 PARALLEL_CHUNKS = 256
 
 
