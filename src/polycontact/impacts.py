@@ -301,9 +301,9 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
             raise ValueError(f"{what}: expected {count} motions (one per shape of "
                              f"{shapes_what}) as an array of shape ({count}, 6), got shape "
                              f"{rows.shape}")
-        bad = ~np.isfinite(rows).all(axis=1)
-        if bad.any():
-            k = int(np.argmax(bad))
+        finite = np.isfinite(rows)
+        if not finite.all():  # (the row named only when one is not)
+            k = int(np.argmin(finite.all(axis=1)))
             raise ValueError(f"{what}[{k}]: expected finite numbers, got {rows[k].tolist()}")
         return MotionRows(rows)
     motions = _sequence(items, what)
