@@ -20,7 +20,9 @@ Paths (size, then the ``--quick`` size):
 - ``nfp_table``: the shipped jakobs1 (25 pieces) at 12 orientations, 90 000 entries
   (at 4 orientations, 10 000), reference at the origin, no cache, by its default choice
   (threads, for pieces without holes); ``nfp_table_workers``: the same table on 1, 2,
-  ... local processes (``workers=``, as ``--workers``; 1 is the calling process);
+  ... local workers (``workers=w, threads=w``, as ``--workers``): at most ``w``
+  processes, which the build starts only where they pay (work that holds the GIL), and
+  otherwise ``w`` threads, as here (1 is the calling thread);
 - ``dask ...`` (only when ``distributed`` is installed, else said and skipped):
   ``nfp_table``, ``classify_many`` and ``time_of_impact_many`` with ``client=`` on a
   ``LocalCluster`` of 1, 2, ... worker processes of one thread each, started and warmed
@@ -78,7 +80,6 @@ PARALLEL = [
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
     ("polycontact._kernels.contact_geometry", "boundary_gaps"),
     ("polycontact._kernels.relation_many", "many_distances"),
-    ("polycontact._depth", "penetrations"),
     ("polycontact._kernels.impact_batch", "body_tables"),
     ("polycontact._kernels.impact_batch", "suspect_bodies"),
     ("polycontact._kernels.swept", "box_pairs"),
@@ -324,14 +325,15 @@ class NfpTable(Path):
 
 
 class NfpTableWorkers(NfpTable):
-    """The table of :class:`NfpTable` on ``workers`` local processes (the count given to
-    ``run``)."""
+    """The table of :class:`NfpTable` on ``w`` local workers (the count given to ``run``):
+    ``workers=w`` processes at most, and ``threads=w`` where processes do not pay."""
 
     name = "nfp_table_workers"
     unit = "workers"
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
-        t = pc.nfp_table(self.inst.pieces, self.angles, progress=False, workers=threads)
+        t = pc.nfp_table(self.inst.pieces, self.angles, progress=False, workers=threads,
+                         threads=threads)
         self.last = t
         return (np.array([t.computed]),)
 

@@ -36,6 +36,8 @@ __all__ = ["penetration", "penetrations"]
 #: the unit by which the pairs and bodies are split over threads.
 DEPTH_SECONDS = 10e-6
 PIECES_SECONDS = 5e-6
+#: The work of one pair's key (:func:`polycontact._kernels.depth.pair_keys`).
+KEY_SECONDS = 50e-9
 
 
 def penetration(xa: np.ndarray, sa: np.ndarray, xb: np.ndarray, sb: np.ndarray,
@@ -110,7 +112,8 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     ``eps`` per pair. ``batch`` is ``(xa, lsa, bsa, fa, xb, lsb, bsb, fb)``, the bodies
     A and B in the packed form of :mod:`polycontact._kernels.relation_many`.
 
-    Each distinct pair (the same two bodies and tolerance) is computed once: by
+    Each distinct pair (the same two bodies and tolerance, found by keys computed in
+    parallel) is computed once: by
     :func:`polycontact._kernels.depth.contact_depths`, then the pairs it leaves by
     :func:`polycontact._kernels.depth.depths_of_pairs`, each distinct body among those
     decomposed once, in parallel (on the threads of
@@ -129,20 +132,15 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     >>> penetrations((sq, ls, bs, f, sq + 0.5, ls, bs, f), np.array([0]), np.array([1e-12]))
     array([[ 0.5, -0.5,  0. ]])
     """
-    from ._kernels.depth import contact_depths, distinct_bodies
+    from ._kernels.depth import contact_depths, distinct_pairs, pair_keys
 
     xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     pairs = np.asarray(pairs, dtype=np.int64)
     eps = np.ascontiguousarray(eps, dtype=np.float64)
-    ua, slot_a = distinct_bodies(xa, lsa, bsa, fa, pairs)
-    ub, slot_b = distinct_bodies(xb, lsb, bsb, fb, pairs)
     # equal pairs (the same A, B and tolerance) have the same depth: one computation
-    order = np.lexsort((eps.view(np.int64), slot_b, slot_a))
-    key = np.c_[slot_a[order], slot_b[order], eps[order].view(np.int64)]
-    new = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
-    one = order[new]  # the first of each group of equal pairs
-    group = np.empty(len(pairs), np.int64)
-    group[order] = np.cumsum(new) - 1
+    keys = _joined_rows(map_work(lambda p0, p1: pair_keys(batch, pairs[p0:p1], eps[p0:p1]),
+                                 len(pairs), KEY_SECONDS))
+    one, group = distinct_pairs(batch, pairs, eps, keys)
     todo, todo_eps = pairs[one], eps[one]
     out = _joined_rows(map_work(lambda p0, p1: contact_depths(batch, todo[p0:p1],
                                                               todo_eps[p0:p1]),
@@ -218,7 +216,7 @@ def _depths_by_pieces(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
 
 
 def _joined_rows(parts: list[np.ndarray]) -> np.ndarray:
-    """The depth rows of consecutive runs of pairs, as one array."""
+    """The rows (depths, or keys) of consecutive runs of pairs, as one array."""
     return parts[0] if len(parts) == 1 else np.concatenate(parts)
 
 

@@ -34,20 +34,24 @@ region's WKB, exact fits and slides, in compiled code that releases the GIL
 (:mod:`polycontact._kernels.nfp_batch`): a local build shares the missing entries among
 threads (``threads=``, by the threading policy of :doc:`conventions`), in chunks of
 ``chunk_size`` entries. The entries it leaves to :func:`polycontact.no_fit_polygon`
-(pieces with holes, rings too large for ear clipping) hold the GIL; when they are most
-of a large build, the build uses a pool of ``workers`` processes instead, but only
-where the work measured on a first chunk outweighs the processes' start
-(:data:`PROCESS_START`); the pool is started once, after the kernels are compiled here,
-so the processes load them and never compile. This process works alongside the pool,
-from the other end of the tasks, and computes the tasks of processes that are slow to
-start (or stop) itself, so that processes never make a build much slower than this
-process alone. The processes are spawned (as on macOS and Windows), and a spawned process
-runs the main script's top-level code again: a build called from there, outside an
-``if __name__ == "__main__":`` block, runs on threads instead (with a warning when
-``workers`` asked for processes), since each process would otherwise start the build
-again. With ``client=`` (a ``dask.distributed.Client``), or when called where a Dask
-client is the default, the missing entries run as tasks on the cluster
-(:mod:`polycontact.distributed`), each of at least
+(pieces with holes, rings too large for ear clipping) hold the GIL; only when they are
+most of the work measured on a first chunk, and each process's share of that work
+outweighs its start (:data:`PROCESS_START`), does the build use a pool of processes
+instead: at most ``workers`` of them (by default ``threads``), as many as have that
+much work each. ``workers`` is a bound, not a command: a build that processes would not
+speed up runs on threads whatever ``workers`` says, so ``workers=16`` on pieces without
+holes scales as 16 threads do, and ``workers=1`` keeps the build in this process (on
+its threads). The pool is started once, after the kernels are compiled here, so the
+processes load them and never compile. This process works alongside the pool, from the
+other end of the tasks, and computes the tasks of processes that are slow to start (or
+stop) itself, so that processes never make a build much slower than this process
+alone. The processes are spawned (as on macOS and Windows), and a spawned process runs
+the main script's top-level code again: a build called from there, outside an ``if
+__name__ == "__main__":`` block, runs on threads instead (with a warning when it was
+given ``workers`` and would have started processes), since each process would
+otherwise start the build again. With ``client=`` (a ``dask.distributed.Client``), or
+when called where a Dask client is the default, the missing entries run as tasks on the
+cluster (:mod:`polycontact.distributed`), each of at least
 :data:`~polycontact.limits.TASK_SECONDS` of work as measured on a first task, up to
 four per worker thread in whole rounds, the pieces sent to every worker once; the
 client writes the shards as results arrive.
@@ -404,10 +408,12 @@ def nfp_table(
         Show a progress bar (tqdm on stderr), or call ``progress(done, total)`` after
         each batch of entries.
     workers : int, optional
-        Local processes when there is no Dask client (besides this process, which works
-        alongside them). By default none, unless most of the work holds the GIL (pieces
-        with holes, large rings) and each process has more of it than its start costs
-        (:data:`PROCESS_START`); 1: in this process.
+        The most local processes when there is no Dask client (besides this process,
+        which works alongside them; default: ``threads``). Processes are started only
+        where they pay: most of the work, measured on a first chunk, holds the GIL
+        (pieces with holes, large rings) and each process has more of it than its start
+        costs (:data:`PROCESS_START`); otherwise the build runs on threads (``threads``),
+        so no value makes it slower than this process alone. 1: in this process only.
     threads : int, optional
         Threads of a local build (default and meaning: the threading policy of
         :doc:`conventions`: at most ``numba.get_num_threads()``, and no more than the
@@ -741,19 +747,21 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     """The entries of ``pairs`` computed here, as ``(p0, p1, packed)`` spans as they
     finish: a first chunk here (which compiles the kernels before any process starts)
     measures the work and how much of it holds the GIL, which decides between threads
-    and processes (see the module's docstring)."""
+    and processes, at most ``workers`` of them (by default ``threads``), by
+    :func:`_processes_that_pay` (see the module's docstring)."""
     from ._threads import as_done, useful
 
     count = len(pairs)
     first = min(count, chunk_size or PROBE_ENTRIES)
+    _compute(pieces, pairs[:0], reference)  # loads the kernels: the probe times the work
     t0 = time.perf_counter()
     packed, gil_seconds = _compute(pieces, pairs[:first], reference)
     seconds = time.perf_counter() - t0
     yield 0, first, packed
     rest = count - first
-    n_proc = workers or 1
-    if workers is None and gil_seconds > 0.5 * seconds:
-        n_proc = min(threads, int(gil_seconds / first * rest / PROCESS_START))
+    n_proc = _processes_that_pay(threads if workers is None else workers,
+                                 gil_seconds / seconds if seconds > 0.0 else 0.0,
+                                 gil_seconds / first * rest)
     if n_proc > 1 and _spawn_reruns_caller():
         if workers is not None:
             warnings.warn(
@@ -761,8 +769,8 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
                 "script's top-level code, which spawned processes would run again (put "
                 "the call under `if __name__ == '__main__':` to use processes)",
                 RuntimeWarning, stacklevel=4)
-        n_proc, workers = 1, None
-    n_threads = 1 if n_proc > 1 or workers == 1 else useful(threads, seconds / first * rest)
+        n_proc = 1
+    n_threads = 1 if n_proc > 1 else useful(threads, seconds / first * rest)
     size = chunk_size or min(1024, max(64, math.ceil(rest / (4 * max(n_proc, n_threads)))))
     spans = _spans(first, count, size)
     tasks = [pairs[p0:p1] for p0, p1 in spans]
@@ -774,6 +782,23 @@ def _local(pieces: _Pieces, pairs: np.ndarray, reference: str, workers: int | No
     with closing(results):  # type: ignore[type-var]
         for k, got in results:
             yield *spans[k], got
+
+
+def _processes_that_pay(most: int, gil_share: float, gil_work: float) -> int:
+    """The processes (at most ``most``) that a build's remaining entries are worth: more
+    than one only where most of the work holds the GIL (``gil_share`` of the first
+    chunk's time: threads cannot share that part) and each process's share of it
+    (``gil_work`` seconds in all, estimated from the first chunk) outweighs its start
+    (:data:`PROCESS_START`); else 1, and the build runs on threads.
+
+    >>> _processes_that_pay(16, 0.1, 100.0), _processes_that_pay(16, 0.9, 100.0)
+    (1, 16)
+    >>> _processes_that_pay(16, 0.9, 2.5), _processes_that_pay(16, 0.9, 1.5)
+    (2, 1)
+    """
+    if gil_share <= 0.5:
+        return 1
+    return max(1, min(most, int(gil_work / PROCESS_START)))
 
 
 def _spawn_reruns_caller() -> bool:

@@ -130,6 +130,26 @@ def test_distinct_bodies_tells_apart_bodies_of_equal_key():
     assert slot.tolist() == [0, 1, 0, 2, 1]
 
 
+def test_distinct_pairs_groups_equal_bodies_and_tolerances_only():
+    # Bodies 0 and 2 equal; body 1 of the same key as 0 (vertex 0 moved by (1.25, -1));
+    # body 3 that one reversed. Pairs k: (A, B) = (p, p) with tolerances eps[k].
+    sq = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
+    moved = sq.copy()
+    moved[0] = [1.25, -1.0]
+    x = np.concatenate([sq, moved, sq, moved[::-1]])
+    ls = np.array([0, 4, 4, 8, 8, 12, 12, 16])
+    bs = np.array([0, 2, 4, 6, 8])
+    f = np.array([1.0, 1.0, 1.0, -1.0])
+    batch = (x, ls, bs, f, x, ls, bs, f)
+    pairs = np.array([0, 1, 2, 3, 2, 0])
+    eps = np.array([1e-9, 1e-9, 1e-9, 1e-9, 1e-9, 2e-9])
+    keys = kd.pair_keys(batch, pairs, eps)
+    assert keys[1] == keys[0]  # (the case that needs the bodies compared)
+    first, slot = kd.distinct_pairs(batch, pairs, eps, keys)
+    assert first.tolist() == [0, 1, 3, 5]
+    assert slot.tolist() == [0, 1, 0, 2, 0, 3]
+
+
 def test_batch_depth_beyond_its_memory_budget_is_refused(monkeypatch):
     monkeypatch.setattr(limits, "MAX_SUM_VERTICES", 3)
     # (40-gons: two small bodies take the contact segments, which build no sums)

@@ -30,6 +30,8 @@ BAR = [[0, 0], [2, 0], [2, 1], [0, 1], [0, 0]]  # closed ring, as some ESICUP fi
 ELL = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
 # a U whose slot is exactly one unit wide: the square slides in it and fits at its bottom
 U = [[0, 0], [3, 0], [3, 3], [2, 3], [2, 1], [1, 1], [1, 3], [0, 3]]
+# a square frame: its entries go through no_fit_polygon, which holds the GIL
+FRAME = ([[0, 0], [3, 0], [3, 3], [0, 3]], [[[1, 1], [1, 2], [2, 2], [2, 1]]])
 
 
 def write_instance(path: Path, items: list | None = None) -> Path:
@@ -259,11 +261,48 @@ def test_ctrl_c_leaves_a_consistent_cache_and_the_rerun_completes_it(instance, t
         assert same_entry(ref[key], table[key])
 
 
-def test_local_processes_give_the_same_table(instance):
-    serial = pc.nfp_table(instance, progress=False, workers=1)
-    pooled = pc.nfp_table(instance, progress=False, workers=2, chunk_size=20)
+def pools_started(monkeypatch) -> list[int]:
+    """The sizes of the process pools the builds start from now on (recorded)."""
+    pools: list[int] = []
+    start = nfp_tables._run_processes
+    monkeypatch.setattr(nfp_tables, "_run_processes",
+                        lambda n, *args: (pools.append(n), start(n, *args))[1])
+    return pools
+
+
+def test_local_processes_give_the_same_table(instance, monkeypatch):
+    # the frame's entries, first, hold the GIL, and processes start at no cost here: the
+    # build takes a pool of two processes
+    pieces = [pc.Shape(*FRAME), *instance.pieces]
+    angles = [[0, 90], *instance.orientations]
+    serial = pc.nfp_table(pieces, angles, progress=False, workers=1, threads=1)
+    monkeypatch.setattr(nfp_tables, "PROCESS_START", 1e-9)
+    pools = pools_started(monkeypatch)
+    pooled = pc.nfp_table(pieces, angles, progress=False, workers=2, chunk_size=20)
+    assert pools == [2]
     for key in serial:
         assert same_entry(serial[key], pooled[key])
+
+
+@pytest.mark.parametrize("holes, workers", [(False, 2), (True, 1)])
+def test_workers_start_no_process_where_processes_cannot_pay(monkeypatch, holes, workers):
+    # pieces without holes are computed in compiled code that releases the GIL: threads
+    # share that work, and processes would only add their start, however cheap; and
+    # workers=1 keeps even work that holds the GIL in this process
+    pieces = ([pc.Shape(*FRAME)] if holes else []) + [pc.Shape(SQUARE), pc.Shape(ELL),
+                                                      pc.Shape(U)]
+    one = pc.nfp_table(pieces, [0, 90, 180], progress=False, workers=1, threads=1)
+    monkeypatch.setattr(nfp_tables, "PROCESS_START", 1e-9)
+
+    def no_pool(*args):
+        raise AssertionError("a process pool was started")
+
+    monkeypatch.setattr(nfp_tables, "_run_processes", no_pool)
+    built = pc.nfp_table(pieces, [0, 90, 180], progress=False, workers=workers, threads=2,
+                         chunk_size=8)
+    assert built.computed == one.computed
+    for key in one:
+        assert same_entry(one[key], built[key])
 
 
 def test_importing_the_table_imports_neither_dask_nor_tqdm():
@@ -299,9 +338,11 @@ def test_cli_reports_a_bad_instance_in_one_line(tmp_path, capsys):
 def test_a_build_whose_processes_never_start_finishes_in_this_process(monkeypatch):
     # the calling process works alongside its pool, and computes the tasks it handed to
     # processes that never take them: the build ends, with the table of one process
+    pools = []
+
     class IdlePool:
-        def __init__(self, *args, **kwargs):
-            pass
+        def __init__(self, n, *args, **kwargs):
+            pools.append(n)
 
         def submit(self, *args):
             return Future()  # never run
@@ -309,15 +350,18 @@ def test_a_build_whose_processes_never_start_finishes_in_this_process(monkeypatc
         def shutdown(self, **kwargs):
             pass
 
-    sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
-    ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
-    one = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=1)
+    # the frame's entries hold the GIL, and processes start at no cost here: the build
+    # takes a pool
+    pieces = [pc.Shape(*FRAME), pc.Shape(SQUARE), pc.Shape(ELL)]
+    one = pc.nfp_table(pieces, [0, 90], progress=False, workers=1)
+    monkeypatch.setattr(nfp_tables, "PROCESS_START", 1e-9)
     monkeypatch.setattr(nfp_tables, "ProcessPoolExecutor", IdlePool)
     built = []
     build = threading.Thread(target=lambda: built.append(pc.nfp_table(
-        [sq, ell], [0, 90], progress=False, workers=2, chunk_size=2)), daemon=True)
+        pieces, [0, 90], progress=False, workers=2, chunk_size=2)), daemon=True)
     build.start()
     build.join(120)
+    assert pools == [2]
     assert built, "the build waited for processes that never started"
     assert {k: shapely.to_wkb(built[0][k].region) for k in built[0]} == {
         k: shapely.to_wkb(one[k].region) for k in one}

@@ -1,6 +1,7 @@
 """The local worker processes of an NFP-table build end when their parent dies, killed
 or not: none (nor the resource tracker they keep alive) is left behind; a script whose
-top-level code builds a table (no ``if __name__ == "__main__":``) gets it on threads."""
+top-level code builds a table (no ``if __name__ == "__main__":``) gets it on threads,
+and is warned only where the build would have used processes."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import numpy as np
 import pytest
 
 import polycontact
+from polycontact.limits import EAR_CLIPPING_MAX
 
 SRC = str(Path(polycontact.__file__).resolve().parents[1])  # the code under test
 
@@ -61,11 +63,14 @@ def _alive(pids) -> list[int]:
 
 def _instance(path: Path) -> Path:
     """Enough pieces and orientations (518 400 entries) for a build of many seconds on
-    two processes: it is still running when the parent is killed."""
+    two processes: it is still running when the parent is killed. The rings have more
+    vertices than ear clipping takes (:data:`polycontact.limits.EAR_CLIPPING_MAX`): their
+    entries go through ``no_fit_polygon``, which holds the GIL, so that the build takes
+    the processes it is allowed."""
     rng = np.random.default_rng(3)
     items = []
     for k in range(20):
-        n = 10
+        n = EAR_CLIPPING_MAX + 6
         t = 2 * np.pi * np.arange(n) / n
         r = rng.uniform(0.5, 1.5, n)
         ring = np.c_[r * np.cos(t), r * np.sin(t)] * 10
@@ -115,19 +120,22 @@ from polycontact import nfp_tables
 
 sq = pc.Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+# a square frame: its entries, first, hold the GIL (no_fit_polygon)
+frame = pc.Shape([(0, 0), (3, 0), (3, 3), (0, 3)], [[(1, 1), (1, 2), (2, 2), (2, 1)]])
 
 
-def build():
+def build(pieces=(frame, sq, ell)):
+    nfp_tables.PROCESS_START = 1e-9  # processes pay wherever the work holds the GIL
     pools = []
     start = nfp_tables._run_processes
     nfp_tables._run_processes = lambda n, *args: (pools.append(n), start(n, *args))[1]
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
-        table = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=2, chunk_size=2)
-    one = pc.nfp_table([sq, ell], [0, 90], progress=False, workers=1)
+        table = pc.nfp_table(pieces, [0, 90], progress=False, workers=2, chunk_size=2)
+    one = pc.nfp_table(pieces, [0, 90], progress=False, workers=1)
     same = all(shapely.to_wkb(table[k].region) == shapely.to_wkb(one[k].region)
                for k in one)
-    print("same" if same and len(table) == 16 else "differ")
+    print("same" if same and len(table) == (2 * len(pieces)) ** 2 else "differ")
     print("process pools:", pools)
     for w in seen:
         print("warning:", w.category.__name__, w.message)
@@ -151,6 +159,14 @@ def test_a_script_without_a_main_guard_builds_on_threads(tmp_path):
     assert lines[:2] == ["same", "process pools: []"], done.stdout
     assert len(lines) == 3 and lines[2].startswith("warning: RuntimeWarning"), lines
     assert "runs on threads" in lines[2] and "__name__ == '__main__'" in lines[2]
+
+
+def test_a_script_without_a_main_guard_is_not_warned_where_processes_cannot_pay(tmp_path):
+    # pieces without holes run on threads whatever workers= allows: nothing to warn of
+    done = _run_script(tmp_path, _BUILD + "\nbuild((sq, ell))\n")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["same", "process pools: []"], (done.stdout,
+                                                                       done.stderr)
 
 
 def test_a_script_with_a_main_guard_builds_on_processes(tmp_path):

@@ -31,7 +31,8 @@ fits).
 Many pairs (for ``classify_many(...).distances``): :func:`contact_depths` and
 :func:`depths_of_pairs` compute a run of pairs, :func:`pieces_of_bodies` decomposes a
 run of bodies, without the GIL (the caller splits the work over threads),
-:func:`distinct_bodies` finds the bodies to decompose once (see
+:func:`pair_keys` and :func:`distinct_pairs` find the pairs to compute once and
+:func:`distinct_bodies` the bodies to decompose once (see
 :func:`polycontact._depth.penetrations`).
 """
 
@@ -528,41 +529,60 @@ def _samebody(x, ls, bs, f, p, q):
     return True
 
 
-@njit(cache=True, nogil=True)
-def distinct_bodies(x, ls, bs, f, ids):
-    """The distinct bodies among bodies ``ids`` of a packed batch: ``(first, slot)``,
-    ``first`` the ids of the distinct ones (each at its first occurrence, in order) and
-    ``slot[k]`` the position in ``first`` of the body equal to ``ids[k]``.
+@njit(cache=True, nogil=True, inline="always")
+def _body_key(x, ls, bs, f, p):
+    """A weighted sum of the coordinates of body p of a packed batch, with its loops'
+    sizes and orientation: equal bodies have equal keys."""
+    r0 = ls[bs[p]]
+    h = f[p] + (ls[bs[p + 1] - 1] - r0) + 0.5 * (bs[p + 1] - bs[p])
+    for i in range(ls[bs[p + 1] - 1] - r0):
+        w = 1.0 + 0.6180339887498949 * i - np.floor(0.6180339887498949 * i)
+        h += w * x[r0 + i, 0] + (w + 0.25) * x[r0 + i, 1]
+    return h
 
-    Bodies are grouped by a weighted sum of their coordinates (equal bodies have equal
-    sums), then compared in full within a group: O(n log n) for n bodies, plus the
-    comparisons, one per body unless different bodies share a sum.
-    """
-    n = ids.shape[0]
-    key = np.empty(n)
+
+@njit(cache=True, nogil=True)
+def pair_keys(batch, pairs, eps):
+    """A key of each pair ``pairs[k]`` of a packed batch ``(xa, lsa, bsa, fa, xb, lsb,
+    bsb, fb)`` with tolerance ``eps[k]``: equal pairs (equal bodies A and B, equal
+    tolerance) have equal keys. The work of a run of pairs, without the GIL (the caller
+    splits the pairs over threads)."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
+    n = pairs.shape[0]
+    out = np.empty(n)
     for k in range(n):
-        p = ids[k]
-        r0 = ls[bs[p]]
-        h = f[p] + (ls[bs[p + 1] - 1] - r0) + 0.5 * (bs[p + 1] - bs[p])
-        for i in range(ls[bs[p + 1] - 1] - r0):
-            w = 1.0 + 0.6180339887498949 * i - np.floor(0.6180339887498949 * i)
-            h += w * x[r0 + i, 0] + (w + 0.25) * x[r0 + i, 1]
-        key[k] = h
-    order = np.argsort(key, kind="mergesort")  # equal keys stay in order: first is first
-    rep = np.empty(n, np.int64)  # the first k' of ids equal to ids[k]
-    reps = np.empty(n, np.int64)  # the distinct ones of the current group
+        p = pairs[k]
+        out[k] = _body_key(xa, lsa, bsa, fa, p) + 0.7548776662466927 * _body_key(
+            xb, lsb, bsb, fb, p) + eps[k]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _grouped(batch, ids, eps, keys, both):
+    """Groups of equal items ``ids[k]`` of a packed batch, found by their ``keys``
+    (equal items have equal keys) and compared in full within a run of equal keys:
+    ``(first, slot)``, ``first`` the positions k of the first item of each group in
+    increasing order, ``slot[k]`` the position in ``first`` of item k's group. Items are
+    bodies A (``both`` False) or pairs of bodies A and B with tolerances ``eps``."""
+    xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
+    n = ids.shape[0]
+    order = np.argsort(keys, kind="mergesort")  # equal keys stay in order: first is first
+    rep = np.empty(n, np.int64)  # the first k' equal to k
+    reps = np.empty(n, np.int64)  # the distinct ones of the current run
     g = 0
     while g < n:
         e = g + 1
-        while e < n and key[order[e]] == key[order[g]]:
+        while e < n and keys[order[e]] == keys[order[g]]:
             e += 1
         m = 0
         for u in range(g, e):
             k = order[u]
             rep[k] = k
             for v in range(m):
-                if _samebody(x, ls, bs, f, ids[reps[v]], ids[k]):
-                    rep[k] = reps[v]
+                r = reps[v]
+                if _samebody(xa, lsa, bsa, fa, ids[r], ids[k]) and (not both or (
+                        eps[r] == eps[k] and _samebody(xb, lsb, bsb, fb, ids[r], ids[k]))):
+                    rep[k] = r
                     break
             if rep[k] == k:
                 reps[m] = k
@@ -574,11 +594,39 @@ def distinct_bodies(x, ls, bs, f, ids):
     for k in range(n):
         if rep[k] == k:
             slot[k] = m
-            first[m] = ids[k]
+            first[m] = k
             m += 1
         else:
             slot[k] = slot[rep[k]]
     return first[:m].copy(), slot
+
+
+@njit(cache=True, nogil=True)
+def distinct_pairs(batch, pairs, eps, keys):
+    """The distinct pairs among ``pairs`` of a packed batch (as :func:`pair_keys`, whose
+    ``keys`` they are): ``(first, slot)``, ``first`` the positions k of the first pair
+    of each group of equal pairs (equal bodies and tolerance), in increasing order, and
+    ``slot[k]`` the position in ``first`` of pair k's group. O(n log n) for n pairs, plus
+    a comparison of the bodies per pair whose key another pair shares."""
+    return _grouped(batch, pairs, eps, keys, True)
+
+
+@njit(cache=True, nogil=True)
+def distinct_bodies(x, ls, bs, f, ids):
+    """The distinct bodies among bodies ``ids`` of a packed batch: ``(first, slot)``,
+    ``first`` the ids of the distinct ones (each at its first occurrence, in order) and
+    ``slot[k]`` the position in ``first`` of the body equal to ``ids[k]``.
+
+    Bodies are grouped by a weighted sum of their coordinates (equal bodies have equal
+    sums), then compared in full within a group: O(n log n) for n bodies, plus the
+    comparisons, one per body unless different bodies share a sum.
+    """
+    n = ids.shape[0]
+    keys = np.empty(n)
+    for k in range(n):
+        keys[k] = _body_key(x, ls, bs, f, ids[k])
+    first, slot = _grouped((x, ls, bs, f, x, ls, bs, f), ids, keys, keys, False)
+    return ids[first], slot
 
 
 @njit(cache=True, nogil=True)

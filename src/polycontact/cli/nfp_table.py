@@ -39,7 +39,8 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="cache directory")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--workers", type=integer_at_least(1), default=None, metavar="N",
-                       help="local processes (default: one per CPU for large tables)")
+                       help="most local processes, started only where they pay "
+                       "(work holding the GIL); otherwise threads (default: one per CPU)")
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="run on this Dask scheduler (needs polycontact[dask])")
     p.add_argument("--orientations", type=_angle, nargs="+", metavar="DEG",
