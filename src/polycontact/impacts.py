@@ -37,7 +37,6 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      MAX_ITERATIONS, MAX_SLICES, RELATIVE_TOLERANCE, SAMPLES,
                      SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
-from .relation import _UNPACK_WORK
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
@@ -421,8 +420,10 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 _TABLE_SECONDS = 2e-6
 _PAIR_SECONDS = 2e-6
 
-#: Setting up one body pair of ``first_impacts`` for the search, in pair
-#: classifications (see :func:`polycontact._threads.chunks`).
+#: Copying a shape's kernel pack (a 12-gon's), and setting up one body pair of
+#: ``first_impacts`` for the search, in pair classifications (see
+#: :func:`polycontact._threads.chunks`).
+_UNPACK_WORK = 0.1
 _SETUP_WORK = 0.05
 
 
@@ -469,9 +470,9 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     coordinates within the range the kernels take, and motions that do not carry them,
     the points' speeds or accelerations beyond it within [0, t_max]. A shape object in
     many bodies is kept once (its kernel pack, read once). The checks run in compiled
-    code on at most ``threads``
-    threads; the bodies it marks are checked again here, exactly, and the first that
-    fails is refused, named by ``name_of(k) = (shape's, motion's)``."""
+    code on at most ``threads`` threads; the bodies it marks are checked again here,
+    exactly, and the first that fails is refused, named by ``name_of(k) = (shape's,
+    motion's)``."""
     from ._kernels.impact_batch import suspect_bodies
 
     count = len(shapes)

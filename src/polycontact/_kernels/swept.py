@@ -25,7 +25,6 @@ from numba import prange
 
 from .jit import njit
 from .impact import exact_query, sampled_query, unpack_body, work_floats
-from .overlap import _sorted
 
 
 @njit(cache=True, nogil=True)
@@ -256,14 +255,24 @@ def _distinct_partners(bucket, start, i0, i1, kept):
     ``i1 - 1``), keep each once at the front, their count in ``kept[i + 1]``."""
     for i in range(i0, i1):
         seg = bucket[start[i]:start[i + 1]]
+        m = 0
         if seg.shape[0] > 32:
             seg[:] = np.sort(seg)
-        else:  # (a few partners, as most bodies have: sorted in place)
-            _sorted(seg, seg.shape[0])
-        m = 0
-        for r in range(seg.shape[0]):
-            if m == 0 or seg[r] != seg[m - 1]:
-                seg[m] = seg[r]
+            for r in range(seg.shape[0]):
+                if m == 0 or seg[r] != seg[m - 1]:
+                    seg[m] = seg[r]
+                    m += 1
+        else:  # (a few partners, as most bodies have: each inserted unless kept)
+            for r in range(seg.shape[0]):
+                v = seg[r]
+                q = m
+                while q > 0 and seg[q - 1] > v:
+                    q -= 1
+                if q > 0 and seg[q - 1] == v:
+                    continue
+                for t in range(m, q, -1):
+                    seg[t] = seg[t - 1]
+                seg[q] = v
                 m += 1
         kept[i + 1] = m
 
