@@ -57,7 +57,8 @@ FAMILIES: dict[str, tuple[str, ...]] = {
                        "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk",
-                           "impact_batch.body_tables", "impact_batch.suspect_bodies"),
+                           "impact_batch.body_tables", "impact_batch.suspect_bodies",
+                           "impact_batch.pair_bodies"),
     "no-fit polygon table": ("nfp_batch.nfp_pairs",),
 }
 

@@ -37,11 +37,10 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      MAX_ITERATIONS, MAX_SLICES, RELATIVE_TOLERANCE, SAMPLES,
                      SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
-from .relation import shapes_packed
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
-from ._threads import as_done, map_work, requested, useful
+from ._threads import as_done, chunks, map_work, numba_threads, requested, useful
 
 __all__ = ["ImpactBatch", "PairImpact", "PairImpacts", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
@@ -301,9 +300,9 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
             raise ValueError(f"{what}: expected {count} motions (one per shape of "
                              f"{shapes_what}) as an array of shape ({count}, 6), got shape "
                              f"{rows.shape}")
-        bad = ~np.isfinite(rows).all(axis=1)
-        if bad.any():
-            k = int(np.argmax(bad))
+        finite = np.isfinite(rows)
+        if not finite.all():  # (the row named only when one is not)
+            k = int(np.argmin(finite.all(axis=1)))
             raise ValueError(f"{what}[{k}]: expected finite numbers, got {rows[k].tolist()}")
         return MotionRows(rows)
     motions = _sequence(items, what)
@@ -318,13 +317,14 @@ def check_motions(items: Any, what: str, count: int, shapes_what: str) -> Motion
 
 def _rows(*groups: Motions) -> np.ndarray:
     """The kernel vectors of the motions of ``groups``, one group after another, (N, 6)
-    (Motions' bytes joined at once)."""
+    (Motions' bytes joined at once; a writable array, as the rows of an array are, so
+    that the kernels take one type of motions)."""
     if len(groups) == 1 and isinstance(groups[0], MotionRows):
         return groups[0].rows
     lists = [g for g in groups if not isinstance(g, MotionRows)]
     if len(lists) < len(groups):
         return np.concatenate([_rows(g) for g in groups])
-    return np.frombuffer(b"".join(map(_BYTES, chain.from_iterable(lists))),
+    return np.frombuffer(bytearray().join(map(_BYTES, chain.from_iterable(lists))),
                          np.float64).reshape(-1, 6)
 
 
@@ -338,17 +338,19 @@ def check_many_options(t_max: float, method: str, time_tolerance: float, samples
 
 
 # -- the batched search ----------------------------------------------------------------
-def pack_shapes(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
-    """The shapes packed for :mod:`polycontact._kernels.impact_batch`: ``(xy, rows,
-    starts, st_off, centroids, radii)`` (:func:`polycontact.relation.shapes_packed`, each
-    shape's stored centroid and bounding radius read from its kernel pack)."""
-    return _for_batch(shapes_packed(shapes))[0]
+def _for_batch(kernels: Sequence[bytes],
+               threads: int = 1) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+    """Shapes given by their kernel packs (``Shape._kernel``) packed for
+    :mod:`polycontact._kernels.impact_batch`: ``(xy, rows, starts, st_off, centroids,
+    radii)`` (as :func:`polycontact.relation.shapes_packed` packs them, each shape's
+    stored centroid and bounding radius read from its kernel pack), and the shapes'
+    extents; copied in compiled code on at most ``threads`` threads."""
+    from ._kernels.packs import unpack_shapes
 
-
-def _for_batch(unpacked: tuple[np.ndarray, ...]) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
-    """Unpacked kernel packs ``(xy, rows, starts, st_off, sizes)`` as :func:`pack_shapes`
-    gives them, and the shapes' extents."""
-    xy, rows, starts, st_off, sizes = unpacked
+    count = len(kernels)
+    with numba_threads(threads):
+        xy, rows, starts, st_off, sizes = unpack_shapes(
+            np.frombuffer(b"".join(kernels), np.float64), count, chunks(count, _UNPACK_WORK))
     return ((xy, rows, starts, st_off, np.ascontiguousarray(sizes[:, :2]),
              np.ascontiguousarray(sizes[:, 2])), sizes[:, 3])
 
@@ -369,19 +371,24 @@ def empty_result(count: int) -> tuple[np.ndarray, ...]:
 def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
                  ma: np.ndarray, mb: np.ndarray, eps_rel: np.ndarray, t_max: float,
                  method: str, tol: float, samples: int, max_iterations: int,
-                 threads: int) -> tuple[Any, ...]:
+                 threads: int, wanted: np.ndarray | None = None,
+                 motion_rows: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[Any, ...]:
     """Run the pairs ``(shapes[sa[p]], ma[p])`` vs ``(shapes[sb[p]], mb[p])`` of the shapes
-    ``packed`` by :func:`pack_shapes` through the
+    ``packed`` by :func:`_for_batch` through the
     search of ``time_of_impact`` on at most ``threads`` threads (``eps_rel[p]``: the size
     term of pair p's distance tolerance, see :func:`prepare_pairs`); the raw result
-    arrays. The bodies' tables are built in parallel first
+    arrays. With ``motion_rows = (ka, kb)``, pair p's motions are ``ma[ka[p]]`` and
+    ``mb[kb[p]]`` instead. The tables of the shapes (of those ``wanted`` only, a bool
+    mask, when given: at least every shape of a pair) are built in parallel first
     (:func:`polycontact._kernels.impact_batch.body_tables`)."""
     from ._kernels.impact_batch import body_tables, table_sizes
     from ._kernels.swept import impacts_chunk
 
     exact = method == "exact"
     xy, rows, starts, st_off, centroids, radii = packed
-    f_off, i_off = table_sizes(rows, st_off)
+    if wanted is None:
+        wanted = np.ones(len(radii), np.bool_)
+    f_off, i_off = table_sizes(rows, st_off, wanted)
     floats, ints = np.empty(f_off[-1]), np.empty(i_off[-1], np.int64)
     map_work(lambda u0, u1: body_tables(xy, rows, starts, st_off, centroids, radii, f_off,
                                         i_off, u0, u1, floats, ints),
@@ -389,7 +396,9 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     tables = (floats, f_off, ints, i_off)
     p_count = len(sa)
     out = empty_result(p_count)
-    pairs = (sa, sb, ma, mb, eps_rel)
+    order = np.arange(p_count, dtype=np.int64)
+    ka, kb = (order, order) if motion_rows is None else motion_rows
+    pairs = (sa, sb, ma, mb, ka, kb, eps_rel)
     settings = (t_max, BROAD_PHASE_INFLATION, tol, ROUNDING_FACTOR, CONTACT_RESOLUTION,
                 max_iterations, exact, samples)
 
@@ -398,10 +407,10 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
-    order = np.arange(p_count, dtype=np.int64)
     n = useful(threads, p_count * _PAIR_SECONDS)
     n_chunks = 1 if n == 1 else min(p_count // 16, 16 * n)
-    for _ in as_done(run, [order[c::n_chunks].copy() for c in range(n_chunks)], n):
+    todo = [order] if n_chunks == 1 else [order[c::n_chunks].copy() for c in range(n_chunks)]
+    for _ in as_done(run, todo, n):
         pass
     return out
 
@@ -410,6 +419,12 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 #: 12-gon's), for the threads the work can use (see :mod:`polycontact._threads`).
 _TABLE_SECONDS = 2e-6
 _PAIR_SECONDS = 2e-6
+
+#: Copying a shape's kernel pack (a 12-gon's), and setting up one body pair of
+#: ``first_impacts`` for the search, in pair classifications (see
+#: :func:`polycontact._threads.chunks`).
+_UNPACK_WORK = 0.1
+_SETUP_WORK = 0.05
 
 
 def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
@@ -438,8 +453,8 @@ def _names(k: int) -> tuple[str, str]:
 class _Bodies(NamedTuple):
     """Checked moving bodies (see :func:`_bodies`)."""
 
-    shapes: list[Shape]     # the distinct shape objects
-    packed: tuple[np.ndarray, ...]  # their pack_shapes
+    kernels: list[bytes]    # the kernel packs of the distinct shapes
+    packed: tuple[np.ndarray, ...]  # their packing for the batch (_for_batch)
     owner: np.ndarray       # each body's index among them
     motions: np.ndarray     # each body's motion as the kernel vector, (N, 6)
     centroids: np.ndarray   # of the distinct shapes, (U, 2)
@@ -454,17 +469,18 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     after the checks ``time_of_impact`` makes:
     coordinates within the range the kernels take, and motions that do not carry them,
     the points' speeds or accelerations beyond it within [0, t_max]. A shape object in
-    many bodies is kept once. The checks run in compiled code on at most ``threads``
-    threads; the bodies it marks are checked again here, exactly, and the first that
-    fails is refused, named by ``name_of(k) = (shape's, motion's)``."""
+    many bodies is kept once (its kernel pack, read once). The checks run in compiled
+    code on at most ``threads`` threads; the bodies it marks are checked again here,
+    exactly, and the first that fails is refused, named by ``name_of(k) = (shape's,
+    motion's)``."""
     from ._kernels.impact_batch import suspect_bodies
 
     count = len(shapes)
     ids = np.fromiter(map(id, shapes), np.int64, count)
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
-    uniq = list(map(shapes.__getitem__, first.tolist()))
+    uniq = list(map(_KERNEL, map(shapes.__getitem__, first.tolist())))
     owner = owner.reshape(-1).astype(np.int64)
-    packed, extents = _for_batch(shapes_packed(uniq))
+    packed, extents = _for_batch(uniq, threads)
     xy, vrows, _, _, centroids, radii = packed
     suspect = np.zeros(count, np.bool_)
     map_work(lambda k0, k1: suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
@@ -605,7 +621,7 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
                      threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
     eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[ia], bodies.extents[ib])
-    return (bodies.shapes, bodies.packed, ia, ib, bodies.motions[:p_count],
+    return (bodies.kernels, bodies.packed, ia, ib, bodies.motions[:p_count],
             bodies.motions[p_count:], eps_rel)
 
 
@@ -652,12 +668,12 @@ def _remote_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, .
     return raw
 
 
-def _impact_tasks(uniq: list[Any], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
+def _impact_tasks(uniq: list[bytes], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,
                   rows_b: np.ndarray, eps_rel: np.ndarray,
                   spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple[Any, ...]]]:
-    """The shapes several tasks use (sent once to every worker) and the tasks: each its
-    slice of pairs, with its own shapes, the pairs' shape indices numbering the shared
-    shapes first, then the task's own."""
+    """The shapes (``uniq``: their kernel packs) several tasks use (sent once to every
+    worker) and the tasks: each its slice of pairs, with its own shapes, the pairs'
+    shape indices numbering the shared shapes first, then the task's own."""
     task = np.empty(len(sa), np.int64)
     for k, (p0, p1) in enumerate(spans):
         task[p0:p1] = k
@@ -695,8 +711,8 @@ def _impact_slice(shared: _ShapePack, task: tuple[Any, ...], t_max: float, metho
 
 
 class _ShapePack:
-    """Shapes sent to Dask workers as their kernel packs (one ``bytes`` each: coordinates,
-    loop starts, centroid and bounding radius, see
+    """Shapes sent to Dask workers as their kernel packs (``Shape._kernel``, one ``bytes``
+    each: coordinates, loop starts, centroid and bounding radius, see
     :func:`polycontact.relation.shapes_packed`).
 
     A list of :class:`~polycontact.Shape` pickles as a dozen small NumPy buffers per
@@ -709,14 +725,15 @@ class _ShapePack:
     >>> import pickle
     >>> from polycontact import Shape
     >>> frame = Shape([(0, 0), (6, 0), (6, 6), (0, 6)], [[(2, 2), (4, 2), (4, 4), (2, 4)]])
-    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame, frame.moved((1, 0))])))
+    >>> back = pickle.loads(pickle.dumps(_ShapePack([frame._kernel,
+    ...                                              frame.moved((1, 0))._kernel])))
     >>> xy, rows, starts, st_off, centroids, radii = _ShapePack.packed([back], [1])
     >>> centroids.tolist(), float(radii[0]) == frame.bounding_radius, starts.tolist()
     ([[4.0, 3.0]], True, [0, 4, 8])
     """
 
-    def __init__(self, shapes: Sequence[Any]) -> None:
-        self.kernels = list(map(_KERNEL, shapes))
+    def __init__(self, kernels: Sequence[bytes]) -> None:
+        self.kernels = list(kernels)
 
     def __len__(self) -> int:
         return len(self.kernels)
@@ -724,13 +741,9 @@ class _ShapePack:
     @staticmethod
     def packed(packs: Sequence[_ShapePack], chosen: Sequence[int]) -> tuple[np.ndarray, ...]:
         """The shapes ``chosen`` (numbered through ``packs`` one after another) packed as
-        :func:`pack_shapes` packs them."""
-        from ._kernels.packs import unpack_shapes
-
+        :func:`_for_batch` packs them."""
         kernels = [k for p in packs for k in p.kernels]
-        picked = [kernels[k] for k in np.asarray(chosen, np.int64).tolist()]
-        return _for_batch(unpack_shapes(np.frombuffer(b"".join(picked), np.float64),
-                                        len(picked), 1))[0]
+        return _for_batch([kernels[k] for k in np.asarray(chosen, np.int64).tolist()])[0]
 
 
 # -- many moving bodies ----------------------------------------------------------------
@@ -773,12 +786,13 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.
     bodies = check_shapes(shapes, "shapes")
     moves = check_motions(motions, "motions", len(bodies), "shapes")
     t_max = check_t_max(t_max)
+    threads = requested(None)
     return _candidates(_bodies(bodies, _rows(moves), moves.__getitem__, _names, t_max,
-                               requested(None)), t_max)
+                               threads), t_max, threads)
 
 
-def _candidates(bodies: _Bodies, t_max: float) -> np.ndarray:
-    """:func:`candidate_pairs` of checked bodies."""
+def _candidates(bodies: _Bodies, t_max: float, threads: int) -> np.ndarray:
+    """:func:`candidate_pairs` of checked bodies, on at most ``threads`` threads."""
     from ._kernels.swept import box_pairs, swept_boxes
 
     n = len(bodies.owner)
@@ -788,7 +802,8 @@ def _candidates(bodies: _Bodies, t_max: float) -> np.ndarray:
     boxes, owner = swept_boxes(cent, bodies.motions, bodies.radii[bodies.owner], t_max,
                                MAX_SLICES, BROAD_PHASE_INFLATION,
                                SWEPT_ROUNDING_ULPS * 2.0**-52)
-    pairs: np.ndarray = box_pairs(boxes, owner, n)
+    with numba_threads(threads):
+        pairs: np.ndarray = box_pairs(boxes, owner, n)
     return pairs
 
 
@@ -896,25 +911,24 @@ def first_impacts(
     0 2 no-hit contact 0.5
     0 1 hit penetrating 2.0
     """
+    from ._kernels.impact_batch import pair_bodies
+
     shapes = check_shapes(shapes, "shapes")
     moves = check_motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
     bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
-    pairs = _candidates(bodies, t_max)
+    pairs = _candidates(bodies, t_max, threads)
     if len(pairs) == 0:
         return _no_events()
-    # only the shapes of candidate pairs are packed and searched
-    i, j = pairs[:, 0], pairs[:, 1]
-    oi, oj = bodies.owner[i], bodies.owner[j]
-    used, inverse = np.unique(np.concatenate([oi, oj]), return_inverse=True)
-    inverse = inverse.reshape(-1).astype(np.int64)
-    eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[oi], bodies.extents[oj])
-    raw = search_pairs(pack_shapes([bodies.shapes[u] for u in used.tolist()]),
-                       inverse[: len(i)], inverse[len(i):], bodies.motions[i],
-                       bodies.motions[j], eps_rel, t_max, method, tol, samples,
-                       max_iterations, threads)
+    # only the shapes of candidate pairs get tables and are searched
+    with numba_threads(threads):
+        i, j, oi, oj, eps_rel, wanted = pair_bodies(pairs, bodies.owner, bodies.extents,
+                                                    RELATIVE_TOLERANCE,
+                                                    chunks(len(pairs), _SETUP_WORK))
+    raw = search_pairs(bodies.packed, oi, oj, bodies.motions, bodies.motions, eps_rel, t_max,
+                       method, tol, samples, max_iterations, threads, wanted, (i, j))
     code, t_hi, _, contact, _, reached, *_ = raw
     make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
@@ -923,7 +937,8 @@ def first_impacts(
     when = np.select([code[met] == 2, code[met] == 1, code[met] == 3],
                      [0.0, t_hi[met], reached[met]],
                      np.where(contact[met] >= 0.0, contact[met], math.inf))
-    order = np.lexsort((j[met], i[met], when))
+    # (the pairs come sorted by (i, j): a stable sort by time sorts by (time, i, j))
+    order = np.argsort(when, kind="stable")
     chosen = met[order]
     return PairImpacts(np.ascontiguousarray(pairs[chosen], dtype=np.int64), when[order],
                        code[chosen].astype(np.int8), lambda k: make(int(chosen[k])))

@@ -29,7 +29,7 @@ def _pair(value: Any, what: str) -> tuple[float, float]:
     return x, y
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Motion:
     """Constant-acceleration rigid motion about the body's area centroid.
 

@@ -89,3 +89,49 @@ def test_box_pairs_of_boxes_of_every_size_equal_all_pairs(n_boxes, n_bodies, see
     with np.errstate(invalid="ignore"):  # (infinite boxes' centres, run as Python)
         got = box_pairs(boxes, owner, n_bodies)
     assert got.tolist() == want
+
+
+def _overlapping_pairs(boxes: np.ndarray, owner: np.ndarray) -> list[list[int]]:
+    """:func:`_all_pairs` for thousands of boxes: every pair of boxes tested, a block
+    of rows at a time in NumPy."""
+    lo, hi = boxes[:, 0::2], boxes[:, 1::2]
+    want = set()
+    for a0 in range(0, len(boxes), 256):
+        a = slice(a0, a0 + 256)
+        meet = np.all((lo[a, None, :] <= hi[None, :, :]) & (lo[None, :, :] <= hi[a, None, :]),
+                      axis=2)
+        meet &= owner[a, None] < owner[None, :]
+        ka, kb = np.nonzero(meet)
+        want.update(zip(owner[a][ka].tolist(), owner[kb].tolist()))
+    return sorted(map(list, want))
+
+
+def test_box_pairs_of_a_crowd_are_the_same_on_every_number_of_threads():
+    """A crowd large enough to be swept in parallel chunks (bodies of several boxes,
+    boxes touching and spanning several strips): every pair once, whatever the number
+    of Numba's threads."""
+    import numba
+
+    from polycontact._kernels.swept import PARALLEL_BOXES
+
+    rng = np.random.default_rng(7)
+    n_boxes = PARALLEL_BOXES + 300
+    lo = rng.integers(0, 400, (n_boxes, 3)).astype(float)
+    lo[:, 2] = rng.integers(0, 4, n_boxes)
+    size = rng.integers(0, 5, (n_boxes, 3)).astype(float)
+    size[rng.random(n_boxes) < 0.01, 1] = 60.0        # tall boxes: in many strips
+    boxes = np.empty((n_boxes, 6))
+    boxes[:, 0::2] = lo
+    boxes[:, 1::2] = lo + size
+    owner = rng.integers(0, n_boxes // 2, n_boxes).astype(np.int64)
+    want = _overlapping_pairs(boxes, owner)
+    before = numba.get_num_threads()
+    try:
+        got = []
+        for threads in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):
+            numba.set_num_threads(threads)
+            got.append(box_pairs(boxes, owner, n_boxes // 2).tolist())
+    finally:
+        numba.set_num_threads(before)
+    assert len(want) > 1000
+    assert all(g == want for g in got)

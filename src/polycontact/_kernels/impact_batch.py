@@ -6,7 +6,8 @@ vertices about its centroid, circle tree and lengths: what
 :func:`polycontact._kernels.impact.pack_body` packs for one body, the same arrays bit
 for bit) into two flat arrays, each body at offsets known beforehand;
 :func:`suspect_bodies` marks the bodies whose coordinates or motion may be beyond the
-range the kernels take, for the caller to check exactly and refuse.
+range the kernels take, for the caller to check exactly and refuse; :func:`pair_bodies`
+gives the shapes and tolerances of many body pairs.
 
 Bodies are packed as ``xy`` (V, 2) float64, every body's loops one after another,
 ``rows`` (U + 1,) the first row of each body, and ``starts`` with ``st_off`` (U + 1,):
@@ -19,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
 from .jit import njit
 from .advance import edge_table
@@ -26,14 +28,19 @@ from .impact import pack_body
 
 
 @njit(cache=True, nogil=True)
-def table_sizes(rows, st_off):
+def table_sizes(rows, st_off, wanted):
     """Offsets of each body's floats and ints in :func:`body_tables`' arrays: a body of
     n vertices and k loop starts takes ``11 n - 1`` floats and ``7 n + k`` ints (those
-    of ``pack_body`` with its tree of ``2 n - 1`` nodes)."""
+    of ``pack_body`` with its tree of ``2 n - 1`` nodes); a body not ``wanted`` (bool,
+    (U,)) takes none, and gets no table."""
     u_count = rows.shape[0] - 1
     f_off = np.zeros(u_count + 1, np.int64)
     i_off = np.zeros(u_count + 1, np.int64)
     for u in range(u_count):
+        if not wanted[u]:
+            f_off[u + 1] = f_off[u]
+            i_off[u + 1] = i_off[u]
+            continue
         n = rows[u + 1] - rows[u]
         f_off[u + 1] = f_off[u] + 11 * n - 1
         i_off[u + 1] = i_off[u] + 7 * n + st_off[u + 1] - st_off[u]
@@ -63,8 +70,10 @@ def body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, u0, u1
     + 1]]`` and ``ints[i_off[u]:i_off[u + 1]]``, the offsets of :func:`table_sizes`), as
     ``impacts_chunk`` reads them; the caller splits the bodies over threads.
     ``centroids`` (U, 2) and ``radii`` (U,): each body's area centroid and bounding
-    radius."""
+    radius. Bodies given no room (not wanted by :func:`table_sizes`) are skipped."""
     for u in range(u0, u1):
+        if f_off[u + 1] == f_off[u]:
+            continue
         _body_into(xy, rows, starts, st_off, centroids, radii, u,
                    floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
 
@@ -114,3 +123,43 @@ def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, flo
     threads."""
     for k in range(k0, k1):
         out[k] = _suspect(xy, rows, centroids, radii, motions, owner, t_max, limit, floor, k)
+
+
+@njit(cache=True, nogil=True)
+def _pairs_range(pairs, owner, extents, rel, k0, k1, out):
+    """:func:`pair_bodies` for the pairs ``k0`` to ``k1 - 1``, into ``out``."""
+    i, j, oi, oj, eps_rel, wanted = out
+    for k in range(k0, k1):
+        a = pairs[k, 0]
+        b = pairs[k, 1]
+        i[k] = a
+        j[k] = b
+        ua = owner[a]
+        ub = owner[b]
+        oi[k] = ua
+        oj[k] = ub
+        eps_rel[k] = rel * max(extents[ua], extents[ub])
+        wanted[ua] = True  # (chunks may write the same True: no order matters)
+        wanted[ub] = True
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pair_bodies(pairs, owner, extents, rel, chunks):
+    """What the search of the body pairs ``pairs`` (K, 2) needs, in ``chunks`` parallel
+    chunks (1: serial, no thread start): ``(i, j, oi, oj, eps_rel, wanted)``, the two
+    bodies of each pair, their shapes ``owner[i]`` and ``owner[j]``, the size term of
+    the pair's distance tolerance ``rel * max(extents[oi], extents[oj])``, and for each
+    of the U = ``extents.shape[0]`` shapes whether a pair has it."""
+    n = pairs.shape[0]
+    u_count = extents.shape[0]
+    wanted = np.empty(u_count, np.bool_)
+    for u in range(u_count):
+        wanted[u] = False
+    out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
+           np.empty(n, np.int64), np.empty(n), wanted)
+    if chunks == 1:
+        _pairs_range(pairs, owner, extents, rel, 0, n, out)
+        return out
+    for c in prange(chunks):
+        _pairs_range(pairs, owner, extents, rel, n * c // chunks, n * (c + 1) // chunks, out)
+    return out

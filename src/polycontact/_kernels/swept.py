@@ -21,6 +21,7 @@ Batched search. :func:`impacts_chunk` runs, for a list of pairs, exactly what
 from __future__ import annotations
 
 import numpy as np
+from numba import prange
 
 from .jit import njit
 from .impact import exact_query, sampled_query, unpack_body, work_floats
@@ -106,21 +107,20 @@ def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
     return boxes, owner
 
 
-@njit(cache=True, nogil=True)
-def box_pairs(boxes, owner, n_bodies):
-    """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
-    time (closed intervals), once each, sorted; shape (K, 2).
+#: Boxes below which :func:`box_pairs` runs on the calling thread (no thread start: less
+#: than about 2 ms of work); above, it works in :data:`PARALLEL_CHUNKS` chunks that
+#: Numba's threads share.
+PARALLEL_BOXES = 8192
+PARALLEL_CHUNKS = 256
 
-    Sort and sweep on the axis (x or y) along which the boxes' centres spread most,
-    in strips across the other axis: each box goes to every strip its extent there
-    meets, so two boxes that overlap share a strip (the strip of any common point), and
-    a box is swept against those of its strips only (about the boxes of one row of a
-    crowd, not of a whole column). The strips are as high as a box on average, at most
-    one per box; boxes that reach infinity make one strip.
-    """
+
+@njit(cache=True, nogil=True)
+def _strips(boxes):
+    """The sweep axis ``ax`` (0: x, 2: y: the axis along which the boxes' centres spread
+    most), the other axis ``ox`` and its strips: ``(ax, ox, lo, width, strips)``, the
+    strips as high as a box on average, at most one per box; one strip when a box
+    reaches infinity."""
     nb = boxes.shape[0]
-    if nb == 0:
-        return np.empty((0, 2), np.int64)
     mx = 0.0
     my = 0.0
     for k in range(nb):
@@ -133,8 +133,8 @@ def box_pairs(boxes, owner, n_bodies):
     for k in range(nb):
         vx += (0.5 * (boxes[k, 0] + boxes[k, 1]) - mx) ** 2
         vy += (0.5 * (boxes[k, 2] + boxes[k, 3]) - my) ** 2
-    ax = 0 if vx >= vy else 2          # sweep axis: columns ax, ax + 1
-    ox = 2 - ax                        # the other axis, cut into strips
+    ax = 0 if vx >= vy else 2
+    ox = 2 - ax
     lo = np.inf
     hi = -np.inf
     tall = 0.0
@@ -148,6 +148,16 @@ def box_pairs(boxes, owner, n_bodies):
         width = max(tall / nb, (hi - lo) / nb)
         strips = min(nb, int((hi - lo) / width) + 1)
         width = (hi - lo) / strips
+    return ax, ox, lo, width, strips
+
+
+@njit(cache=True, nogil=True)
+def _strip_members(boxes, ox, lo, width, strips):
+    """Each box's first strip and the boxes of each strip: ``(first, start, members,
+    counts)``, strip q's boxes ``members[start[q]:start[q + 1]]`` (a box in every strip
+    its extent on axis ``ox`` meets; the strip of a coordinate grows with it), ``counts``
+    zeros for the pairs of each strip."""
+    nb = boxes.shape[0]
     first = np.empty(nb, np.int64)
     last = np.empty(nb, np.int64)
     start = np.zeros(strips + 1, np.int64)
@@ -169,41 +179,162 @@ def box_pairs(boxes, owner, n_bodies):
         for q in range(first[k], last[k] + 1):
             members[fill[q]] = k
             fill[q] += 1
-    cap = 4 * nb + 16
-    keys = np.empty(cap, np.int64)
-    nk = 0
-    for q in range(strips):
+    return first, start, members, np.zeros(strips + 1, np.int64)
+
+
+@njit(cache=True, nogil=True)
+def _sweep_strips(boxes, owner, ax, ox, first, start, members, q0, q1, at, pi, pj):
+    """Sweep strips ``q0`` to ``q1 - 1``: the overlapping boxes of different bodies,
+    each pair of boxes in the first strip they share only. With ``at`` empty: sort each
+    strip's members along ``ax`` (in place) and count strip q's pairs into
+    ``pi[q + 1]``; else write them (lower body first) to ``pi`` and ``pj`` from
+    ``at[q]``."""
+    count = at.shape[0] == 0
+    for q in range(q0, q1):
         group = members[start[q]:start[q + 1]]
-        order = group[np.argsort(boxes[group, ax], kind="mergesort")]
-        for p in range(order.shape[0]):
-            a = order[p]
+        if count:
+            group[:] = group[np.argsort(boxes[group, ax], kind="mergesort")]
+        k = 0 if count else at[q]
+        for p in range(group.shape[0]):
+            a = group[p]
             top = boxes[a, ax + 1]
             ia = owner[a]
-            for r in range(p + 1, order.shape[0]):
-                b = order[r]
+            for r in range(p + 1, group.shape[0]):
+                b = group[r]
                 if boxes[b, ax] > top:
                     break
                 ib = owner[b]
-                if ia == ib:
+                if ia == ib or max(first[a], first[b]) != q:
                     continue
                 if boxes[b, ox] > boxes[a, ox + 1] or boxes[a, ox] > boxes[b, ox + 1]:
                     continue
                 if boxes[b, 4] > boxes[a, 5] or boxes[a, 4] > boxes[b, 5]:
                     continue
-                if nk == cap:
-                    grown = np.empty(2 * cap, np.int64)
-                    grown[:cap] = keys
-                    keys = grown
-                    cap *= 2
-                i = min(ia, ib)
-                j = max(ia, ib)
-                keys[nk] = i * n_bodies + j
-                nk += 1
-    uniq = np.unique(keys[:nk])
-    out = np.empty((uniq.shape[0], 2), np.int64)
-    for k in range(uniq.shape[0]):
-        out[k, 0] = uniq[k] // n_bodies
-        out[k, 1] = uniq[k] % n_bodies
+                if not count:
+                    pi[k] = min(ia, ib)
+                    pj[k] = max(ia, ib)
+                k += 1
+        if count:
+            pi[q + 1] = k
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _sweep_in_chunks(strip_sets, strips, chunks, at, pi, pj):
+    """:func:`_sweep_strips` of every strip (``strip_sets``: its first seven arguments),
+    in ``chunks`` parallel chunks of strips (1: here, no thread start)."""
+    boxes, owner, ax, ox, first, start, members = strip_sets
+    if chunks == 1:
+        _sweep_strips(boxes, owner, ax, ox, first, start, members, 0, strips, at, pi, pj)
+        return
+    for c in prange(chunks):
+        _sweep_strips(boxes, owner, ax, ox, first, start, members, strips * c // chunks,
+                      strips * (c + 1) // chunks, at, pi, pj)
+
+
+@njit(cache=True, nogil=True)
+def _partners(pi, pj, n_bodies):
+    """The pairs ``(pi[k], pj[k])`` grouped by their first body: ``(start, bucket,
+    kept)``, body i's partners ``bucket[start[i]:start[i + 1]]`` in the order given,
+    ``kept`` zeros for their distinct counts."""
+    start = np.zeros(n_bodies + 1, np.int64)
+    for k in range(pi.shape[0]):
+        start[pi[k] + 1] += 1
+    for i in range(n_bodies):
+        start[i + 1] += start[i]
+    bucket = np.empty(pi.shape[0], np.int64)
+    fill = start[:n_bodies].copy()
+    for k in range(pi.shape[0]):
+        bucket[fill[pi[k]]] = pj[k]
+        fill[pi[k]] += 1
+    return start, bucket, np.zeros(n_bodies + 1, np.int64)
+
+
+@njit(cache=True, nogil=True)
+def _distinct_partners(bucket, start, i0, i1, kept):
+    """Sort each body i's partners ``bucket[start[i]:start[i + 1]]`` (i from ``i0`` to
+    ``i1 - 1``), keep each once at the front, their count in ``kept[i + 1]``."""
+    for i in range(i0, i1):
+        seg = bucket[start[i]:start[i + 1]]
+        m = 0
+        if seg.shape[0] > 32:
+            seg[:] = np.sort(seg)
+            for r in range(seg.shape[0]):
+                if m == 0 or seg[r] != seg[m - 1]:
+                    seg[m] = seg[r]
+                    m += 1
+        else:  # (a few partners, as most bodies have: each inserted unless kept)
+            for r in range(seg.shape[0]):
+                v = seg[r]
+                q = m
+                while q > 0 and seg[q - 1] > v:
+                    q -= 1
+                if q > 0 and seg[q - 1] == v:
+                    continue
+                for t in range(m, q, -1):
+                    seg[t] = seg[t - 1]
+                seg[q] = v
+                m += 1
+        kept[i + 1] = m
+
+
+@njit(cache=True, nogil=True)
+def _write_pairs(bucket, start, kept, i0, i1, out):
+    """Body i's distinct partners (i from ``i0`` to ``i1 - 1``) as rows ``(i, j)`` of
+    ``out`` from ``kept[i]``."""
+    for i in range(i0, i1):
+        for r in range(kept[i + 1] - kept[i]):
+            out[kept[i] + r, 0] = i
+            out[kept[i] + r, 1] = bucket[start[i] + r]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def box_pairs(boxes, owner, n_bodies):
+    """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
+    time (closed intervals), once each, sorted; shape (K, 2).
+
+    Sort and sweep on the axis (x or y) along which the boxes' centres spread most,
+    in strips across the other axis: each box goes to every strip its extent there
+    meets, so two boxes that overlap share a strip (the strip of any common point), and
+    a box is swept against those of its strips only (about the boxes of one row of a
+    crowd, not of a whole column); a pair of boxes is kept in the first strip they
+    share only. The strips are as high as a box on average, at most one per box; boxes
+    that reach infinity make one strip. The strips are swept, and each body's partners
+    sorted, in parallel chunks on Numba's threads (as many as ``numba.get_num_threads()``
+    allows; on the calling thread alone below :data:`PARALLEL_BOXES` boxes); every chunk
+    writes its own places, so the answer does not depend on the number of threads.
+    """
+    nb = boxes.shape[0]
+    if nb == 0:
+        return np.empty((0, 2), np.int64)
+    ax, ox, lo, width, strips = _strips(boxes)
+    first, start, members, at = _strip_members(boxes, ox, lo, width, strips)
+    chunks = 1 if nb < PARALLEL_BOXES else PARALLEL_CHUNKS
+    none = np.empty(0, np.int64)
+    strip_sets = (boxes, owner, ax, ox, first, start, members)
+    _sweep_in_chunks(strip_sets, strips, chunks, none, at, none)  # (counts)
+    for q in range(strips):
+        at[q + 1] += at[q]
+    pi = np.empty(at[strips], np.int64)
+    pj = np.empty(at[strips], np.int64)
+    _sweep_in_chunks(strip_sets, strips, chunks, at, pi, pj)
+    # each body's partners (a pair of bodies meets in several pairs of boxes when a
+    # body has several slices): grouped, then sorted and kept once in parallel
+    part, bucket, kept = _partners(pi, pj, n_bodies)
+    if chunks == 1:
+        _distinct_partners(bucket, part, 0, n_bodies, kept)
+    else:
+        for c in prange(chunks):
+            _distinct_partners(bucket, part, n_bodies * c // chunks,
+                               n_bodies * (c + 1) // chunks, kept)
+    for i in range(n_bodies):
+        kept[i + 1] += kept[i]
+    out = np.empty((kept[n_bodies], 2), np.int64)
+    if chunks == 1:
+        _write_pairs(bucket, part, kept, 0, n_bodies, out)
+    else:
+        for c in prange(chunks):
+            _write_pairs(bucket, part, kept, n_bodies * c // chunks,
+                         n_bodies * (c + 1) // chunks, out)
     return out
 
 
@@ -212,8 +343,8 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
     """Time of impact of the pairs ``todo`` (indices into the pair arrays), results
     written in place at those indices.
 
-    ``pairs`` is ``(sa, sb, ma, mb, eps_rel)``: pair p is shape ``sa[p]`` moving with
-    ``ma[p]`` against shape ``sb[p]`` moving with ``mb[p]``, the size term of its
+    ``pairs`` is ``(sa, sb, ma, mb, ka, kb, eps_rel)``: pair p is shape ``sa[p]`` moving
+    with ``ma[ka[p]]`` against shape ``sb[p]`` moving with ``mb[kb[p]]``, the size term of its
     distance tolerance ``eps_rel[p]`` (the kernels add ``ulps`` times the largest
     |coordinate| at each time they examine). ``shapes`` is ``(floats, f_off, ints,
     i_off)``: shape s is ``floats[f_off[s]:f_off[s + 1]]`` and
@@ -226,13 +357,14 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
     ``(code, t_hi, t_lo, contact, iters, reached, n_iv, iv)``, its broad-phase intervals
     to ``iv[p, :n_iv[p]]``.
     """
-    sa, sb, ma, mb, eps_rel = pairs
+    sa, sb, ma, mb, ka, kb, eps_rel = pairs
     floats, f_off, ints, i_off = shapes
     t_max, inflate, time_tol, ulps, contact_resolution, max_iter, exact, samples = settings
     code, t_hi, t_lo, contact, iters, reached, n_iv, iv = out
     widest = 0
     for s in range(i_off.shape[0] - 1):
-        widest = max(widest, ints[i_off[s]])
+        if i_off[s + 1] > i_off[s]:  # (a shape left out of the batch has no table)
+            widest = max(widest, ints[i_off[s]])
     work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
@@ -243,9 +375,9 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
         query = (t_max, inflate, time_tol, eps_rel[p], ulps, contact_resolution * (a[3] + b[3]),
                  max_iter, samples)
         if exact:
-            res = exact_query(a, ea, ma[p], b, eb, mb[p], query, work)
+            res = exact_query(a, ea, ma[ka[p]], b, eb, mb[kb[p]], query, work)
         else:
-            res = sampled_query(a, ma[p], b, mb[p], query, work)
+            res = sampled_query(a, ma[ka[p]], b, mb[kb[p]], query, work)
         n, c, hi, lo, ct, its, got = res
         code[p] = c
         t_hi[p] = hi
