@@ -23,6 +23,7 @@ from __future__ import annotations
 from typing import Any, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from ._pieces import pieces_packed
 from ._threads import map_work
@@ -140,7 +141,8 @@ def penetrations(batch: tuple[np.ndarray, ...], pairs: np.ndarray,
     # equal pairs (the same A, B and tolerance) have the same depth: one computation
     keys = _joined_rows(map_work(lambda p0, p1: pair_keys(batch, pairs[p0:p1], eps[p0:p1]),
                                  len(pairs), KEY_SECONDS))
-    one, group = distinct_pairs(batch, pairs, eps, keys)
+    one, group = cast("tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]",
+                      distinct_pairs(batch, pairs, eps, keys))
     todo, todo_eps = pairs[one], eps[one]
     out = _joined_rows(map_work(lambda p0, p1: contact_depths(batch, todo[p0:p1],
                                                               todo_eps[p0:p1]),

@@ -420,11 +420,9 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 _TABLE_SECONDS = 2e-6
 _PAIR_SECONDS = 2e-6
 
-#: Copying a shape's kernel pack (a 12-gon's), and setting up one body pair of
-#: ``first_impacts`` for the search, in pair classifications (see
+#: Copying a shape's kernel pack (a 12-gon's), in pair classifications (see
 #: :func:`polycontact._threads.chunks`).
 _UNPACK_WORK = 0.1
-_SETUP_WORK = 0.05
 
 
 def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],
@@ -923,10 +921,8 @@ def first_impacts(
     if len(pairs) == 0:
         return _no_events()
     # only the shapes of candidate pairs get tables and are searched
-    with numba_threads(threads):
-        i, j, oi, oj, eps_rel, wanted = pair_bodies(pairs, bodies.owner, bodies.extents,
-                                                    RELATIVE_TOLERANCE,
-                                                    chunks(len(pairs), _SETUP_WORK))
+    i, j, oi, oj, eps_rel, wanted = pair_bodies(pairs, bodies.owner, bodies.extents,
+                                                RELATIVE_TOLERANCE)
     raw = search_pairs(bodies.packed, oi, oj, bodies.motions, bodies.motions, eps_rel, t_max,
                        method, tol, samples, max_iterations, threads, wanted, (i, j))
     code, t_hi, _, contact, _, reached, *_ = raw

@@ -7,7 +7,7 @@ import numpy as np
 from polycontact._kernels.impact_batch import pair_bodies
 
 
-def test_pair_bodies_are_the_same_in_any_number_of_chunks():
+def test_pair_bodies_gathers_the_bodies_shapes_and_tolerances_of_each_pair():
     rng = np.random.default_rng(3)
     owner = rng.integers(0, 40, 200).astype(np.int64)       # 200 bodies of 40 shapes
     extents = rng.uniform(0.1, 10.0, 50)                    # (10 shapes in no body)
@@ -17,6 +17,5 @@ def test_pair_bodies_are_the_same_in_any_number_of_chunks():
     wanted[oi] = wanted[oj] = True
     want = [pairs[:, 0], pairs[:, 1], oi, oj, 1e-9 * np.maximum(extents[oi], extents[oj]),
             wanted]
-    for chunks in (1, 3, 16):
-        got = pair_bodies(pairs, owner, extents, 1e-9, chunks)
-        assert all(np.array_equal(g, w) for g, w in zip(got, want))
+    got = pair_bodies(pairs, owner, extents, 1e-9)
+    assert all(np.array_equal(g, w) for g, w in zip(got, want))

@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
 from .jit import njit
 from .advance import edge_table
@@ -126,10 +125,20 @@ def suspect_bodies(xy, rows, centroids, radii, motions, owner, t_max, limit, flo
 
 
 @njit(cache=True, nogil=True)
-def _pairs_range(pairs, owner, extents, rel, k0, k1, out):
-    """:func:`pair_bodies` for the pairs ``k0`` to ``k1 - 1``, into ``out``."""
-    i, j, oi, oj, eps_rel, wanted = out
-    for k in range(k0, k1):
+def pair_bodies(pairs, owner, extents, rel):
+    """What the search of the body pairs ``pairs`` (K, 2) needs, in one pass (a gather:
+    a few nanoseconds a pair): ``(i, j, oi, oj, eps_rel, wanted)``, the two bodies of
+    each pair, their shapes ``owner[i]`` and ``owner[j]``, the size term of the pair's
+    distance tolerance ``rel * max(extents[oi], extents[oj])``, and for each of the U =
+    ``extents.shape[0]`` shapes whether a pair has it."""
+    n = pairs.shape[0]
+    i = np.empty(n, np.int64)
+    j = np.empty(n, np.int64)
+    oi = np.empty(n, np.int64)
+    oj = np.empty(n, np.int64)
+    eps_rel = np.empty(n)
+    wanted = np.zeros(extents.shape[0], np.bool_)
+    for k in range(n):
         a = pairs[k, 0]
         b = pairs[k, 1]
         i[k] = a
@@ -139,27 +148,6 @@ def _pairs_range(pairs, owner, extents, rel, k0, k1, out):
         oi[k] = ua
         oj[k] = ub
         eps_rel[k] = rel * max(extents[ua], extents[ub])
-        wanted[ua] = True  # (chunks may write the same True: no order matters)
+        wanted[ua] = True
         wanted[ub] = True
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def pair_bodies(pairs, owner, extents, rel, chunks):
-    """What the search of the body pairs ``pairs`` (K, 2) needs, in ``chunks`` parallel
-    chunks (1: serial, no thread start): ``(i, j, oi, oj, eps_rel, wanted)``, the two
-    bodies of each pair, their shapes ``owner[i]`` and ``owner[j]``, the size term of
-    the pair's distance tolerance ``rel * max(extents[oi], extents[oj])``, and for each
-    of the U = ``extents.shape[0]`` shapes whether a pair has it."""
-    n = pairs.shape[0]
-    u_count = extents.shape[0]
-    wanted = np.empty(u_count, np.bool_)
-    for u in range(u_count):
-        wanted[u] = False
-    out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
-           np.empty(n, np.int64), np.empty(n), wanted)
-    if chunks == 1:
-        _pairs_range(pairs, owner, extents, rel, 0, n, out)
-        return out
-    for c in prange(chunks):
-        _pairs_range(pairs, owner, extents, rel, n * c // chunks, n * (c + 1) // chunks, out)
-    return out
+    return i, j, oi, oj, eps_rel, wanted
