@@ -220,8 +220,9 @@ def test_impact_tasks_send_shapes_of_several_tasks_once():
     sb = np.array([1, 2, 1, 3, 4])
     uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
     rows, eps = np.zeros((5, 6)), np.ones(5)
-    shared, tasks = impacts._impact_tasks(uniq, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
-    kernel = {s._kernel: k for k, s in enumerate(uniq)}  # each shape's kernel pack
+    packs = [s._kernel for s in uniq]  # each shape's kernel pack
+    shared, tasks = impacts._impact_tasks(packs, sa, sb, rows, rows, eps, [(0, 2), (2, 4), (4, 5)])
+    kernel = {p: k for k, p in enumerate(packs)}
     assert [kernel[p] for p in shared.kernels] == [0, 1]
     assert [[kernel[p] for p in t[2].kernels] for t in tasks] == [[2], [3], [4]]
     # a task numbers the shared shapes first, then its own
