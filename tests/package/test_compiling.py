@@ -126,6 +126,42 @@ def test_warmup_command_reports_every_family(tmp_path, processes):
     assert out.stdout.startswith("kernels ready in")
 
 
+def test_warmup_processes_take_the_longest_families_first(monkeypatch):
+    # every family has its compile cost, and the pool is given them longest first
+    assert set(compiling._COMPILE_SECONDS) == set(compiling.FAMILIES)
+    taken = []
+
+    class Pool:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def submit(self, fn, family):
+            import concurrent.futures
+
+            taken.append(family)
+            done = concurrent.futures.Future()
+            done.set_result(0.0)
+            return done
+
+    import concurrent.futures
+
+    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", Pool)
+    seen = []
+    compiling.warmup(list(compiling.FAMILIES), processes=2,
+                     progress=lambda family, k, n, s: seen.append((family, k)))
+    costs = [compiling._COMPILE_SECONDS[f] for f in taken]
+    assert sorted(taken) == sorted(compiling.FAMILIES) and costs == sorted(costs, reverse=True)
+    # each family keeps its number in the order given
+    assert sorted(set(seen), key=lambda fk: fk[1]) == [
+        (f, k) for k, f in enumerate(compiling.FAMILIES, 1)]
+
+
 def test_warmup_workers_number_their_functions_apart_from_other_processes():
     # two processes that compile into one cache must not give one name to different
     # functions (numba/numba#10486): a worker's numbers start at its process id * 2**20
