@@ -37,10 +37,11 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      MAX_ITERATIONS, MAX_SLICES, RELATIVE_TOLERANCE, SAMPLES,
                      SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
+from .relation import kernels_unpacked
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
-from ._threads import as_done, chunks, map_work, numba_threads, requested, useful
+from ._threads import as_done, map_work, numba_threads, requested, useful
 
 __all__ = ["ImpactBatch", "PairImpact", "PairImpacts", "time_of_impact_many", "first_impacts", "first_impact",
            "candidate_pairs", "event_time"]
@@ -345,12 +346,8 @@ def _for_batch(kernels: Sequence[bytes],
     radii)`` (as :func:`polycontact.relation.shapes_packed` packs them, each shape's
     stored centroid and bounding radius read from its kernel pack), and the shapes'
     extents; copied in compiled code on at most ``threads`` threads."""
-    from ._kernels.packs import unpack_shapes
-
-    count = len(kernels)
     with numba_threads(threads):
-        xy, rows, starts, st_off, sizes = unpack_shapes(
-            np.frombuffer(b"".join(kernels), np.float64), count, chunks(count, _UNPACK_WORK))
+        xy, rows, starts, st_off, sizes = kernels_unpacked(kernels, len(kernels))
     return ((xy, rows, starts, st_off, np.ascontiguousarray(sizes[:, :2]),
              np.ascontiguousarray(sizes[:, 2])), sizes[:, 3])
 
@@ -419,10 +416,6 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
 #: 12-gon's), for the threads the work can use (see :mod:`polycontact._threads`).
 _TABLE_SECONDS = 2e-6
 _PAIR_SECONDS = 2e-6
-
-#: Copying a shape's kernel pack (a 12-gon's), in pair classifications (see
-#: :func:`polycontact._threads.chunks`).
-_UNPACK_WORK = 0.1
 
 
 def _maker(shape_of: Callable[[int, int], Shape], motion_of: Callable[[int, int], Motion],

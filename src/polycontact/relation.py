@@ -24,7 +24,7 @@ import operator
 import threading
 import weakref
 from contextlib import closing
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Generic, TypeVar, cast, overload
@@ -882,13 +882,23 @@ def shapes_packed(shapes: Sequence[Any]) -> tuple[np.ndarray, ...]:
     >>> shapes_packed([sq])[4].round(6).tolist()
     [[0.5, 0.5, 0.707107, 1.0]]
     """
+    return kernels_unpacked(map(_KERNEL, shapes), len(shapes))
+
+
+def kernels_unpacked(kernels: Iterable[bytes], count: int) -> tuple[np.ndarray, ...]:
+    """:func:`shapes_packed` of the ``count`` shapes whose kernel packs
+    (``Shape._kernel``) are ``kernels``: the packs joined, then read in compiled code on
+    the threads the threading policy gives.
+
+    >>> sq = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
+    >>> kernels_unpacked([sq._kernel], 1)[1].tolist()
+    [0, 4]
+    """
     from ._kernels.packs import unpack_shapes
     from ._threads import chunks
 
-    count = len(shapes)
     out: tuple[np.ndarray, ...] = unpack_shapes(
-        np.frombuffer(b"".join(map(_KERNEL, shapes)), np.float64), count,
-        chunks(count, _UNPACK_WORK))
+        np.frombuffer(b"".join(kernels), np.float64), count, chunks(count, _UNPACK_WORK))
     return out
 
 
