@@ -82,7 +82,6 @@ PARALLEL = [
     ("polycontact._kernels.relation_many", "many_distances"),
     ("polycontact._kernels.impact_batch", "body_tables"),
     ("polycontact._kernels.impact_batch", "suspect_bodies"),
-    ("polycontact._kernels.swept", "box_pairs"),
     ("polycontact._threads", "map_chunks"),
     ("polycontact._threads", "as_done"),
 ]

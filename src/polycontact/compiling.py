@@ -56,7 +56,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "no-fit polygon": ("nfp.ring_entrance", "nfp.entrance_packed", "fits.touching_contacts",
                        "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
-    "many moving bodies": ("swept.swept_boxes", "swept.box_pairs", "swept.impacts_chunk",
+    "many moving bodies": ("swept.swept_boxes", "swept.sweep_strips", "swept.impacts_chunk",
                            "impact_batch.body_tables", "impact_batch.suspect_bodies",
                            "impact_batch.pair_bodies"),
     "no-fit polygon table": ("nfp_batch.nfp_pairs",),

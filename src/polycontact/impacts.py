@@ -784,18 +784,95 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.
 
 def _candidates(bodies: _Bodies, t_max: float, threads: int) -> np.ndarray:
     """:func:`candidate_pairs` of checked bodies, on at most ``threads`` threads."""
-    from ._kernels.swept import box_pairs, swept_boxes
+    return swept_pairs(np.ascontiguousarray(bodies.centroids[bodies.owner]), bodies.motions,
+                       bodies.radii[bodies.owner], t_max, threads)
 
-    n = len(bodies.owner)
+
+#: Seconds of sweep per member of a strip (a box swept against the boxes of one of its
+#: strips): the unit of work that :func:`box_pairs` shares among threads.
+STRIP_MEMBER_SECONDS = 100e-9
+
+#: Seconds per pair of boxes found, to sort and keep each body's partners once.
+PARTNER_SECONDS = 20e-9
+
+
+def swept_pairs(centroids: np.ndarray, motions: np.ndarray, radii: np.ndarray,
+                t_max: float, threads: int | None = None) -> np.ndarray:
+    """The pairs of bodies whose swept boxes meet over [0, ``t_max``] (the swept broad
+    phase of :func:`first_impacts` and ``World.sweep``): each body's centroid
+    (``centroids``, (N, 2)) follows its motion (``motions``, rows ``vx, vy, ax, ay,
+    omega, alpha``) and its bounding circle (``radii``, (N,)) goes with it, in boxes of
+    time slices (:func:`polycontact._kernels.swept.swept_boxes`); the pairs of
+    :func:`box_pairs`, on at most ``threads`` threads.
+
+    >>> swept_pairs(np.array([[0.0, 0], [3, 0], [0, 30]]),
+    ...             np.array([[1.0, 0, 0, 0, 0, 0], [0] * 6, [0] * 6]),
+    ...             np.array([0.8, 0.8, 0.8]), 5.0).tolist()
+    [[0, 1]]
+    """
+    from ._kernels.swept import swept_boxes
+
+    n = len(centroids)
     if n < 2:
         return np.empty((0, 2), np.int64)
-    cent = np.ascontiguousarray(bodies.centroids[bodies.owner])
-    boxes, owner = swept_boxes(cent, bodies.motions, bodies.radii[bodies.owner], t_max,
-                               MAX_SLICES, BROAD_PHASE_INFLATION,
-                               SWEPT_ROUNDING_ULPS * 2.0**-52)
-    with numba_threads(threads):
-        pairs: np.ndarray = box_pairs(boxes, owner, n)
-    return pairs
+    boxes, owner = swept_boxes(centroids, motions, radii, t_max, MAX_SLICES,
+                               BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
+    return box_pairs(boxes, owner, n, threads)
+
+
+def box_pairs(boxes: np.ndarray, owner: np.ndarray, n_bodies: int,
+              threads: int | None = None) -> np.ndarray:
+    """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
+    time (closed intervals), once each, sorted; shape (K, 2).
+
+    ``boxes``: rows ``(x0, x1, y0, y1, t0, t1)``, box k of body ``owner[k]`` (below
+    ``n_bodies``). Sort and sweep on the axis (x or y) along which the boxes' centres
+    spread most, in strips across the other axis: each box goes to every strip its
+    extent there meets, so two boxes that overlap share a strip (the strip of any
+    common point), and a box is swept against those of its strips only (about the boxes
+    of one row of a crowd, not of a whole column); a pair of boxes is kept in the first
+    strip they share only (:func:`polycontact._kernels.swept.box_strips`). The strips
+    are swept, and each body's partners sorted, in chunks on at most ``threads``
+    threads (:func:`polycontact._threads.map_work`; by default as many as
+    ``numba.get_num_threads()``) by kernels that release the GIL; every chunk writes its
+    own places, so the answer does not depend on the number of threads.
+
+    >>> boxes = np.array([[0, 1, 0, 1, 0, 1], [0.5, 2, 0.5, 2, 0, 1], [0, 4, 3, 4, 0, 1],
+    ...                   [0, 1, 0, 1, 2, 3.0]])
+    >>> box_pairs(boxes, np.array([0, 1, 2, 0]), 3).tolist()
+    [[0, 1]]
+    """
+    from ._kernels.swept import (box_strips, distinct_partners, partners_of, sweep_strips,
+                                 write_pairs)
+
+    if len(boxes) == 0:
+        return np.empty((0, 2), np.int64)
+    ax, ox, first, start, members = box_strips(boxes)
+    strips = len(start) - 1
+    per_strip = STRIP_MEMBER_SECONDS * len(members) / strips
+    none = np.empty(0, np.int64)
+
+    def sweep(at: np.ndarray, pi: np.ndarray, pj: np.ndarray) -> None:
+        map_work(lambda q0, q1: sweep_strips(boxes, owner, ax, ox, first, start, members,
+                                             q0, q1, at, pi, pj), strips, per_strip, threads)
+
+    at = np.zeros(strips + 1, np.int64)
+    sweep(none, at, none)  # sorts each strip, counts its pairs into at[q + 1]
+    np.cumsum(at, out=at)
+    pi = np.empty(at[-1], np.int64)
+    pj = np.empty(at[-1], np.int64)
+    sweep(at, pi, pj)
+    # each body's partners (a pair of bodies meets in several pairs of boxes when a
+    # body has several slices): grouped, then sorted and kept once
+    part, bucket, kept = partners_of(pi, pj, n_bodies)
+    per_body = PARTNER_SECONDS * len(pi) / n_bodies
+    map_work(lambda i0, i1: distinct_partners(bucket, part, i0, i1, kept), n_bodies,
+             per_body, threads)
+    np.cumsum(kept, out=kept)
+    out = np.empty((kept[-1], 2), np.int64)
+    map_work(lambda i0, i1: write_pairs(bucket, part, kept, i0, i1, out), n_bodies,
+             per_body, threads)
+    return out
 
 
 def event_time(impact: Impact) -> float:

@@ -42,10 +42,9 @@ from ._checks import finite_number, one_value, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .impacts import PairImpact, PairImpacts, first_impact, first_impacts
+from .impacts import PairImpact, PairImpacts, first_impact, first_impacts, swept_pairs
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
-                     MAX_SLICES, RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, SWEPT_ROUNDING_ULPS,
-                     TIME_TOLERANCE)
+                     RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, TIME_TOLERANCE)
 from .shape import Shape, ShapeLike, as_shape, frozen_ints
 from .tolerances import ROUNDING_FACTOR, check_range, default_tolerance
 from ._threads import chunks as _chunks
@@ -1609,7 +1608,6 @@ class World:
         [[1.0, 0.0]]
         """
         from ._kernels.world_sweep import sweep_search, turned_frames
-        from ._kernels.swept import box_pairs, swept_boxes
 
         step = finite_number(dt, "dt", minimum=0.0)
         ids = self.ids
@@ -1630,12 +1628,7 @@ class World:
             raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
         self._check_motions(ids, motion, step)
         pos = self._pos[ids]
-        if n >= 2:
-            boxes, owner = swept_boxes(pos, motion, self._rad[ids], step, MAX_SLICES,
-                                       BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
-            cand = box_pairs(boxes, owner, n)
-        else:
-            cand = np.empty((0, 2), np.int64)
+        cand = swept_pairs(pos, motion, self._rad[ids], step)
         bodies = ids[np.unique(cand)]
         self._sweep_frames(bodies)
         tint, tflt, tio, tfo = self._frames[:4]

@@ -21,7 +21,6 @@ Batched search. :func:`impacts_chunk` runs, for a list of pairs, exactly what
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
 from .jit import njit
 from .impact import exact_query, sampled_query, unpack_body, work_floats
@@ -107,15 +106,8 @@ def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
     return boxes, owner
 
 
-#: Boxes below which :func:`box_pairs` runs on the calling thread (no thread start: less
-#: than about 2 ms of work); above, it works in :data:`PARALLEL_CHUNKS` chunks that
-#: Numba's threads share.
-PARALLEL_BOXES = 8192
-PARALLEL_CHUNKS = 256
-
-
 @njit(cache=True, nogil=True)
-def _strips(boxes):
+def _strip_axis(boxes):
     """The sweep axis ``ax`` (0: x, 2: y: the axis along which the boxes' centres spread
     most), the other axis ``ox`` and its strips: ``(ax, ox, lo, width, strips)``, the
     strips as high as a box on average, at most one per box; one strip when a box
@@ -152,11 +144,15 @@ def _strips(boxes):
 
 
 @njit(cache=True, nogil=True)
-def _strip_members(boxes, ox, lo, width, strips):
-    """Each box's first strip and the boxes of each strip: ``(first, start, members,
-    counts)``, strip q's boxes ``members[start[q]:start[q + 1]]`` (a box in every strip
-    its extent on axis ``ox`` meets; the strip of a coordinate grows with it), ``counts``
-    zeros for the pairs of each strip."""
+def box_strips(boxes):
+    """The strips of a sort and sweep of ``boxes`` (rows ``x0, x1, y0, y1, t0, t1``):
+    ``(ax, ox, first, start, members)``, the sweep axis ``ax`` (0: x, 2: y: the axis
+    along which the boxes' centres spread most) and the other axis ``ox``, across which
+    the strips lie, as high as a box on average, at most one per box (one when a box
+    reaches infinity); each box's first strip, and strip q's boxes
+    ``members[start[q]:start[q + 1]]`` (a box in every strip its extent on axis ``ox``
+    meets; the strip of a coordinate grows with it)."""
+    ax, ox, lo, width, strips = _strip_axis(boxes)
     nb = boxes.shape[0]
     first = np.empty(nb, np.int64)
     last = np.empty(nb, np.int64)
@@ -179,11 +175,11 @@ def _strip_members(boxes, ox, lo, width, strips):
         for q in range(first[k], last[k] + 1):
             members[fill[q]] = k
             fill[q] += 1
-    return first, start, members, np.zeros(strips + 1, np.int64)
+    return ax, ox, first, start, members
 
 
 @njit(cache=True, nogil=True)
-def _sweep_strips(boxes, owner, ax, ox, first, start, members, q0, q1, at, pi, pj):
+def sweep_strips(boxes, owner, ax, ox, first, start, members, q0, q1, at, pi, pj):
     """Sweep strips ``q0`` to ``q1 - 1``: the overlapping boxes of different bodies,
     each pair of boxes in the first strip they share only. With ``at`` empty: sort each
     strip's members along ``ax`` (in place) and count strip q's pairs into
@@ -218,21 +214,8 @@ def _sweep_strips(boxes, owner, ax, ox, first, start, members, q0, q1, at, pi, p
             pi[q + 1] = k
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def _sweep_in_chunks(strip_sets, strips, chunks, at, pi, pj):
-    """:func:`_sweep_strips` of every strip (``strip_sets``: its first seven arguments),
-    in ``chunks`` parallel chunks of strips (1: here, no thread start)."""
-    boxes, owner, ax, ox, first, start, members = strip_sets
-    if chunks == 1:
-        _sweep_strips(boxes, owner, ax, ox, first, start, members, 0, strips, at, pi, pj)
-        return
-    for c in prange(chunks):
-        _sweep_strips(boxes, owner, ax, ox, first, start, members, strips * c // chunks,
-                      strips * (c + 1) // chunks, at, pi, pj)
-
-
 @njit(cache=True, nogil=True)
-def _partners(pi, pj, n_bodies):
+def partners_of(pi, pj, n_bodies):
     """The pairs ``(pi[k], pj[k])`` grouped by their first body: ``(start, bucket,
     kept)``, body i's partners ``bucket[start[i]:start[i + 1]]`` in the order given,
     ``kept`` zeros for their distinct counts."""
@@ -250,7 +233,7 @@ def _partners(pi, pj, n_bodies):
 
 
 @njit(cache=True, nogil=True)
-def _distinct_partners(bucket, start, i0, i1, kept):
+def distinct_partners(bucket, start, i0, i1, kept):
     """Sort each body i's partners ``bucket[start[i]:start[i + 1]]`` (i from ``i0`` to
     ``i1 - 1``), keep each once at the front, their count in ``kept[i + 1]``."""
     for i in range(i0, i1):
@@ -278,64 +261,13 @@ def _distinct_partners(bucket, start, i0, i1, kept):
 
 
 @njit(cache=True, nogil=True)
-def _write_pairs(bucket, start, kept, i0, i1, out):
+def write_pairs(bucket, start, kept, i0, i1, out):
     """Body i's distinct partners (i from ``i0`` to ``i1 - 1``) as rows ``(i, j)`` of
     ``out`` from ``kept[i]``."""
     for i in range(i0, i1):
         for r in range(kept[i + 1] - kept[i]):
             out[kept[i] + r, 0] = i
             out[kept[i] + r, 1] = bucket[start[i] + r]
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def box_pairs(boxes, owner, n_bodies):
-    """Every pair of bodies ``(i, j)``, i < j, two of whose boxes overlap in x, y and
-    time (closed intervals), once each, sorted; shape (K, 2).
-
-    Sort and sweep on the axis (x or y) along which the boxes' centres spread most,
-    in strips across the other axis: each box goes to every strip its extent there
-    meets, so two boxes that overlap share a strip (the strip of any common point), and
-    a box is swept against those of its strips only (about the boxes of one row of a
-    crowd, not of a whole column); a pair of boxes is kept in the first strip they
-    share only. The strips are as high as a box on average, at most one per box; boxes
-    that reach infinity make one strip. The strips are swept, and each body's partners
-    sorted, in parallel chunks on Numba's threads (as many as ``numba.get_num_threads()``
-    allows; on the calling thread alone below :data:`PARALLEL_BOXES` boxes); every chunk
-    writes its own places, so the answer does not depend on the number of threads.
-    """
-    nb = boxes.shape[0]
-    if nb == 0:
-        return np.empty((0, 2), np.int64)
-    ax, ox, lo, width, strips = _strips(boxes)
-    first, start, members, at = _strip_members(boxes, ox, lo, width, strips)
-    chunks = 1 if nb < PARALLEL_BOXES else PARALLEL_CHUNKS
-    none = np.empty(0, np.int64)
-    strip_sets = (boxes, owner, ax, ox, first, start, members)
-    _sweep_in_chunks(strip_sets, strips, chunks, none, at, none)  # (counts)
-    for q in range(strips):
-        at[q + 1] += at[q]
-    pi = np.empty(at[strips], np.int64)
-    pj = np.empty(at[strips], np.int64)
-    _sweep_in_chunks(strip_sets, strips, chunks, at, pi, pj)
-    # each body's partners (a pair of bodies meets in several pairs of boxes when a
-    # body has several slices): grouped, then sorted and kept once in parallel
-    part, bucket, kept = _partners(pi, pj, n_bodies)
-    if chunks == 1:
-        _distinct_partners(bucket, part, 0, n_bodies, kept)
-    else:
-        for c in prange(chunks):
-            _distinct_partners(bucket, part, n_bodies * c // chunks,
-                               n_bodies * (c + 1) // chunks, kept)
-    for i in range(n_bodies):
-        kept[i + 1] += kept[i]
-    out = np.empty((kept[n_bodies], 2), np.int64)
-    if chunks == 1:
-        _write_pairs(bucket, part, kept, 0, n_bodies, out)
-    else:
-        for c in prange(chunks):
-            _write_pairs(bucket, part, kept, n_bodies * c // chunks,
-                         n_bodies * (c + 1) // chunks, out)
-    return out
 
 
 @njit(cache=True, nogil=True)
