@@ -385,12 +385,12 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     xy, rows, starts, st_off, centroids, radii = packed
     if wanted is None:
         wanted = np.ones(len(radii), np.bool_)
-    f_off, i_off = table_sizes(rows, st_off, wanted)
+    f_off, i_off, widest = table_sizes(rows, st_off, wanted)
     floats, ints = np.empty(f_off[-1]), np.empty(i_off[-1], np.int64)
     map_work(lambda u0, u1: body_tables(xy, rows, starts, st_off, centroids, radii, f_off,
                                         i_off, u0, u1, floats, ints),
              len(radii), _TABLE_SECONDS, threads)
-    tables = (floats, f_off, ints, i_off)
+    tables = (floats, f_off, ints, i_off, widest)
     p_count = len(sa)
     out = empty_result(p_count)
     order = np.arange(p_count, dtype=np.int64)
@@ -405,11 +405,31 @@ def search_pairs(packed: tuple[np.ndarray, ...], sa: np.ndarray, sb: np.ndarray,
     # many small interleaved chunks: the cost of a pair varies a thousandfold (an
     # empty broad phase against a long slide), so the threads take chunks as they go
     n = useful(threads, p_count * _PAIR_SECONDS)
-    n_chunks = 1 if n == 1 else min(p_count // 16, 16 * n)
-    todo = [order] if n_chunks == 1 else [order[c::n_chunks].copy() for c in range(n_chunks)]
+    n_chunks = 1 if n == 1 else min(-(-p_count // _RESULT_BLOCK), 16 * n)
+    todo = [order] if n_chunks == 1 else _interleaved_blocks(p_count, n_chunks)
     for _ in as_done(run, todo, n):
         pass
     return out
+
+
+#: Pairs whose results lie side by side go to the same chunk in blocks of this many (a
+#: cache line holds 64 of the one-byte statuses): two threads writing to one cache line
+#: would pass it back and forth at every pair.
+_RESULT_BLOCK = 64
+
+
+def _interleaved_blocks(count: int, n_chunks: int) -> list[np.ndarray]:
+    """``range(count)`` in ``n_chunks`` chunks of whole blocks of
+    :data:`_RESULT_BLOCK` items, interleaved: chunk c holds blocks c, c + n_chunks,
+    c + 2 n_chunks, ... (so that every chunk samples the whole range).
+
+    >>> [c.tolist() for c in _interleaved_blocks(200, 2)]  # doctest: +ELLIPSIS
+    [[0, 1, ..., 63, 128, ..., 191], [64, ..., 127, 192, ..., 199]]
+    """
+    rounds = -(-count // (_RESULT_BLOCK * n_chunks))
+    grid = np.arange(rounds * n_chunks * _RESULT_BLOCK, dtype=np.int64).reshape(
+        rounds, n_chunks, _RESULT_BLOCK)
+    return [c[c < count] for c in grid.transpose(1, 0, 2).reshape(n_chunks, -1)]
 
 
 #: Seconds of one body's tables, and of one pair's search at the least (both about a

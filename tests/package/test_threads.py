@@ -260,6 +260,23 @@ def test_time_of_impact_many_on_two_threads_equals_one_thread(share_everything):
     assert one.impact(7).status is single.status
 
 
+@pytest.mark.parametrize("count, n_chunks", [(1, 2), (64, 2), (65, 3), (1000, 7),
+                                             (40_000, 256), (40_001, 32)])
+def test_pairs_shared_among_threads_in_whole_blocks_each_once(count, n_chunks):
+    """The time-of-impact chunks: every pair once, and a chunk owns whole blocks of
+    pairs (their results side by side), the last block cut at the end."""
+    from polycontact.impacts import _RESULT_BLOCK, _interleaved_blocks
+
+    chunks = _interleaved_blocks(count, n_chunks)
+    assert len(chunks) == n_chunks
+    assert sorted(np.concatenate(chunks).tolist()) == list(range(count))
+    owner = np.empty(count, np.int64)
+    for c, todo in enumerate(chunks):
+        owner[todo] = c
+    blocks = owner[: count // _RESULT_BLOCK * _RESULT_BLOCK].reshape(-1, _RESULT_BLOCK)
+    assert (blocks == blocks[:, :1]).all()
+
+
 def test_motions_as_rows_give_the_answers_of_motions(share_everything):
     rng = np.random.default_rng(8)
     ell = pc.Shape([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])

@@ -28,22 +28,25 @@ from .impact import pack_body
 
 @njit(cache=True, nogil=True)
 def table_sizes(rows, st_off, wanted):
-    """Offsets of each body's floats and ints in :func:`body_tables`' arrays: a body of
-    n vertices and k loop starts takes ``11 n - 1`` floats and ``7 n + k`` ints (those
-    of ``pack_body`` with its tree of ``2 n - 1`` nodes); a body not ``wanted`` (bool,
+    """Offsets of each body's floats and ints in :func:`body_tables`' arrays, and the
+    most vertices of a body with a table: ``(f_off, i_off, widest)``. A body of n
+    vertices and k loop starts takes ``11 n - 1`` floats and ``7 n + k`` ints (those of
+    ``pack_body`` with its tree of ``2 n - 1`` nodes); a body not ``wanted`` (bool,
     (U,)) takes none, and gets no table."""
     u_count = rows.shape[0] - 1
     f_off = np.zeros(u_count + 1, np.int64)
     i_off = np.zeros(u_count + 1, np.int64)
+    widest = 0
     for u in range(u_count):
         if not wanted[u]:
             f_off[u + 1] = f_off[u]
             i_off[u + 1] = i_off[u]
             continue
         n = rows[u + 1] - rows[u]
+        widest = max(widest, n)
         f_off[u + 1] = f_off[u] + 11 * n - 1
         i_off[u + 1] = i_off[u] + 7 * n + st_off[u + 1] - st_off[u]
-    return f_off, i_off
+    return f_off, i_off, widest
 
 
 @njit(cache=True, nogil=True)

@@ -279,9 +279,10 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
     with ``ma[ka[p]]`` against shape ``sb[p]`` moving with ``mb[kb[p]]``, the size term of its
     distance tolerance ``eps_rel[p]`` (the kernels add ``ulps`` times the largest
     |coordinate| at each time they examine). ``shapes`` is ``(floats, f_off, ints,
-    i_off)``: shape s is ``floats[f_off[s]:f_off[s + 1]]`` and
+    i_off, widest)``: shape s is ``floats[f_off[s]:f_off[s + 1]]`` and
     ``ints[i_off[s]:i_off[s + 1]]``, its :func:`polycontact._kernels.impact.pack_body`
-    (vertices about its centroid, loop starts, centroid, bounding radius, circle tree).
+    (vertices about its centroid, loop starts, centroid, bounding radius, circle tree),
+    and no shape has more than ``widest`` vertices (the work buffers' size).
     ``settings`` is ``(t_max, inflate, time_tol, ulps, contact_resolution, max_iter,
     exact, samples)``. Each pair runs ``exact_query`` (``exact``) or ``sampled_query``
     with the same arguments as ``polycontact.time_of_impact`` (contact resolution
@@ -290,13 +291,9 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
     to ``iv[p, :n_iv[p]]``.
     """
     sa, sb, ma, mb, ka, kb, eps_rel = pairs
-    floats, f_off, ints, i_off = shapes
+    floats, f_off, ints, i_off, widest = shapes
     t_max, inflate, time_tol, ulps, contact_resolution, max_iter, exact, samples = settings
     code, t_hi, t_lo, contact, iters, reached, n_iv, iv = out
-    widest = 0
-    for s in range(i_off.shape[0] - 1):
-        if i_off[s + 1] > i_off[s]:  # (a shape left out of the batch has no table)
-            widest = max(widest, ints[i_off[s]])
     work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
