@@ -684,15 +684,17 @@ def _impact_tasks(uniq: list[bytes], sa: np.ndarray, sb: np.ndarray, rows_a: np.
                   spans: list[tuple[int, int]]) -> tuple[_ShapePack, list[tuple[Any, ...]]]:
     """The shapes (``uniq``: their kernel packs) several tasks use (sent once to every
     worker) and the tasks: each its slice of pairs, with its own shapes, the pairs'
-    shape indices numbering the shared shapes first, then the task's own."""
-    task = np.empty(len(sa), np.int64)
+    shape indices numbering the shared shapes first, then the task's own. Pairs outside
+    the ``spans`` play no part."""
+    task = np.full(len(sa), -1, np.int64)
     for k, (p0, p1) in enumerate(spans):
         task[p0:p1] = k
+    given = task >= 0
     first = np.full(len(uniq), len(spans), np.int64)
     last = np.full(len(uniq), -1, np.int64)
-    for s in (sa, sb):
-        np.minimum.at(first, s, task)
-        np.maximum.at(last, s, task)
+    for s in (sa[given], sb[given]):
+        np.minimum.at(first, s, task[given])
+        np.maximum.at(last, s, task[given])
     shared_ids = np.flatnonzero(first < last)
     number = np.full(len(uniq), -1, np.int64)
     number[shared_ids] = np.arange(len(shared_ids))

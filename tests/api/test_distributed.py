@@ -231,6 +231,21 @@ def test_impact_tasks_send_shapes_of_several_tasks_once():
     assert [t[0].tolist() for t in tasks] == [[0, 0], [0, 0], [0]]
 
 
+def test_impact_tasks_of_part_of_the_pairs_share_only_the_shapes_of_those_pairs():
+    # the pairs 0..1 are in no task (as before the spans of the tasks after a first
+    # probing task): shape 0, which pair 0 shares with the last task, is that task's own
+    sa = np.array([0, 1, 2, 2, 0])
+    sb = np.array([1, 3, 3, 4, 4])
+    uniq = [pc.Shape(np.array(SQUARE, float) + [3 * k, 0]) for k in range(5)]
+    rows, eps = np.zeros((5, 6)), np.ones(5)
+    packs = [s._kernel for s in uniq]
+    shared, tasks = impacts._impact_tasks(packs, sa, sb, rows, rows, eps, [(2, 3), (3, 4),
+                                                                         (4, 5)])
+    kernel = {p: k for k, p in enumerate(packs)}
+    assert [kernel[p] for p in shared.kernels] == [2, 4]
+    assert [[kernel[p] for p in t[2].kernels] for t in tasks] == [[3], [], [0]]
+
+
 def test_map_batches_keeps_the_order(client):
     out = pd.map_batches(_sum_pairs, np.arange(10), np.arange(10, 20), client=client,
                          chunk_size=3, scale=2)
