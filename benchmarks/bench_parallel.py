@@ -13,8 +13,12 @@ Paths (size, then the ``--quick`` size):
   against a copy moved by up to 0.8 (most pairs overlap);
 - ``distances``: the signed distances of 10⁵ of those pairs (10⁴), given as Shapes;
 - ``time_of_impact_many``: 4·10⁴ pairs (4·10³), bench_distributed's pairs (a square, an
-  L and a U against each other and a square frame, random motions over [0, 3]); and
+  L and a U against each other and a square frame, random motions over [0, 3]);
   ``time_of_impact_many_rows``, the same with the motions given as the rows of arrays;
+  and ``time_of_impact_many_arrays``, 4·10⁴ pairs (4·10³) in the packed form, no
+  Python object per pair: 12-gons as (P, N, 2) arrays, each against a copy moved by up
+  to 1.5, motions as rows (random velocities, spins and some accelerations, over [0,
+  3]);
 - ``first_impacts``: 2·10⁴ moving 12-gons (2·10³) on a jittered grid, random velocities
   and spins, over [0, 0.5];
 - ``nfp_table``: the shipped jakobs1 (25 pieces) at 12 orientations, 90 000 entries
@@ -82,6 +86,8 @@ PARALLEL = [
     ("polycontact._kernels.relation_many", "many_distances"),
     ("polycontact._kernels.impact_batch", "body_tables"),
     ("polycontact._kernels.impact_batch", "suspect_bodies"),
+    ("polycontact._kernels.impact_batch", "ring_bodies"),
+    ("polycontact._kernels.impact_batch", "pack_rings"),
     ("polycontact._threads", "map_chunks"),
     ("polycontact._threads", "as_done"),
 ]
@@ -262,6 +268,27 @@ class Impacts(Path):
             ma, mb = (np.array([m.array for m in ms]) for ms in (ma, mb))
         self.pairs = (a, ma, b, mb)
         self.name = "time_of_impact_many" + (" (motions as rows)" if rows else "")
+        self.size = f"{count} pairs"
+
+    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+        b = pc.time_of_impact_many(*self.pairs, t_max=3, threads=threads)
+        return b.statuses, b.times, b.first_contacts
+
+
+class ImpactArrays(Path):
+    """``time_of_impact_many`` in the packed form: ring arrays, motions as rows."""
+
+    name = "time_of_impact_many_arrays"
+
+    def __init__(self, count: int) -> None:
+        rng = np.random.default_rng(5)
+        a = stars(rng, count)
+        b = a + rng.uniform(-1.5, 1.5, (count, 1, 2))
+        ma = np.c_[rng.uniform(-2, 2, (count, 2)),
+                   rng.uniform(-1, 1, (count, 2)) * (np.arange(count) % 4 == 0)[:, None],
+                   rng.uniform(-1, 1, count), np.zeros(count)]
+        mb = np.c_[rng.uniform(-1, 1, (count, 2)), np.zeros((count, 4))]
+        self.pairs = (a, ma, b, mb)
         self.size = f"{count} pairs"
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
@@ -480,7 +507,8 @@ def main() -> None:
                          "--quick)")
     ap.add_argument("--repeat", type=int, default=None, help="calls per figure (5; 3 quick)")
     ap.add_argument("--paths", default=None, help="comma-separated paths (default all): "
-                    "contacts,time_of_impact_many,time_of_impact_many_rows,nfp_table,"
+                    "contacts,time_of_impact_many,time_of_impact_many_rows,"
+                    "time_of_impact_many_arrays,nfp_table,"
                     "nfp_table_workers,classify_many,set_poses,first_impacts,distances,"
                     "geometry,dask")
     ap.add_argument("--json", metavar="OUT", help="write the figures to this file")
@@ -499,8 +527,9 @@ def main() -> None:
     repeat = args.repeat or (3 if args.quick else 5)
     q = int(args.quick)
     chosen = (args.paths.split(",") if args.paths else
-              ["contacts", "time_of_impact_many", "time_of_impact_many_rows", "nfp_table",
-               "nfp_table_workers", "classify_many", "set_poses", "first_impacts",
+              ["contacts", "time_of_impact_many", "time_of_impact_many_rows",
+               "time_of_impact_many_arrays", "nfp_table", "nfp_table_workers",
+               "classify_many", "set_poses", "first_impacts",
                "distances", "geometry", "dask"])
     head = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "command": " ".join(["python", *sys.argv]), "machine": machine(),
@@ -527,6 +556,8 @@ def main() -> None:
             path = ClassifyMany(SIZES[name][q], name == "distances")
         elif name in ("time_of_impact_many", "time_of_impact_many_rows"):
             path = Impacts(SIZES["time_of_impact_many"][q], name.endswith("rows"))
+        elif name == "time_of_impact_many_arrays":
+            path = ImpactArrays(SIZES["time_of_impact_many"][q])
         elif name == "first_impacts":
             path = FirstImpacts(SIZES[name][q])
         elif name == "nfp_table":

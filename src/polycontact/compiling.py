@@ -58,7 +58,8 @@ FAMILIES: dict[str, tuple[str, ...]] = {
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.swept_boxes", "swept.sweep_strips", "swept.impacts_chunk",
                            "impact_batch.body_tables", "impact_batch.suspect_bodies",
-                           "impact_batch.pair_bodies"),
+                           "impact_batch.pair_bodies", "impact_batch.ring_bodies",
+                           "impact_batch.pack_rings"),
     "no-fit polygon table": ("nfp_batch.nfp_pairs",),
 }
 
@@ -143,12 +144,14 @@ def _run(family: str) -> None:
 
         entrance_block(Shape(sq), Shape(sq + 0.5)).to_shapely()
     elif family == "many moving bodies":
-        from .impacts import first_impacts
+        from .impacts import first_impacts, time_of_impact_many
         from .motion import Motion
 
         for method in ("exact", "sampled"):
             first_impacts([Shape(sq), Shape(sq + (3.0, 0.0))], [Motion(velocity=(1.0, 0.0)),
                           Motion()], t_max=5.0, method=method, threads=1)
+        time_of_impact_many(sq[None], np.array([[1.0, 0, 0, 0, 0, 0]]), sq[None] + 3.0,
+                            np.zeros((1, 6)), t_max=5.0, threads=1)  # the packed form
     else:
         raise ValueError(f"family: expected one of {', '.join(FAMILIES)}, got {family!r}")
 

@@ -484,15 +484,33 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     code on at most ``threads`` threads; the bodies it marks are checked again here,
     exactly, and the first that fails is refused, named by ``name_of(k) = (shape's,
     motion's)``."""
-    from ._kernels.impact_batch import suspect_bodies
-
     count = len(shapes)
     ids = np.fromiter(map(id, shapes), np.int64, count)
     _, first, owner = np.unique(ids, return_index=True, return_inverse=True)
     uniq = list(map(_KERNEL, map(shapes.__getitem__, first.tolist())))
     owner = owner.reshape(-1).astype(np.int64)
     packed, extents = _for_batch(uniq, threads)
+    centroids, radii = packed[4:]
+    _refuse_suspects(packed, owner, rows, shapes.__getitem__, motion_of, name_of, t_max,
+                     threads)
+    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
+
+
+def _refuse_suspects(packed: tuple[np.ndarray, ...], owner: np.ndarray, rows: np.ndarray,
+                     shape_of: Callable[[int], Shape], motion_of: Callable[[int], Motion],
+                     name_of: Callable[[int], tuple[str, str]], t_max: float,
+                     threads: int) -> None:
+    """Refuse the first body k (shape ``owner[k]`` of the ``packed`` shapes, moving with
+    the kernel vector ``rows[k]``) whose coordinates, or whose motion within [0,
+    ``t_max``], lie beyond the range the kernels take: the compiled check
+    (:func:`polycontact._kernels.impact_batch.suspect_bodies`, on at most ``threads``
+    threads) marks the bodies that may, which are checked again exactly here, as
+    ``time_of_impact`` checks them (``shape_of(k)``, ``motion_of(k)``; the error names
+    ``name_of(k) = (shape's, motion's)``)."""
+    from ._kernels.impact_batch import suspect_bodies
+
     xy, vrows, _, _, centroids, radii = packed
+    count = len(owner)
     suspect = np.zeros(count, np.bool_)
     map_work(lambda k0, k1: suspect_bodies(xy, vrows, centroids, radii, rows, owner, t_max,
                                            COORDINATE_LIMIT, EXTENT_FLOOR, k0, k1, suspect),
@@ -500,21 +518,20 @@ def _bodies(shapes: list[Shape], rows: np.ndarray, motion_of: Callable[[int], Mo
     if suspect.any():
         marked = np.flatnonzero(suspect).tolist()
         for k in marked:
-            check_range(shapes[k].packed[0], name_of(k)[0])
+            check_range(shape_of(k).packed[0], name_of(k)[0])
         for k in marked:
-            sh, m = shapes[k], motion_of(k)
+            sh, m = shape_of(k), motion_of(k)
             if reach_excess(base_reach(sh), sh.bounding_radius, m._norms, t_max) is not None:
                 check_reach(sh, m, t_max, name_of(k)[1])  # raises, naming the motion
-    return _Bodies(uniq, packed, owner, rows, centroids, radii, extents)
 
 
 _BYTES = operator.attrgetter("_bytes")
 
 
 def time_of_impact_many(
-    shapes_a: Sequence[ShapeLike],
+    shapes_a: Sequence[ShapeLike] | np.ndarray,
     motions_a: Sequence[Motion] | np.ndarray,
-    shapes_b: Sequence[ShapeLike],
+    shapes_b: Sequence[ShapeLike] | np.ndarray,
     motions_b: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
@@ -543,8 +560,15 @@ def time_of_impact_many(
 
     Parameters
     ----------
-    shapes_a, shapes_b : sequence of Shape, shapely Polygon or array_like of shape (N, 2)
-        The bodies at t = 0, P of each.
+    shapes_a, shapes_b : sequence of bodies, or ndarray of shape (P, N, 2)
+        The bodies at t = 0, P of each: Shapes, shapely Polygons or (N, 2) arrays; or,
+        both sides alike, the packed form: P outer
+        rings of N vertices each (closed or not, either orientation; ``shapes_b`` may
+        have another N), checked, packed and given their centroids in compiled code on
+        the threads, with no Python object per pair (the quick form for many pairs,
+        with motions as rows). A ring that is not certified valid as given (see
+        :func:`polycontact.classify_many`) is decided by :class:`~polycontact.Shape`,
+        as in the other forms; ``impact(k)`` makes pair k's two Shapes.
     motions_a, motions_b : sequence of Motion, or ndarray of shape (P, 6)
         Their motions, one per shape: Motions, or their kernel vectors ``[vx, vy, ax,
         ay, ω, α]`` (:attr:`polycontact.Motion.array`) as the rows of an array, read as
@@ -593,24 +617,125 @@ def time_of_impact_many(
     from ._cluster import check_chunk_size, current_client
 
     check_chunk_size(chunk_size)
-    a = check_shapes(shapes_a, "shapes_a")
-    b = check_shapes(shapes_b, "shapes_b")
-    if len(a) != len(b):
-        raise ValueError(f"shapes_a and shapes_b differ in length ({len(a)} and {len(b)})")
-    ma = check_motions(motions_a, "motions_a", len(a), "shapes_a")
-    mb = check_motions(motions_b, "motions_b", len(b), "shapes_b")
+    remote = current_client(client)
+    rings = _ring_arrays(shapes_a, shapes_b) if remote is None else None
+    if rings is None:
+        a = check_shapes(shapes_a, "shapes_a")
+        b = check_shapes(shapes_b, "shapes_b")
+        counts = (len(a), len(b))
+    else:
+        counts = (len(rings[0]), len(rings[1]))
+    if counts[0] != counts[1]:
+        raise ValueError(f"shapes_a and shapes_b differ in length ({counts[0]} and "
+                         f"{counts[1]})")
+    ma = check_motions(motions_a, "motions_a", counts[0], "shapes_a")
+    mb = check_motions(motions_b, "motions_b", counts[1], "shapes_b")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
-    remote = current_client(client)
+    options = (t_max, method, tol, samples, max_iterations)
+    if rings is not None:
+        ringed = prepare_rings(*rings, ma, mb, t_max, threads)
+        if ringed is not None:
+            copies, packed, sa, sb, rows_a, rows_b, eps_rel = ringed
+            raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, *options, threads)
+            return impact_batch(lambda p, s: Shape(copies[s][p]), ma, mb, raw, eps_rel,
+                                *options[:3])
+        a = check_shapes(rings[0], "shapes_a")  # (refused here, naming the ring)
+        b = check_shapes(rings[1], "shapes_b")
     prepared = prepare_pairs(a, b, ma, mb, t_max, threads)
     if remote is None:
         _, packed, sa, sb, rows_a, rows_b, eps_rel = prepared
-        raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, t_max, method, tol,
-                           samples, max_iterations, threads)
+        raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, *options, threads)
     else:
-        raw = _remote_search(remote, prepared, (t_max, method, tol, samples, max_iterations),
-                            chunk_size)
-    return impact_batch(a, b, ma, mb, raw, prepared[6], t_max, method, tol)
+        raw = _remote_search(remote, prepared, options, chunk_size)
+    pairs = (a, b)
+    return impact_batch(lambda p, s: pairs[s][p], ma, mb, raw, prepared[6], *options[:3])
+
+
+def _ring_arrays(shapes_a: Any, shapes_b: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(shapes_a, shapes_b)`` when both are arrays of outer rings, (P, N, 2) and (P',
+    M, 2) of real numbers (the packed form of :func:`time_of_impact_many`), else None."""
+    from .relation import raw_ring_array
+
+    arr_a, arr_b = raw_ring_array(shapes_a), raw_ring_array(shapes_b)
+    return None if arr_a is None or arr_b is None else (arr_a, arr_b)
+
+
+def prepare_rings(arr_a: np.ndarray, arr_b: np.ndarray, ma: Motions, mb: Motions,
+                  t_max: float, threads: int) -> tuple[Any, ...] | None:
+    """:func:`prepare_pairs` of the pairs of outer rings ``arr_a[p]`` and ``arr_b[p]``
+    ((P, N, 2) and (P, M, 2) arrays) without a Shape: the rings copied (float64),
+    checked, oriented counter-clockwise and packed, with their centroids, radii and
+    extents, in compiled code on at most ``threads`` threads; ``(copies, packed, sa,
+    sb, rows_a, rows_b, eps_rel)``, ``copies`` the two copied ring arrays, which a
+    :class:`~polycontact.Shape` is made of when the caller asks (for ``impact(k)``, or
+    to refuse a body exactly). None when a ring is not certified valid as given
+    (:func:`polycontact._kernels.impact_batch.ring_bodies`): the caller then makes
+    Shapes, which decide, and name the ring they refuse."""
+    from ._kernels.impact_batch import pack_rings, ring_bodies
+    from .relation import RING_ARGS
+
+    p_count = len(arr_a)
+    total = 2 * p_count
+    copies = (np.empty(arr_a.shape), np.empty(arr_b.shape))
+    used = np.empty(total, np.int64)
+    sign = np.empty(total, np.int8)
+    centroids = np.empty((total, 2))
+    radii = np.empty(total)
+    extents = np.empty(total)
+
+    def sides(k0: int, k1: int) -> Iterator[tuple[int, int, int]]:
+        """The rings k0 to k1 - 1 of both sides: ``(side, p0, p1)``."""
+        for side, base in ((0, 0), (1, p_count)):
+            p0, p1 = max(k0 - base, 0), min(k1 - base, p_count)
+            if p0 < p1:
+                yield side, p0, p1
+
+    def check(k0: int, k1: int) -> None:
+        for side, p0, p1 in sides(k0, k1):
+            base = side * p_count
+            copies[side][p0:p1] = (arr_a, arr_b)[side][p0:p1]
+            ring_bodies(copies[side], *RING_ARGS, p0, p1, used[base:], sign[base:],
+                        centroids[base:], radii[base:], extents[base:])
+
+    map_work(check, total, _RING_SECONDS, threads)
+    if (used < 0).any():
+        return None
+    rows = np.zeros(total + 1, np.int64)
+    np.cumsum(used, out=rows[1:])
+    xy = np.empty((int(rows[-1]), 2))
+
+    def pack(k0: int, k1: int) -> None:
+        for side, p0, p1 in sides(k0, k1):
+            base = side * p_count
+            pack_rings(copies[side], used[base:], sign[base:], rows[base:], p0, p1, xy)
+
+    map_work(pack, total, _RING_SECONDS / 4, threads)
+    starts = np.zeros(2 * total, np.int64)
+    starts[1::2] = used
+    packed = (xy, rows, starts, np.arange(0, 2 * total + 1, 2, dtype=np.int64), centroids,
+              radii)
+    motions = _rows(ma, mb)
+    _refuse_suspects(packed, np.arange(total, dtype=np.int64), motions,
+                     lambda k: Shape(copies[k // p_count][k % p_count]),
+                     lambda k: ma[k] if k < p_count else mb[k - p_count],
+                     lambda k: _pair_names(k, p_count), t_max, threads)
+    order = np.arange(p_count, dtype=np.int64)
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(extents[:p_count], extents[p_count:])
+    return (copies, packed, order, order + p_count, motions[:p_count], motions[p_count:],
+            eps_rel)
+
+
+#: Seconds of checking one raw ring (a 12-gon's) and making it a body, for the threads
+#: the work can use (see :mod:`polycontact._threads`).
+_RING_SECONDS = 1e-6
+
+
+def _pair_names(k: int, p_count: int) -> tuple[str, str]:
+    """The names of body k of :func:`time_of_impact_many`'s ``2 P`` bodies (the P of
+    side a, then the P of side b): ``(shape's, motion's)``."""
+    side, q = ("a", k) if k < p_count else ("b", k - p_count)
+    return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
 
 
 def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
@@ -622,31 +747,24 @@ def prepare_pairs(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
     tolerance (``RELATIVE_TOLERANCE`` times the larger of the two shapes' extents).
     (:func:`_remote_search` runs :func:`search_pairs` on slices of them in tasks.)"""
     p_count = len(a)
-
-    def name_of(k: int) -> tuple[str, str]:
-        side, q = ("a", k) if k < p_count else ("b", k - p_count)
-        return f"shapes_{side}[{q}]", f"motions_{side}[{q}]"
-
     bodies = _bodies(a + b, _rows(ma, mb),
-                     lambda k: ma[k] if k < p_count else mb[k - p_count], name_of, t_max,
-                     threads)
+                     lambda k: ma[k] if k < p_count else mb[k - p_count],
+                     lambda k: _pair_names(k, p_count), t_max, threads)
     ia, ib = bodies.owner[:p_count], bodies.owner[p_count:]
     eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[ia], bodies.extents[ib])
     return (bodies.kernels, bodies.packed, ia, ib, bodies.motions[:p_count],
             bodies.motions[p_count:], eps_rel)
 
 
-def impact_batch(a: list[Shape], b: list[Shape], ma: Motions, mb: Motions,
+def impact_batch(shape_of: Callable[[int, int], Shape], ma: Motions, mb: Motions,
                  raw: tuple[Any, ...], eps_rel: np.ndarray, t_max: float, method: str,
                  tol: float) -> ImpactBatch:
-    """The :class:`ImpactBatch` of the pairs ``(a[p], ma[p])`` vs ``(b[p], mb[p])`` from
-    the raw result arrays of :func:`search_pairs`."""
+    """The :class:`ImpactBatch` of the pairs ``(shape_of(p, 0), ma[p])`` vs
+    ``(shape_of(p, 1), mb[p])`` from the raw result arrays of :func:`search_pairs`."""
     code, t_hi, _, contact, *_ = raw
     collides = code == 1
-    pairs = (a, b)
     moves = (ma, mb)
-    make = _maker(lambda p, s: pairs[s][p], lambda p, s: moves[s][p], raw, t_max, method,
-                  eps_rel, tol)
+    make = _maker(shape_of, lambda p, s: moves[s][p], raw, t_max, method, eps_rel, tol)
     return ImpactBatch(
         statuses=code,
         collides=collides,

@@ -480,7 +480,7 @@ def _kr() -> Any:
 _RAW: list[Any] = []  # [classify_raw], bound on first use
 
 #: The default-tolerance rule and the range of coordinates, as the ring kernels take them.
-_RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
+RING_ARGS = (RELATIVE_TOLERANCE, ROUNDING_ULPS, COORDINATE_LIMIT, EXTENT_FLOOR)
 
 
 _new = object.__new__
@@ -596,7 +596,7 @@ def _classify_other(a: ShapeLike, b: ShapeLike, tolerance: float | None) -> Rela
             from ._kernels.rings import classify_raw
 
             _RAW.append(classify_raw)
-        code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, *_RING_ARGS)
+        code, eps, na, fa, nb, fb = _RAW[0](a, b, tol, *RING_ARGS)
         if code >= 0:
             # The lean path: the bytes are the copy the lazy parts are computed from.
             obj = _new(Relation)
@@ -692,7 +692,7 @@ def _split(count: int, fn: Any, threads: int) -> list[Any]:
     return map_work(fn, count, PAIR_SECONDS, threads)
 
 
-def _raw_array(arr: Any) -> np.ndarray | None:
+def raw_ring_array(arr: Any) -> np.ndarray | None:
     """``arr`` if it is a (P, N, 2) array of real rings, else None."""
     if not (isinstance(arr, np.ndarray) and arr.ndim == 3 and arr.shape[2] == 2):
         return None
@@ -721,7 +721,7 @@ def _pack_ring_array(arr: np.ndarray, what: str) -> tuple[Any, ...]:
     copy = np.array(arr, dtype=np.float64, order="C")
     p_count, n = copy.shape[0], copy.shape[1]
     used, sign = km.check_rings(copy.reshape(-1, 2), np.arange(p_count, dtype=np.int64) * n,
-                                np.full(p_count, n, dtype=np.int64), *_RING_ARGS)
+                                np.full(p_count, n, dtype=np.int64), *RING_ARGS)
     if (used < 0).any():
         return pack_bodies(list(copy), what)
     return _ring_pack(copy, used, sign)
@@ -747,7 +747,7 @@ def _classify_arrays(
     def chunk(p0: int, p1: int) -> None:
         copy_a[p0:p1] = arr_a[p0:p1]
         copy_b[p0:p1] = arr_b[p0:p1]
-        km.raw_states(copy_a[p0:p1], copy_b[p0:p1], tol, *_RING_ARGS,
+        km.raw_states(copy_a[p0:p1], copy_b[p0:p1], tol, *RING_ARGS,
                       tuple(o[p0:p1] for o in out))
 
     try:
@@ -841,7 +841,7 @@ def _pack_sequence(items: Sequence[Any] | np.ndarray, what: str,
         lo = np.zeros(len(rings), dtype=np.int64)
         lo[1:] = np.cumsum(n)[:-1]
         xy = np.concatenate(rings) if rings else np.empty((0, 2))
-        used, sg = km.check_rings(xy, lo, n, *_RING_ARGS)
+        used, sg = km.check_rings(xy, lo, n, *RING_ARGS)
         for k, i in enumerate(raw):
             if used[k] < 0:
                 bodies[i] = as_shape(items[i], f"{what}[{i}]")
@@ -1031,8 +1031,8 @@ def classify_many(
     n_threads = requested(threads)
     check_chunk_size(chunk_size)
     remote = current_client(client)
-    arr_a = _raw_array(shapes_a)
-    arr_b = _raw_array(shapes_b)
+    arr_a = raw_ring_array(shapes_a)
+    arr_b = raw_ring_array(shapes_b)
     if remote is None and arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
         batch = _classify_arrays(arr_a, arr_b, tol, n_threads)
         if batch is not None:

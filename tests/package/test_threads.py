@@ -260,6 +260,21 @@ def test_time_of_impact_many_on_two_threads_equals_one_thread(share_everything):
     assert one.impact(7).status is single.status
 
 
+def test_time_of_impact_many_of_ring_arrays_on_two_threads_equals_one_thread(share_everything):
+    rng = np.random.default_rng(9)
+    a = stars(rng, 3000)
+    b = a + rng.uniform(-1.5, 1.5, (3000, 1, 2))
+    ma = np.c_[rng.uniform(-2, 2, (3000, 2)), np.zeros((3000, 2)), rng.uniform(-1, 1, 3000),
+               np.zeros(3000)]
+    mb = np.zeros((3000, 6))
+    one = on(1, lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, threads=1))
+    two = on(2, lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, threads=2))
+    for name in ("statuses", "times", "first_contacts"):
+        assert same(getattr(one, name), getattr(two, name)), name
+    assert np.count_nonzero(one.collides) > 300
+    assert one.impact(11) == two.impact(11)
+
+
 @pytest.mark.parametrize("count, n_chunks", [(1, 2), (64, 2), (65, 3), (1000, 7),
                                              (40_000, 256), (40_001, 32)])
 def test_pairs_shared_among_threads_in_whole_blocks_each_once(count, n_chunks):

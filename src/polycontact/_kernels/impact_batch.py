@@ -7,7 +7,8 @@ vertices about its centroid, circle tree and lengths: what
 for bit) into two flat arrays, each body at offsets known beforehand;
 :func:`suspect_bodies` marks the bodies whose coordinates or motion may be beyond the
 range the kernels take, for the caller to check exactly and refuse; :func:`pair_bodies`
-gives the shapes and tolerances of many body pairs.
+gives the shapes and tolerances of many body pairs; :func:`ring_bodies` and
+:func:`pack_rings` make bodies of raw outer rings, without a Shape.
 
 Bodies are packed as ``xy`` (V, 2) float64, every body's loops one after another,
 ``rows`` (U + 1,) the first row of each body, and ``starts`` with ``st_off`` (U + 1,):
@@ -24,6 +25,7 @@ import numpy as np
 from .jit import njit
 from .advance import edge_table
 from .impact import pack_body
+from .rings import raw_ring
 
 
 @njit(cache=True, nogil=True)
@@ -154,3 +156,78 @@ def pair_bodies(pairs, owner, extents, rel):
         wanted[ua] = True
         wanted[ub] = True
     return i, j, oi, oj, eps_rel, wanted
+
+
+@njit(cache=True, nogil=True)
+def _ring_vertex(ring, n, sign, i):
+    """Vertex i of the first ``n`` of ``ring`` turned counter-clockwise as
+    :class:`polycontact.Shape` turns a clockwise outer loop (``ring[:n][::-1]``)."""
+    return ring[i] if sign > 0 else ring[n - 1 - i]
+
+
+@njit(cache=True, nogil=True)
+def ring_bodies(rings, rel, ulps, limit, floor, p0, p1, used, sign, centroids, radii,
+                extents):
+    """Rings ``p0`` to ``p1 - 1`` of ``rings`` (P, N, 2) as bodies, written into
+    ``used`` (int64), ``sign`` (int8), ``centroids`` (P, 2), ``radii`` and ``extents``;
+    the caller splits the rings over threads.
+
+    ``used[p]``: the vertices ring p keeps (a repeated closing point dropped), or -1
+    when the caller must let :class:`polycontact.Shape` decide: the ring is not
+    certified a valid simple polygon within ``limit`` and ``floor`` as given
+    (:func:`polycontact._kernels.rings.raw_ring`, with ``rel`` and ``ulps``), or twice
+    its area summed in floats is not clear of its rounding (a sliver, which ``Shape``
+    sums exactly). ``sign[p]``: 1 counter-clockwise, -1 clockwise. The area centroid,
+    bounding radius and extent of ring p are computed as ``Shape`` computes them (the
+    ring turned counter-clockwise, coordinates taken relative to its first vertex; the
+    sums in another order, so they may differ in the last bits)."""
+    for p in range(p0, p1):
+        ring = rings[p]
+        n, s, _, box = raw_ring(ring, rel, ulps, limit, floor)
+        used[p] = n
+        sign[p] = 1 if s > 0 else -1
+        if n < 0:
+            continue
+        o = _ring_vertex(ring, n, s, 0)
+        a2 = 0.0
+        sx = 0.0
+        sy = 0.0
+        mags = 0.0
+        for i in range(n):
+            u = _ring_vertex(ring, n, s, i)
+            v = _ring_vertex(ring, n, s, (i + 1) % n)
+            x = u[0] - o[0]
+            y = u[1] - o[1]
+            xn = v[0] - o[0]
+            yn = v[1] - o[1]
+            c = x * yn - xn * y
+            a2 += c
+            sx += (x + xn) * c
+            sy += (y + yn) * c
+            mags += abs(x * yn) + abs(xn * y)
+        # (the rule of Shape's _area_clear: (n + 8) ulps of the products' magnitudes)
+        if not a2 > (n + 8) * 2.0**-52 * mags or mags < 2.0**-1000:
+            used[p] = -1
+            continue
+        cx = o[0] + sx / (3.0 * a2)
+        cy = o[1] + sy / (3.0 * a2)
+        radius = 0.0
+        for i in range(n):
+            radius = max(radius, math.hypot(ring[i, 0] - cx, ring[i, 1] - cy))
+        centroids[p, 0] = cx
+        centroids[p, 1] = cy
+        radii[p] = radius
+        extents[p] = max(box[1] - box[0], box[3] - box[2])
+
+
+@njit(cache=True, nogil=True)
+def pack_rings(rings, used, sign, rows, p0, p1, xy):
+    """The kept vertices of rings ``p0`` to ``p1 - 1`` (:func:`ring_bodies`' ``used``
+    and ``sign``), counter-clockwise, written into ``xy[rows[p]:rows[p] + used[p]]``;
+    the caller splits the rings over threads."""
+    for p in range(p0, p1):
+        n = used[p]
+        for i in range(n):
+            v = _ring_vertex(rings[p], n, sign[p], i)
+            xy[rows[p] + i, 0] = v[0]
+            xy[rows[p] + i, 1] = v[1]
