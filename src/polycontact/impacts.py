@@ -618,7 +618,7 @@ def time_of_impact_many(
 
     check_chunk_size(chunk_size)
     remote = current_client(client)
-    rings = _ring_arrays(shapes_a, shapes_b) if remote is None else None
+    rings = _ring_arrays(shapes_a, shapes_b)
     if rings is None:
         a = check_shapes(shapes_a, "shapes_a")
         b = check_shapes(shapes_b, "shapes_b")
@@ -637,7 +637,9 @@ def time_of_impact_many(
         ringed = prepare_rings(*rings, ma, mb, t_max, threads)
         if ringed is not None:
             copies, packed, sa, sb, rows_a, rows_b, eps_rel = ringed
-            raw = search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, *options, threads)
+            raw = (search_pairs(packed, sa, sb, rows_a, rows_b, eps_rel, *options, threads)
+                   if remote is None else
+                   _remote_ring_search(remote, ringed, options, chunk_size))
             return impact_batch(lambda p, s: Shape(copies[s][p]), ma, mb, raw, eps_rel,
                                 *options[:3])
         a = check_shapes(rings[0], "shapes_a")  # (refused here, naming the ring)
@@ -795,6 +797,65 @@ def _remote_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, .
             for whole, got in zip(raw, part):
                 whole[p0:p1] = got
     return raw
+
+
+def _remote_ring_search(client: Any, ringed: tuple[Any, ...], options: tuple[Any, ...],
+                        chunk_size: int | None) -> tuple[Any, ...]:
+    """:func:`_remote_search` of pairs of rings prepared by :func:`prepare_rings`: each
+    task carries the packed rows of its own pairs' bodies, nothing else."""
+    from ._cluster import run_spans
+
+    _, packed, _, _, rows_a, rows_b, eps_rel = ringed
+    count = len(rows_a)
+    raw = empty_result(count)
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[None, list[tuple[Any, ...]]]:
+        return None, [_ring_task(packed, rows_a, rows_b, eps_rel, p0, p1) for p0, p1 in spans]
+
+    with closing(run_spans(client, _ring_slice, count, tasks_of, *options,
+                           chunk_size=chunk_size, family="many moving bodies")) as results:
+        for p0, p1, part in results:
+            for whole, got in zip(raw, part):
+                whole[p0:p1] = got
+    return raw
+
+
+def _ring_task(packed: tuple[np.ndarray, ...], rows_a: np.ndarray, rows_b: np.ndarray,
+               eps_rel: np.ndarray, p0: int, p1: int) -> tuple[Any, ...]:
+    """The task of pairs ``p0:p1`` of P pairs of rings packed by :func:`prepare_rings`
+    (ring p of side a is body p, of side b body P + p): their bodies packed alone (side
+    a's, then side b's), their motion rows and ``eps_rel``.
+
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> _, packed, *rest = prepare_rings(np.stack([sq, sq + 5]), np.stack([sq + 2, sq + 9]),
+    ...                                  MotionRows(np.zeros((2, 6))),
+    ...                                  MotionRows(np.zeros((2, 6))), 1.0, 1)
+    >>> task = _ring_task(packed, rest[2], rest[3], rest[4], 1, 2)
+    >>> task[0][0].tolist()[::4], task[0][1].tolist()
+    ([[5.0, 5.0], [9.0, 9.0]], [0, 4, 8])
+    """
+    xy, rows, _, _, centroids, radii = packed
+    p_count = len(rows_a)
+    pick = np.r_[p0:p1, p_count + p0:p_count + p1]
+    used = np.diff(rows)[pick]
+    own_rows = np.zeros(len(pick) + 1, np.int64)
+    np.cumsum(used, out=own_rows[1:])
+    starts = np.zeros(2 * len(pick), np.int64)
+    starts[1::2] = used
+    own_xy = np.concatenate([xy[rows[p0]:rows[p1]], xy[rows[p_count + p0]:rows[p_count + p1]]])
+    own = (own_xy, own_rows, starts, np.arange(0, 2 * len(pick) + 1, 2, dtype=np.int64),
+           centroids[pick], radii[pick])
+    return own, rows_a[p0:p1], rows_b[p0:p1], eps_rel[p0:p1]
+
+
+def _ring_slice(shared: None, task: tuple[Any, ...], t_max: float, method: str, tol: float,
+                samples: int, max_iterations: int) -> tuple[Any, ...]:
+    """One task of :func:`_remote_ring_search`: the local search of its pairs; the raw
+    result arrays."""
+    packed, rows_a, rows_b, eps_rel = task
+    order = np.arange(len(rows_a), dtype=np.int64)
+    return search_pairs(packed, order, order + len(order), rows_a, rows_b, eps_rel, t_max,
+                        method, tol, samples, max_iterations, 1)
 
 
 def _impact_tasks(uniq: list[bytes], sa: np.ndarray, sb: np.ndarray, rows_a: np.ndarray,

@@ -180,6 +180,24 @@ def test_time_of_impact_many_on_the_cluster_is_identical(client, method):
     assert set(remote.statuses.tolist()) == {0, 1, 2}
 
 
+def test_time_of_impact_many_of_ring_arrays_on_the_cluster_is_identical(client):
+    rng = np.random.default_rng(12)
+    t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    star = np.c_[np.cos(t), np.sin(t)] * np.where(np.arange(8) % 2, 0.4, 1.0)[:, None]
+    a = star[None] * rng.uniform(0.5, 1.5, (300, 1, 1)) + rng.uniform(-3, 3, (300, 1, 2))
+    b = a + rng.uniform(-1.5, 1.5, (300, 1, 2))
+    ma = np.c_[rng.uniform(-2, 2, (300, 2)), np.zeros((300, 2)), rng.uniform(-1, 1, 300),
+               np.zeros(300)]
+    mb = np.zeros((300, 6))
+    local = here(lambda: pc.time_of_impact_many(a, ma, b, mb, t_max=3, threads=1))
+    remote = pc.time_of_impact_many(a, ma, b, mb, t_max=3, client=client, chunk_size=37)
+    assert same_batch(local, remote) and set(remote.statuses.tolist()) == {0, 1, 2}
+    bad = a.copy()
+    bad[40, 2] = bad[40, 7]  # (two vertices at one point: refused, named, at the call)
+    with pytest.raises(pc.InvalidShapeError, match=r"shapes_a\[40\]: "):
+        pc.time_of_impact_many(bad, ma, b, mb, t_max=3, client=client)
+
+
 def test_time_of_impact_many_uses_the_default_client_and_its_warm_up(client):
     a, ma, b, mb = impact_pairs(40, seed=5)
     arrays = [np.asarray(s.exterior) for s in a]  # every pair its own shape objects
