@@ -657,46 +657,65 @@ def time_of_impact_many(
 def _ring_arrays(shapes_a: Any, shapes_b: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """``(shapes_a, shapes_b)`` when both are arrays of outer rings, (P, N, 2) and (P',
     M, 2) of real numbers (the packed form of :func:`time_of_impact_many`), else None."""
-    from .relation import raw_ring_array
-
-    arr_a, arr_b = raw_ring_array(shapes_a), raw_ring_array(shapes_b)
+    arr_a, arr_b = _raw_rings(shapes_a), _raw_rings(shapes_b)
     return None if arr_a is None or arr_b is None else (arr_a, arr_b)
 
 
 def prepare_rings(arr_a: np.ndarray, arr_b: np.ndarray, ma: Motions, mb: Motions,
                   t_max: float, threads: int) -> tuple[Any, ...] | None:
     """:func:`prepare_pairs` of the pairs of outer rings ``arr_a[p]`` and ``arr_b[p]``
-    ((P, N, 2) and (P, M, 2) arrays) without a Shape: the rings copied (float64),
-    checked, oriented counter-clockwise and packed, with their centroids, radii and
-    extents, in compiled code on at most ``threads`` threads; ``(copies, packed, sa,
-    sb, rows_a, rows_b, eps_rel)``, ``copies`` the two copied ring arrays, which a
-    :class:`~polycontact.Shape` is made of when the caller asks (for ``impact(k)``, or
-    to refuse a body exactly). None when a ring is not certified valid as given
-    (:func:`polycontact._kernels.impact_batch.ring_bodies`): the caller then makes
-    Shapes, which decide, and name the ring they refuse."""
+    ((P, N, 2) and (P, M, 2) arrays) without a Shape (:func:`_ring_bodies`): ``(copies,
+    packed, sa, sb, rows_a, rows_b, eps_rel)``, ``copies`` the two copied ring arrays,
+    which a :class:`~polycontact.Shape` is made of when the caller asks (for
+    ``impact(k)``). None when a ring is not certified valid as given: the caller then
+    makes Shapes, which decide, and name the ring they refuse."""
+    p_count = len(arr_a)
+    got = _ring_bodies((arr_a, arr_b), _rows(ma, mb),
+                       lambda k: ma[k] if k < p_count else mb[k - p_count],
+                       lambda k: _pair_names(k, p_count), t_max, threads)
+    if got is None:
+        return None
+    copies, bodies = got
+    order = np.arange(p_count, dtype=np.int64)
+    eps_rel = RELATIVE_TOLERANCE * np.maximum(bodies.extents[:p_count],
+                                              bodies.extents[p_count:])
+    return (copies, bodies.packed, order, order + p_count, bodies.motions[:p_count],
+            bodies.motions[p_count:], eps_rel)
+
+
+def _ring_bodies(arrays: Sequence[np.ndarray], motions: np.ndarray,
+                 motion_of: Callable[[int], Motion], name_of: Callable[[int], tuple[str, str]],
+                 t_max: float, threads: int) -> tuple[tuple[np.ndarray, ...], _Bodies] | None:
+    """:func:`_bodies` of the outer rings of ``arrays`` ((P, N, 2) arrays, one after
+    another: body k is the k-th ring counted through them) without a Shape: the rings
+    copied (float64), checked, oriented counter-clockwise and packed, with their
+    centroids, radii and extents, in compiled code on at most ``threads`` threads
+    (:func:`polycontact._kernels.impact_batch.ring_bodies`); ``(copies, bodies)``, the
+    copied arrays, of which a :class:`~polycontact.Shape` is made where one is needed
+    (to refuse a body exactly, or for an ``Impact``), and the bodies, each its own
+    shape. None when a ring is not certified valid as given."""
     from ._kernels.impact_batch import pack_rings, ring_bodies
     from .relation import RING_ARGS
 
-    p_count = len(arr_a)
-    total = 2 * p_count
-    copies = (np.empty(arr_a.shape), np.empty(arr_b.shape))
+    bases = np.cumsum([0] + [len(arr) for arr in arrays])
+    total = int(bases[-1])
+    copies = tuple(np.empty(arr.shape) for arr in arrays)
     used = np.empty(total, np.int64)
     sign = np.empty(total, np.int8)
     centroids = np.empty((total, 2))
     radii = np.empty(total)
     extents = np.empty(total)
 
-    def sides(k0: int, k1: int) -> Iterator[tuple[int, int, int]]:
-        """The rings k0 to k1 - 1 of both sides: ``(side, p0, p1)``."""
-        for side, base in ((0, 0), (1, p_count)):
-            p0, p1 = max(k0 - base, 0), min(k1 - base, p_count)
+    def parts(k0: int, k1: int) -> Iterator[tuple[int, int, int, int]]:
+        """The rings k0 to k1 - 1 in each array: ``(array, base, p0, p1)``."""
+        for side, base in enumerate(bases[:-1].tolist()):
+            p0, p1 = max(k0 - base, 0), min(k1 - base, len(arrays[side]))
             if p0 < p1:
-                yield side, p0, p1
+                yield side, base, p0, p1
 
     def check(k0: int, k1: int) -> None:
-        for side, p0, p1 in sides(k0, k1):
-            base = side * p_count
-            copies[side][p0:p1] = (arr_a, arr_b)[side][p0:p1]
+        for side, base, p0, p1 in parts(k0, k1):
+            copies[side][p0:p1] = arrays[side][p0:p1]
             ring_bodies(copies[side], *RING_ARGS, p0, p1, used[base:], sign[base:],
                         centroids[base:], radii[base:], extents[base:])
 
@@ -708,8 +727,7 @@ def prepare_rings(arr_a: np.ndarray, arr_b: np.ndarray, ma: Motions, mb: Motions
     xy = np.empty((int(rows[-1]), 2))
 
     def pack(k0: int, k1: int) -> None:
-        for side, p0, p1 in sides(k0, k1):
-            base = side * p_count
+        for side, base, p0, p1 in parts(k0, k1):
             pack_rings(copies[side], used[base:], sign[base:], rows[base:], p0, p1, xy)
 
     map_work(pack, total, _RING_SECONDS / 4, threads)
@@ -717,15 +735,42 @@ def prepare_rings(arr_a: np.ndarray, arr_b: np.ndarray, ma: Motions, mb: Motions
     starts[1::2] = used
     packed = (xy, rows, starts, np.arange(0, 2 * total + 1, 2, dtype=np.int64), centroids,
               radii)
-    motions = _rows(ma, mb)
-    _refuse_suspects(packed, np.arange(total, dtype=np.int64), motions,
-                     lambda k: Shape(copies[k // p_count][k % p_count]),
-                     lambda k: ma[k] if k < p_count else mb[k - p_count],
-                     lambda k: _pair_names(k, p_count), t_max, threads)
-    order = np.arange(p_count, dtype=np.int64)
-    eps_rel = RELATIVE_TOLERANCE * np.maximum(extents[:p_count], extents[p_count:])
-    return (copies, packed, order, order + p_count, motions[:p_count], motions[p_count:],
-            eps_rel)
+    owner = np.arange(total, dtype=np.int64)
+
+    def shape_of(k: int) -> Shape:
+        side = int(np.searchsorted(bases, k, side="right")) - 1
+        return Shape(copies[side][k - bases[side]])
+
+    _refuse_suspects(packed, owner, motions, shape_of, motion_of, name_of, t_max, threads)
+    return copies, _Bodies([], packed, owner, motions, centroids, radii, extents)
+
+
+def _moving_bodies(shapes: Any, motions: Any, t_max: float,
+                   threads: int) -> tuple[Callable[[int], Shape], Motions, _Bodies]:
+    """The bodies ``(shapes[k], motions[k])`` of :func:`first_impacts` and
+    :func:`candidate_pairs`, checked over [0, ``t_max``] on at most ``threads`` threads
+    (errors naming ``shapes[k]``, ``motions[k]``): ``(shape_of, moves, bodies)``.
+    ``shapes`` as a (N, V, 2) ring array is packed without a Shape
+    (:func:`_ring_bodies`) unless a ring is not certified valid as given;
+    ``shape_of(k)`` is body k's Shape (made when asked, for a ring)."""
+    rings = _raw_rings(shapes)
+    if rings is not None:
+        moves = check_motions(motions, "motions", len(rings), "shapes")
+        got = _ring_bodies((rings,), _rows(moves), moves.__getitem__, _names, t_max, threads)
+        if got is not None:
+            copies, bodies = got
+            return lambda k: Shape(copies[0][k]), moves, bodies
+    listed = check_shapes(shapes, "shapes")
+    moves = check_motions(motions, "motions", len(listed), "shapes")
+    return listed.__getitem__, moves, _bodies(listed, _rows(moves), moves.__getitem__, _names,
+                                               t_max, threads)
+
+
+def _raw_rings(shapes: Any) -> np.ndarray | None:
+    """``shapes`` if it is a (N, V, 2) array of real rings, else None."""
+    from .relation import raw_ring_array
+
+    return raw_ring_array(shapes)
 
 
 #: Seconds of checking one raw ring (a 12-gon's) and making it a body, for the threads
@@ -939,8 +984,8 @@ class _ShapePack:
 
 
 # -- many moving bodies ----------------------------------------------------------------
-def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.ndarray, *,
-                    t_max: float) -> np.ndarray:
+def candidate_pairs(shapes: Sequence[ShapeLike] | np.ndarray,
+                    motions: Sequence[Motion] | np.ndarray, *, t_max: float) -> np.ndarray:
     """Pairs of moving bodies whose swept bounds over ``[0, t_max]`` meet: the pairs
     :func:`first_impacts` searches.
 
@@ -975,12 +1020,9 @@ def candidate_pairs(shapes: Sequence[ShapeLike], motions: Sequence[Motion] | np.
     >>> candidate_pairs(shapes, motions, t_max=5).tolist()
     [[0, 1]]
     """
-    bodies = check_shapes(shapes, "shapes")
-    moves = check_motions(motions, "motions", len(bodies), "shapes")
     t_max = check_t_max(t_max)
     threads = requested(None)
-    return _candidates(_bodies(bodies, _rows(moves), moves.__getitem__, _names, t_max,
-                               threads), t_max, threads)
+    return _candidates(_moving_bodies(shapes, motions, t_max, threads)[2], t_max, threads)
 
 
 def _candidates(bodies: _Bodies, t_max: float, threads: int) -> np.ndarray:
@@ -1109,7 +1151,7 @@ def event_time(impact: Impact) -> float:
 
 
 def first_impacts(
-    shapes: Sequence[ShapeLike],
+    shapes: Sequence[ShapeLike] | np.ndarray,
     motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,
@@ -1138,8 +1180,10 @@ def first_impacts(
 
     Parameters
     ----------
-    shapes : sequence of ShapeLike
-        The bodies at t = 0.
+    shapes : sequence of ShapeLike, or ndarray of shape (N, V, 2)
+        The bodies at t = 0; or the packed form, N outer rings of V vertices each
+        (checked and packed in compiled code, as :func:`time_of_impact_many` takes
+        them).
     motions : sequence of Motion, or ndarray of shape (N, 6)
         One per body: Motions, or their kernel vectors as rows (as for
         :func:`time_of_impact_many`).
@@ -1182,12 +1226,10 @@ def first_impacts(
     """
     from ._kernels.impact_batch import pair_bodies
 
-    shapes = check_shapes(shapes, "shapes")
-    moves = check_motions(motions, "motions", len(shapes), "shapes")
     t_max, tol, samples, max_iterations, threads = check_many_options(
         t_max, method, time_tolerance, samples, max_iterations, threads)
     # every body is checked as time_of_impact checks it, searched or not
-    bodies = _bodies(shapes, _rows(moves), moves.__getitem__, _names, t_max, threads)
+    shape_of, moves, bodies = _moving_bodies(shapes, motions, t_max, threads)
     pairs = _candidates(bodies, t_max, threads)
     if len(pairs) == 0:
         return _no_events()
@@ -1197,7 +1239,7 @@ def first_impacts(
     raw = search_pairs(bodies.packed, oi, oj, bodies.motions, bodies.motions, eps_rel, t_max,
                        method, tol, samples, max_iterations, threads, wanted, (i, j))
     code, t_hi, _, contact, _, reached, *_ = raw
-    make = _maker(lambda p, s: shapes[pairs[p, s]], lambda p, s: moves[pairs[p, s]], raw,
+    make = _maker(lambda p, s: shape_of(pairs[p, s]), lambda p, s: moves[pairs[p, s]], raw,
                   t_max, method, eps_rel, tol)
     met = np.flatnonzero((code != 0) | (contact >= 0.0))
     # event_time of each, from the arrays (tested equal)
@@ -1221,7 +1263,7 @@ def _no_events() -> PairImpacts:
 
 
 def first_impact(
-    shapes: Sequence[ShapeLike],
+    shapes: Sequence[ShapeLike] | np.ndarray,
     motions: Sequence[Motion] | np.ndarray,
     *,
     t_max: float,

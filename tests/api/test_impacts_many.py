@@ -287,6 +287,21 @@ def test_time_of_impact_many_of_ring_arrays_equals_time_of_impact_of_their_shape
         assert (math.isnan(got.times[k]) if one.time is None else got.times[k] == one.time)
 
 
+@examples(40)
+@given(ring_batches(), st.sampled_from(["exact", "sampled"]))
+def test_first_impacts_of_a_ring_array_equals_first_impacts_of_its_shapes(batch, method):
+    a, ma, b, mb, t_max = batch
+    rings = np.concatenate([a, b[:, :a.shape[1]]])  # (b's closing point dropped)
+    rows = np.concatenate([ma, mb])
+    got = first_impacts(rings, rows, t_max=t_max, method=method, max_iterations=BUDGET)
+    want = first_impacts([Shape(r) for r in rings], [row_motion(m) for m in rows],
+                         t_max=t_max, method=method, max_iterations=BUDGET)
+    assert same_events({(i, j): imp for i, j, imp in got},
+                       {(i, j): imp for i, j, imp in want})
+    assert candidate_pairs(rings, rows, t_max=t_max).tolist() == candidate_pairs(
+        [Shape(r) for r in rings], rows, t_max=t_max).tolist()
+
+
 def test_time_of_impact_many_of_ring_arrays_neither_changes_nor_keeps_reading_them():
     ring = np.array([[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]] * 2)
     other = ring + [[[3.0, 0.0]], [[0.0, 5.0]]]
@@ -342,6 +357,14 @@ def test_time_of_impact_many_of_ring_arrays_leaves_uncertain_rings_to_shape():
 def test_bad_ring_arrays_are_named_with_their_index(call, error, message):
     with pytest.raises(error, match=message):
         call()
+
+
+def test_first_impacts_of_a_ring_array_names_the_ring_it_refuses():
+    rings = np.stack([SQ_RINGS[0], SQ_RINGS[0] + 3, [(0, 0), (1, 1), (1, 0), (0, 1)]])
+    with pytest.raises(InvalidShapeError, match=r"shapes\[2\]: outer loop: self-inter"):
+        first_impacts(rings, np.zeros((3, 6)), t_max=1)
+    with pytest.raises(ValueError, match=r"motions\[1\]: the body's coordinates reach"):
+        first_impacts(rings[:2], np.array([[0.0] * 6, [1e60, 0, 0, 0, 0, 0]]), t_max=1e50)
 
 
 def test_time_of_impact_many_of_empty_ring_arrays():

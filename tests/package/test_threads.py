@@ -334,6 +334,21 @@ def test_first_impacts_on_two_threads_equal_one_thread(share_everything):
     assert len(one) > 100 and one == events(2)
 
 
+def test_first_impacts_of_a_ring_array_on_two_threads_equal_one_thread(share_everything):
+    rng = np.random.default_rng(10)
+    rings = stars(rng, 300)
+    rows = np.c_[rng.uniform(-1, 1, (300, 2)), np.zeros((300, 2)), rng.uniform(-1, 1, 300),
+                 np.zeros(300)]
+
+    def events(threads):
+        return [(e.i, e.j, e.impact.status, e.impact.time)
+                for e in on(threads, lambda: pc.first_impacts(rings, rows, t_max=0.5,
+                                                                threads=threads))]
+
+    one = events(1)
+    assert len(one) > 100 and one == events(2)
+
+
 def test_time_of_impact_many_refuses_as_the_pair_would(share_everything):
     far = pc.Motion(velocity=(1e60, 0))
     a = [pc.Shape(SQ)] * 300
