@@ -827,17 +827,25 @@ def _remote_search(client: Any, prepared: tuple[Any, ...], options: tuple[Any, .
     """The raw result arrays of :func:`search_pairs` for the prepared pairs
     (:func:`prepare_pairs`'s answer), in tasks on the cluster of ``client``; ``options`` = ``(t_max,
     method, tol, samples, max_iterations)``."""
-    from ._cluster import run_spans
-
     uniq, _, sa, sb, rows_a, rows_b, eps_rel = prepared
-    count = len(sa)
-    raw = empty_result(count)
 
     def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
         return _impact_tasks(uniq, sa, sb, rows_a, rows_b, eps_rel, spans)
 
-    with closing(run_spans(client, _impact_slice, count, tasks_of, *options,
-                           chunk_size=chunk_size, family="many moving bodies")) as results:
+    return _gathered(client, _impact_slice, len(sa), tasks_of, options, chunk_size)
+
+
+def _gathered(client: Any, fn: Callable[..., tuple[Any, ...]], count: int,
+              tasks_of: Callable[[list[tuple[int, int]]], tuple[Any, list[Any]]],
+              options: tuple[Any, ...], chunk_size: int | None) -> tuple[Any, ...]:
+    """The raw result arrays of ``count`` pairs, from the tasks ``fn(shared, task,
+    *options)`` of :func:`polycontact._cluster.run_spans` (``tasks_of``: as there), each
+    task's slice written in as it finishes."""
+    from ._cluster import run_spans
+
+    raw = empty_result(count)
+    with closing(run_spans(client, fn, count, tasks_of, *options, chunk_size=chunk_size,
+                           family="many moving bodies")) as results:
         for p0, p1, part in results:
             for whole, got in zip(raw, part):
                 whole[p0:p1] = got
@@ -848,21 +856,12 @@ def _remote_ring_search(client: Any, ringed: tuple[Any, ...], options: tuple[Any
                         chunk_size: int | None) -> tuple[Any, ...]:
     """:func:`_remote_search` of pairs of rings prepared by :func:`prepare_rings`: each
     task carries the packed rows of its own pairs' bodies, nothing else."""
-    from ._cluster import run_spans
-
     _, packed, _, _, rows_a, rows_b, eps_rel = ringed
-    count = len(rows_a)
-    raw = empty_result(count)
 
-    def tasks_of(spans: list[tuple[int, int]]) -> tuple[None, list[tuple[Any, ...]]]:
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
         return None, [_ring_task(packed, rows_a, rows_b, eps_rel, p0, p1) for p0, p1 in spans]
 
-    with closing(run_spans(client, _ring_slice, count, tasks_of, *options,
-                           chunk_size=chunk_size, family="many moving bodies")) as results:
-        for p0, p1, part in results:
-            for whole, got in zip(raw, part):
-                whole[p0:p1] = got
-    return raw
+    return _gathered(client, _ring_slice, len(rows_a), tasks_of, options, chunk_size)
 
 
 def _ring_task(packed: tuple[np.ndarray, ...], rows_a: np.ndarray, rows_b: np.ndarray,
