@@ -37,7 +37,7 @@ from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT
                      MAX_ITERATIONS, MAX_SLICES, RELATIVE_TOLERANCE, SAMPLES,
                      SWEPT_ROUNDING_ULPS, TIME_TOLERANCE)
 from .motion import Motion
-from .relation import kernels_unpacked
+from .relation import RING_ARGS, kernels_unpacked, raw_ring_array
 from .shape import Shape, ShapeLike, as_shape
 from .tolerances import ROUNDING_FACTOR, check_range
 from ._checks import real_array
@@ -657,7 +657,7 @@ def time_of_impact_many(
 def _ring_arrays(shapes_a: Any, shapes_b: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """``(shapes_a, shapes_b)`` when both are arrays of outer rings, (P, N, 2) and (P',
     M, 2) of real numbers (the packed form of :func:`time_of_impact_many`), else None."""
-    arr_a, arr_b = _raw_rings(shapes_a), _raw_rings(shapes_b)
+    arr_a, arr_b = raw_ring_array(shapes_a), raw_ring_array(shapes_b)
     return None if arr_a is None or arr_b is None else (arr_a, arr_b)
 
 
@@ -695,7 +695,6 @@ def _ring_bodies(arrays: Sequence[np.ndarray], motions: np.ndarray,
     (to refuse a body exactly, or for an ``Impact``), and the bodies, each its own
     shape. None when a ring is not certified valid as given."""
     from ._kernels.impact_batch import pack_rings, ring_bodies
-    from .relation import RING_ARGS
 
     bases = np.cumsum([0] + [len(arr) for arr in arrays])
     total = int(bases[-1])
@@ -753,7 +752,7 @@ def _moving_bodies(shapes: Any, motions: Any, t_max: float,
     ``shapes`` as a (N, V, 2) ring array is packed without a Shape
     (:func:`_ring_bodies`) unless a ring is not certified valid as given;
     ``shape_of(k)`` is body k's Shape (made when asked, for a ring)."""
-    rings = _raw_rings(shapes)
+    rings = raw_ring_array(shapes)
     if rings is not None:
         moves = check_motions(motions, "motions", len(rings), "shapes")
         got = _ring_bodies((rings,), _rows(moves), moves.__getitem__, _names, t_max, threads)
@@ -764,13 +763,6 @@ def _moving_bodies(shapes: Any, motions: Any, t_max: float,
     moves = check_motions(motions, "motions", len(listed), "shapes")
     return listed.__getitem__, moves, _bodies(listed, _rows(moves), moves.__getitem__, _names,
                                                t_max, threads)
-
-
-def _raw_rings(shapes: Any) -> np.ndarray | None:
-    """``shapes`` if it is a (N, V, 2) array of real rings, else None."""
-    from .relation import raw_ring_array
-
-    return raw_ring_array(shapes)
 
 
 #: Seconds of checking one raw ring (a 12-gon's) and making it a body, for the threads
