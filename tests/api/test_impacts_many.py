@@ -235,7 +235,7 @@ def ring_batches(draw):
     p = draw(st.integers(1, 4))
     n = draw(st.integers(3, 9))
     scale = draw(st.sampled_from([1e-6, 1e-3, 1.0, 1e3, 1e6]))
-    offset = draw(st.sampled_from([0.0, 0.0, 1e3, -1e5])) * scale
+    offset = draw(st.sampled_from([0.0, 0.0, 1e3, -1e5, 1e9])) * scale
     t_max = draw(st.sampled_from([0.5, 1.0, 3.0]))
 
     def rings(centres):
