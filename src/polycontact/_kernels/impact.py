@@ -338,6 +338,14 @@ def work_floats(size):
 
 
 @njit(cache=True, nogil=True)
+def _interval_views(work):
+    """The broad-phase intervals (MAX_INTERVALS, 2) and the broad phase's scratch, the
+    first floats of ``work`` (see :func:`_work_views`)."""
+    k = 2 * MAX_INTERVALS
+    return view(work, 0, MAX_INTERVALS, 2, np.float64), work[k:k + BROAD_PHASE_FLOATS]
+
+
+@njit(cache=True, nogil=True)
 def _work_views(work, na, nb):
     """The buffers of a query on bodies of ``na`` and ``nb`` vertices as views of
     ``work`` (at least :func:`work_floats` (na + nb) floats; a shorter one raises):
@@ -350,10 +358,8 @@ def _work_views(work, na, nb):
     size = na + nb
     if work.shape[0] < work_floats(size):
         raise ValueError("time of impact: the scratch buffer is too short for the bodies")
-    k = 2 * MAX_INTERVALS
-    iv = view(work, 0, MAX_INTERVALS, 2, np.float64)
-    bw = work[k:k + BROAD_PHASE_FLOATS]
-    k += BROAD_PHASE_FLOATS
+    iv, bw = _interval_views(work)
+    k = 2 * MAX_INTERVALS + BROAD_PHASE_FLOATS
     pa = work[k:k + 2]
     pb = work[k + 2:k + 4]
     crit = vector(work, k + 4, 3, np.int64)  # (4 floats: crit, with a spare)
@@ -436,7 +442,7 @@ def exact_search_tables(a, ea, ma, b, eb, mb, intervals, search):
     given (``ea``, ``eb``: built once per shape by the caller)."""
     _, _, placed, stepping = _work_views(np.empty(work_floats(a[0].shape[0] + b[0].shape[0])),
                                          a[0].shape[0], b[0].shape[0])
-    return _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping)
+    return _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping, False)
 
 
 # The searches run without Numba's reference counting (``_nrt=False``): each step passes
@@ -444,11 +450,14 @@ def exact_search_tables(a, ea, ma, b, eb, mb, intervals, search):
 # the geometry of a small pair. Nothing in them may allocate (the compiler refuses if it
 # does): their callers pass every buffer in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
+def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping,
+                  apart_at_start):
     """:func:`exact_search` with its buffers passed in (``ea``, ``eb``: the
     :func:`polycontact._kernels.advance.edge_table` of each body; ``placed``,
     ``stepping``: see :func:`_work_views`). The bodies are placed only to be classified
-    or for a slide: the steps read each vertex they need from the body frame."""
+    or for a slide: the steps read each vertex they need from the body frame. With
+    ``apart_at_start`` the caller has classified the bodies at t = 0 (they do not
+    penetrate there), and they are not classified there again."""
     time_tol, eps_rel, ulps, lam0, max_iter = search
     ra, sa, ca, la = a
     rb, sb, cb, lb = b
@@ -470,7 +479,7 @@ def _exact_search(a, ea, ma, b, eb, mb, intervals, search, placed, stepping):
         pa[0], pa[1] = centre(ca, ma, t)
         pb[0], pb[1] = centre(cb, mb, t)
         # after t = 0 an interval opens with the bounding circles just touching: apart
-        if t == 0.0 and state_at(a, ma, b, mb, t,
+        if t == 0.0 and not apart_at_start and state_at(a, ma, b, mb, t,
                                  tolerance_at(ca, ma, la, cb, mb, lb, t, eps_rel, ulps),
                                  placed) == _PENETRATING:
             return INITIALLY_PENETRATING, 0.0, 0.0, 0.0, it, 0.0
@@ -664,15 +673,37 @@ def exact_query(a, ea, ma, b, eb, mb, query, work):
     iteration budget of the search, the samples of the sampled one (unused here).
     Returns ``(n, status, t_hi, t_lo, first_contact, iterations, t_reached)``, the n
     broad-phase intervals in ``work[:2 n]`` as (start, end) pairs."""
-    t_max, inflate, time_tol, eps_rel, ulps, lam, max_iter, _ = query
-    ra, _, ca, la = a
-    rb, _, cb, lb = b
-    iv, bw, placed, stepping = _work_views(work, ra.shape[0], rb.shape[0])
-    n = overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
-    code, hi, lo, contact, its, reached = _exact_search(
-        a, ea, ma, b, eb, mb, iv[:n], (time_tol, eps_rel, ulps, lam, max_iter), placed,
-        stepping)
-    return n, code, hi, lo, contact, its, reached
+    n = query_intervals(a[2], ma, a[3], b[2], mb, b[3], query[0], query[1], work)
+    return (n,) + query_search(a, ea, ma, b, eb, mb, n, query, work, False)
+
+
+@njit(cache=True, nogil=True)
+def query_intervals(ca, ma, la, cb, mb, lb, t_max, inflate, work):
+    """The broad phase of :func:`exact_query`: the intervals of [0, ``t_max``] over
+    which the bounding circles (centres ``ca``, ``cb`` at t = 0, radii ``la``, ``lb``)
+    overlap, written into ``work[:2 n]`` as (start, end) pairs; returns n.
+
+    >>> import numpy as np
+    >>> still, work = np.zeros(6), np.empty(work_floats(8))
+    >>> query_intervals(np.zeros(2), still, 1.0, np.array([1.5, 0.0]), still, 1.0, 2.0, 0.0,
+    ...                 work), work[:2].tolist()
+    (1, [0.0, 2.0])
+    """
+    iv, bw = _interval_views(work)
+    return overlap_intervals_into(ca, ma, la, cb, mb, lb, t_max, inflate, iv, bw)
+
+
+@njit(cache=True, nogil=True)
+def query_search(a, ea, ma, b, eb, mb, n, query, work, apart_at_start):
+    """The search of :func:`exact_query` over the n intervals that
+    :func:`query_intervals` wrote into ``work``: ``(status, t_hi, t_lo, first_contact,
+    iterations, t_reached)``. With ``apart_at_start`` the caller has classified the
+    bodies at t = 0 (they do not penetrate there) and the search does not classify them
+    there again."""
+    _, _, time_tol, eps_rel, ulps, lam, max_iter, _ = query
+    iv, _, placed, stepping = _work_views(work, a[0].shape[0], b[0].shape[0])
+    return _exact_search(a, ea, ma, b, eb, mb, iv[:n], (time_tol, eps_rel, ulps, lam, max_iter),
+                         placed, stepping, apart_at_start)
 
 
 @njit(cache=True, nogil=True)

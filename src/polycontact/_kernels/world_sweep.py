@@ -2,19 +2,23 @@
 
 Each body of the World moves rigidly about its centroid (design.md §3) from its current
 pose: ``x(t) = c(t) + R(θ(t)) r`` with ``r`` its rows relative to its centroid turned by
-its current angle (``r = R(angle)(bxy − cen)``, so that ``pos + r`` are the stored rows
-to the bit). The candidate pairs come from the swept broad phase of
+its current angle (``r = R(angle)(bxy − cen)``, so that ``pos + r`` are the stored rows:
+to the bit for a body given a pose, within the rounding of its coordinates for one
+added as it was). The candidate pairs come from the swept broad phase of
 :func:`polycontact.first_impacts` (:mod:`polycontact._kernels.swept`), and each pair runs
-``exact_query`` of :mod:`polycontact._kernels.impact` exactly as
-:func:`polycontact.time_of_impact` does.
+the search of :mod:`polycontact._kernels.impact` as :func:`polycontact.time_of_impact`
+does (``exact_query``, in its two steps :func:`~polycontact._kernels.impact.query_intervals`
+and :func:`~polycontact._kernels.impact.query_search`).
 
 The circle tree of each body's edges (:func:`polycontact._kernels.advance.edge_table`)
 is built once, about the body's base rows (:func:`frame_tables`), and turned with the
 body at each step, once per step for all the pairs it is in (:func:`turned_frames`): a
 rigid turn moves the smallest circles with the points they hold (their radii keep
 their relative margin of 1e-12 over the rounding of the turn). A pair whose bounding
-circles overlap at the start and that penetrates there is reported as ``exact_query``
-reports it without turning anything: the bodies at t = 0 are their stored rows.
+circles overlap at the start is classified there once, as the bodies stand (the bodies
+at t = 0 are their stored rows): if it penetrates it is reported as ``exact_query``
+reports it, without turning anything; if not, the search starts from there without
+classifying it again.
 
 At the first contact time of a pair (time 0 when it touches or penetrates at the
 start), both bodies are placed and classified, and the contact's point and normal are
@@ -30,9 +34,9 @@ from numba import prange
 
 from .jit import njit
 from .advance import edge_table
-from .broad_phase import BROAD_PHASE_FLOATS, MAX_INTERVALS, overlap_intervals_into
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
-from .impact import INITIALLY_PENETRATING, exact_query, state_at, tolerance_at, work_floats
+from .impact import INITIALLY_PENETRATING, query_intervals, query_search, state_at, \
+    tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, view
 from .relation import PENETRATING, state_in
 from .world import body_view
@@ -182,8 +186,6 @@ def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
     sa = np.empty(lmax + 1, np.int64)
     sb = np.empty(lmax + 1, np.int64)
     work = np.empty(work_floats(2 * vmax))
-    iv = np.empty((MAX_INTERVALS, 2))
-    bw = np.empty(BROAD_PHASE_FLOATS)
     scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
     for k in range(k0, k1):
         a = ids[pi[k]]
@@ -197,11 +199,11 @@ def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
             state[k] = 0
             continue
         rel_k = rel * max(extent[a], extent[b])
-        # exact_query's first step where the bounding circles overlap at the start: the
-        # state at t = 0, of the bodies placed there, which are their stored rows
-        n = overlap_intervals_into(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate,
-                                   iv, bw)
-        if n > 0 and iv[0, 0] == 0.0:
+        # exact_query's first steps: its broad phase, and where the bounding circles
+        # overlap at the start (the first interval starts at 0), the state at t = 0, of
+        # the bodies there, which are their stored rows
+        n = query_intervals(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate, work)
+        if n > 0 and work[0] == 0.0:
             ya, s1 = body_view(rows[0], rows[1], rows[2], rows[3], a, sa)
             yb, s2 = body_view(rows[0], rows[1], rows[2], rows[3], b, sb)
             eps = tolerance_at(pos[a], ma, rad[a], pos[b], mb, rad[b], 0.0, rel_k, ulps)
@@ -215,14 +217,14 @@ def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
         r2, s2, e2 = _turned(b, base, tables, frames, sb)
         query = (t_max, inflate, time_tol, rel_k, ulps, resolution * (rad[a] + rad[b]),
                  max_iter, 0)
-        got = exact_query((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
-                          query, work)
-        c = got[1]
+        got = query_search((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
+                           n, query, work, True)
+        c = got[0]
         code[k] = c
-        t_hi[k] = got[2]
-        t = got[4] if c != 2 else 0.0
+        t_hi[k] = got[1]
+        t = got[3] if c != 2 else 0.0
         if c == 3 and t < 0.0:
-            t = got[6]
+            t = got[5]
         t_contact[k] = t
         state[k] = 0 if t < 0.0 else (2 if c == 1 or c == 2 else 1)
 
