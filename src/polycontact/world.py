@@ -1648,7 +1648,9 @@ class World:
              CONTACT_RESOLUTION, int(max_iterations)),
             self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
         met = np.flatnonzero(state > 0)
-        order = met[np.lexsort((pj[met], pi[met], t_contact[met]))]
+        # by time, then by pair: the candidate pairs come sorted by pair, and a stable
+        # sort keeps that order among equal times
+        order = met[np.argsort(t_contact[met], kind="stable")]
         i, j = pi[order], pj[order]
         a, b = ids[i], ids[j]
         times = t_contact[order]
