@@ -169,11 +169,29 @@ def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
     px = dx + vx * t
     py = dy + vy * t
     acc = 0.5 * math.sqrt(ax * ax + ay * ay) * t_max * t_max
-    big = la + lb
-    terms = (abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + math.sqrt(v2) * t_max + acc
-             + big)
-    r = big * (1.0 + 2.0 * inflate) + _APART_ULPS * 2.0**-52 * terms
+    r = _circles_reach(ca, la, cb, lb, math.sqrt(v2) * t_max + acc, inflate)
     return math.sqrt(px * px + py * py) - acc > r
+
+
+@njit(cache=True, nogil=True)
+def _circles_meet_at_start(ca, la, cb, lb, inflate):
+    """Whether the bounding circles may overlap at t = 0, with the margin of
+    :func:`_circles_apart`: where the first interval of ``exact_query``'s broad phase
+    starts at 0, they do."""
+    dx = cb[0] - ca[0]
+    dy = cb[1] - ca[1]
+    return math.sqrt(dx * dx + dy * dy) <= _circles_reach(ca, la, cb, lb, 0.0, inflate)
+
+
+@njit(cache=True, nogil=True)
+def _circles_reach(ca, la, cb, lb, travel, inflate):
+    """The distance of the centres (``ca``, ``cb``) beyond which bounding circles of
+    radii ``la`` and ``lb`` are apart with more than the margin of ``exact_query``'s broad
+    phase: the radii inflated twice as much, and :data:`_APART_ULPS` of the terms of the
+    centres' paths (``travel``: what the motions add to them) for the rounding."""
+    big = la + lb
+    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + big
+    return big * (1.0 + 2.0 * inflate) + _APART_ULPS * 2.0**-52 * terms
 
 
 @njit(cache=True, nogil=True)
@@ -199,11 +217,11 @@ def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
             state[k] = 0
             continue
         rel_k = rel * max(extent[a], extent[b])
-        # exact_query's first steps: its broad phase, and where the bounding circles
-        # overlap at the start (the first interval starts at 0), the state at t = 0, of
-        # the bodies there, which are their stored rows
-        n = query_intervals(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate, work)
-        if n > 0 and work[0] == 0.0:
+        # exact_query's first step where the bounding circles overlap at the start: the
+        # state at t = 0, of the bodies there, which are their stored rows (before its
+        # broad phase: in a crowded step most such pairs penetrate, and need none)
+        at_start = _circles_meet_at_start(pos[a], rad[a], pos[b], rad[b], inflate)
+        if at_start:
             ya, s1 = body_view(rows[0], rows[1], rows[2], rows[3], a, sa)
             yb, s2 = body_view(rows[0], rows[1], rows[2], rows[3], b, sb)
             eps = tolerance_at(pos[a], ma, rad[a], pos[b], mb, rad[b], 0.0, rel_k, ulps)
@@ -213,12 +231,13 @@ def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
                 t_contact[k] = 0.0
                 state[k] = 2
                 continue
+        n = query_intervals(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate, work)
         r1, s1, e1 = _turned(a, base, tables, frames, sa)
         r2, s2, e2 = _turned(b, base, tables, frames, sb)
         query = (t_max, inflate, time_tol, rel_k, ulps, resolution * (rad[a] + rad[b]),
                  max_iter, 0)
         got = query_search((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
-                           n, query, work, True)
+                           n, query, work, at_start)
         c = got[0]
         code[k] = c
         t_hi[k] = got[1]
