@@ -189,6 +189,29 @@ def test_exact_search_on_flush_squares():
     assert lo <= 2.0 <= hi and contact <= hi
 
 
+@given(vec, st.floats(-1, 1), vec, st.floats(0.0, 2.0), st.floats(-3.0, 3.0))
+@example((1.0, 0.0), 0.0, (0.0, 0.0), 1.5, 0.0)   # apart, circles overlapping at t = 0
+@example((-2.0, 0.0), 0.0, (0.0, 0.0), 0.5, 0.0)  # penetrating at t = 0
+def test_query_in_two_steps_answers_as_exact_query(va, wa, vb, gap, dy):
+    # the broad phase (query_intervals) then the search (query_search) give what
+    # exact_query gives; a caller that has found the bodies apart at t = 0 may say so,
+    # and then gets the same answer without the search classifying them there again
+    sq = Shape([(0, 0), (2, 0), (2, 2), (1, 1), (0, 2)])
+    b = Shape([(0, 0), (1, 0), (1, 1), (0, 1)]).moved((2.0 + gap - 1.0, dy))
+    a_, ma, b_, mb = _kernel_args(sq, Motion(velocity=va, angular_velocity=wa), b,
+                                  Motion(velocity=vb))
+    ea, eb = edge_table(a_[0], a_[1]), edge_table(b_[0], b_[1])
+    query = (3.0, 1e-12, 1e-4, 1e-12, ULPS, 1e-6, 100_000, 0)
+    work = np.empty(ki.work_floats(a_[0].shape[0] + b_[0].shape[0]))
+    whole = ki.exact_query(a_, ea, ma, b_, eb, mb, query, work)
+    n = ki.query_intervals(a_[2], ma, a_[3], b_[2], mb, b_[3], query[0], query[1], work)
+    assert n == whole[0]
+    assert ki.query_search(a_, ea, ma, b_, eb, mb, n, query, work, False) == whole[1:]
+    if whole[1] != ki.INITIALLY_PENETRATING:
+        n = ki.query_intervals(a_[2], ma, a_[3], b_[2], mb, b_[3], query[0], query[1], work)
+        assert ki.query_search(a_, ea, ma, b_, eb, mb, n, query, work, True) == whole[1:]
+
+
 def test_exact_search_reports_the_budget():
     # a square spinning in a square hole it fits exactly, the holed body spinning with
     # it a hair faster: in contact throughout, turning apart by far less than the
