@@ -238,6 +238,18 @@ def test_a_sweep_refusal_names_the_argument_that_carries_the_overflow():
         w.sweep(0.1, [(1e200, 0), (0, 0)])
 
 
+def test_a_sweep_takes_motions_whose_bounds_hold_body_by_body():
+    # one body far out, the other travelling far: together their largest terms pass
+    # the limit, each body's own bound does not, so nothing is refused
+    limit = pc.limits.COORDINATE_LIMIT
+    w = pc.World()
+    w.add_many([SQ, SQ], [(0.6 * limit, 0.0), (0.0, 0.0)])
+    s = w.sweep(10.0, [(0.0, 0.0), (0.0, 0.06 * limit)])
+    assert len(s) == 0
+    with pytest.raises(ValueError, match=r"^velocities\[1\]"):
+        w.sweep(10.0, [(0.0, 0.0), (0.0, 0.2 * limit)])
+
+
 def test_booleans_among_real_numbers_are_refused():
     w, ids = _pair_world()
     with pytest.raises(TypeError, match="angles"):
