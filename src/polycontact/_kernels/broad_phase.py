@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
+from .packs import view
 
 _ULP = 2.0**-52
 #: Breakpoints of f on [lo, hi]: both ends and at most one root per derivative of
@@ -253,7 +254,7 @@ def overlap_intervals_into(ca, ma, ra, cb, mb, rb, t_max, inflate, out, work):
     allocated (for callers that query many times)."""
     big = ra + rb
     r = max(big * (1.0 + inflate), big + rounding_allowance(ca, ma, cb, mb, 0.0))
-    p = _relative_motion_into(ca, ma, cb, mb, work[:8].reshape(4, 2))
+    p = _relative_motion_into(ca, ma, cb, mb, view(work, 0, 4, 2, np.float64))
     if big + rounding_allowance(ca, ma, cb, mb, t_max) > r:
         # the radius grows with the terms of the positions, as the allowance at t does:
         # R(t) = r + R1 t + R2 t² >= big + the allowance at t, whatever t_max is
