@@ -49,3 +49,41 @@ def test_scratch_views_compiled_first_from_a_kernel_without_reference_counting(t
                          env=env, timeout=900)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split("\n")[:3] == ["1", "[5, 5, 5, 5, 5]", "True"]
+
+
+SWEEP_FIRST = """
+import numpy as np
+import polycontact as pc
+from polycontact._kernels import broad_phase as kb
+w = pc.World()
+sq = [(0, 0), (1, 0), (1, 1), (0, 1)]
+w.add_many([sq, sq, sq], [(0.5, 0.5), (2.0, 0.5), (0.5, 5.0)])
+# the swept search first: the broad phase and the search are compiled from it
+s = w.sweep(1.0, [(1.0, 0.0), (0.0, 0.0), (0.0, 0.0)])
+print(s.pairs.tolist(), [round(t, 4) for t in s.times.tolist()])
+ca, cb = np.array([0.0, 0.0]), np.array([3.0, 0.0])
+ma, mb = np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), np.zeros(6)
+got = [kb.relative_motion(ca, ma, cb, mb) for _ in range(200)]
+print(all(g.tolist() == [[-3.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]] for g in got),
+      got[0].base is None or got[0].base.refcount == 1)
+iv = [kb.overlap_intervals(ca, ma, 1.0, cb, mb, 1.0, 5.0, 0.0) for _ in range(200)]
+print(all(i.round(9).tolist() == [[1.0, 5.0]] for i in iv))
+b = pc.time_of_impact(sq, pc.Motion(velocity=(1, 0)), pc.Shape(sq).moved((3, 0)), pc.Motion(),
+                      t_max=5)
+print(b.status.value, round(b.time, 3))
+"""
+
+
+@pytest.mark.slow  # compiles from an empty cache
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="compiled code only")
+def test_broad_phase_compiled_first_from_the_swept_search_keeps_its_arrays(tmp_path):
+    # the World's swept search runs without reference counting; the broad-phase helper
+    # that returns its argument is inlined, so a reference-counted caller compiled
+    # after it still owns the arrays it gets back
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(NUMBA_CACHE_DIR=str(tmp_path),
+               PYTHONPATH=os.pathsep.join([str(SRC), env.get("PYTHONPATH", "")]))
+    out = subprocess.run([sys.executable, "-c", SWEEP_FIRST], capture_output=True,
+                         text=True, env=env, timeout=900)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split("\n")[:4] == ["[[0, 1]] [0.5]", "True True", "True", "hit 2.0"]

@@ -48,7 +48,7 @@ def relative_motion(ca, ma, cb, mb):
     return _relative_motion_into(ca, ma, cb, mb, np.empty((4, 2)))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _relative_motion_into(ca, ma, cb, mb, p):
     """:func:`relative_motion` written into ``p`` (4, 2); returns ``p``."""
     for k in range(2):
@@ -179,7 +179,8 @@ def _breakpoints_into(p, r, lo, hi, work):
         npts = nn
         second = not second
     if second:
-        work[:npts] = pts[:npts]
+        for q in range(npts):  # (a loop: a slice copy may allocate)
+            work[q] = pts[q]
     return npts
 
 

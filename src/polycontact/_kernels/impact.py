@@ -337,7 +337,7 @@ def work_floats(size):
             + scratch_floats(size))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _interval_views(work):
     """The broad-phase intervals (MAX_INTERVALS, 2) and the broad phase's scratch, the
     first floats of ``work`` (see :func:`_work_views`)."""
@@ -345,7 +345,7 @@ def _interval_views(work):
     return view(work, 0, MAX_INTERVALS, 2, np.float64), work[k:k + BROAD_PHASE_FLOATS]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _work_views(work, na, nb):
     """The buffers of a query on bodies of ``na`` and ``nb`` vertices as views of
     ``work`` (at least :func:`work_floats` (na + nb) floats; a shorter one raises):

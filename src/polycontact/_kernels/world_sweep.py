@@ -124,7 +124,7 @@ def turned_frames(base, tables, bodies, ang, chunks):
     return frames
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _turned(b, base, tables, frames, st):
     """Body b as turned by :func:`turned_frames`: ``(r, starts, table)``, its rows about
     its centroid, loop starts (written into ``st``) and
@@ -194,17 +194,29 @@ def _circles_reach(ca, la, cb, lb, travel, inflate):
     return big * (1.0 + 2.0 * inflate) + _APART_ULPS * 2.0**-52 * terms
 
 
-@njit(cache=True, nogil=True)
-def _search_range(pi, pj, movers, world, settings, vmax, lmax, k0, k1, out):
-    """:func:`sweep_search` for the pairs ``k0:k1``, into ``out``."""
+@njit(cache=True, nogil=True, inline="always")
+def _search_buffers(vmax, lmax):
+    """The scratch of :func:`_search_range` for bodies of up to ``vmax`` vertices and
+    ``lmax`` loops: two bodies' loop starts, the search's ``work`` and the state kernel's
+    scratch."""
+    return (np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64),
+            np.empty(work_floats(2 * vmax)),
+            state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax))
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): each pair takes a dozen
+# views of the World's arrays (its rows, its turned frames, the search's buffers), whose
+# atomic reference counts cost a tenth of a pair's search. Nothing in it may allocate:
+# the caller passes the buffers in, and what it calls that returns views is inlined.
+@njit(cache=True, nogil=True, _nrt=False)
+def _search_range(pi, pj, movers, world, settings, buffers, k0, k1, out):
+    """:func:`sweep_search` for the pairs ``k0:k1``, into ``out`` (``buffers``:
+    :func:`_search_buffers`)."""
     ids, pos, ang, rad, extent, motion = movers
     base, tables, frames, rows = world
     t_max, inflate, time_tol, rel, ulps, resolution, max_iter = settings
     code, t_hi, t_contact, state = out
-    sa = np.empty(lmax + 1, np.int64)
-    sb = np.empty(lmax + 1, np.int64)
-    work = np.empty(work_floats(2 * vmax))
-    scratch = state_scratch_views(np.empty(scratch_floats(2 * vmax)), 2 * vmax)
+    sa, sb, work, scratch = buffers
     for k in range(k0, k1):
         a = ids[pi[k]]
         b = ids[pj[k]]
@@ -272,12 +284,12 @@ def sweep_search(pi, pj, movers, base, tables, frames, rows, settings, vmax, lma
     n = pi.shape[0]
     out = (np.zeros(n, np.int8), np.empty(n), np.empty(n), np.zeros(n, np.int8))
     if chunks == 1:
-        _search_range(pi, pj, movers, (base, tables, frames, rows), settings, vmax, lmax, 0,
-                      n, out)
+        _search_range(pi, pj, movers, (base, tables, frames, rows), settings,
+                      _search_buffers(vmax, lmax), 0, n, out)
         return out
     for c in prange(chunks):
-        _search_range(pi, pj, movers, (base, tables, frames, rows), settings, vmax, lmax,
-                      n * c // chunks, n * (c + 1) // chunks, out)
+        _search_range(pi, pj, movers, (base, tables, frames, rows), settings,
+                      _search_buffers(vmax, lmax), n * c // chunks, n * (c + 1) // chunks, out)
     return out
 
 
