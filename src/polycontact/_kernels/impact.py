@@ -742,7 +742,7 @@ def pack_body(r, starts, centroid, radius, table):
     return f, i
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def unpack_body(f, i):
     """``(body, table)`` of a :func:`pack_body`, as views: ``body`` = ``(r, starts,
     centroid, radius)`` (see :func:`exact_search`), ``table`` its

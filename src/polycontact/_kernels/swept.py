@@ -290,11 +290,22 @@ def impacts_chunk(todo, pairs, shapes, settings, out):
     ``(code, t_hi, t_lo, contact, iters, reached, n_iv, iv)``, its broad-phase intervals
     to ``iv[p, :n_iv[p]]``.
     """
+    # every pair's buffers, reused
+    _impacts_into(todo, pairs, shapes, settings, out, np.empty(work_floats(2 * shapes[4])))
+
+
+# Compiled without Numba's reference counting (``_nrt=False``): each pair takes a dozen
+# views of the packed shapes and of the search's buffers, whose atomic reference counts
+# cost about a tenth of a pair's search. Nothing in it may allocate (the caller passes
+# ``work``), and what it calls that returns views is inlined.
+@njit(cache=True, nogil=True, _nrt=False)
+def _impacts_into(todo, pairs, shapes, settings, out, work):
+    """:func:`impacts_chunk` with its buffer passed in (``work``: at least
+    :func:`polycontact._kernels.impact.work_floats` of twice the widest shape)."""
     sa, sb, ma, mb, ka, kb, eps_rel = pairs
-    floats, f_off, ints, i_off, widest = shapes
+    floats, f_off, ints, i_off, _ = shapes
     t_max, inflate, time_tol, ulps, contact_resolution, max_iter, exact, samples = settings
     code, t_hi, t_lo, contact, iters, reached, n_iv, iv = out
-    work = np.empty(work_floats(2 * widest))  # every pair's buffers, reused
     for k in range(todo.shape[0]):
         p = todo[k]
         a, ea = unpack_body(floats[f_off[sa[p]]:f_off[sa[p] + 1]],
