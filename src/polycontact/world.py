@@ -511,7 +511,7 @@ class Sweep:
 def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarray]:
     """Point and normal of pair k of a Sweep's events by :func:`polycontact.classify`
     (for bodies too large for the compiled depth)."""
-    (pa, pb, times, ca, cb, ta, tb, _, _, _, ma, mb), (bxy, ls, lo, nl, cen) = ev[:2]
+    (pa, pb, times, ca, cb, ta, tb, _, _, _, ma, mb, _), (bxy, ls, lo, nl, cen) = ev[:2]
     shapes = []
     for b, c, turn, m in ((pa[k], ca[k], ta[k], ma[k]), (pb[k], cb[k], tb[k], mb[k])):
         st = ls[lo[b] : lo[b] + nl[b] + 1]
@@ -1656,7 +1656,8 @@ class World:
         times = t_contact[order]
         events = ((a, b, times, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
                    self._rad[a], self._rad[b],
-                   RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j]),
+                   RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j],
+                   code[order] == 2),  # (penetrating at the start)
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
                   (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
                   ROUNDING_FACTOR)

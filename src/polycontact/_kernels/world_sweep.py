@@ -21,8 +21,9 @@ reports it, without turning anything; if not, the search starts from there witho
 classifying it again.
 
 At the first contact time of a pair (time 0 when it touches or penetrates at the
-start), both bodies are placed and classified, and the contact's point and normal are
-those of :func:`polycontact._kernels.contact_geometry.pair_geometry_into` in that state.
+start), both bodies are placed and classified (a pair found penetrating at the start is
+not classified again), and the contact's point and normal are those of
+:func:`polycontact._kernels.contact_geometry.pair_geometry_into` in that state.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from numba import prange
 from .jit import njit
 from .advance import edge_table
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
-from .impact import INITIALLY_PENETRATING, query_intervals, query_search, state_at, \
+from .impact import INITIALLY_PENETRATING, place, query_intervals, query_search, state_at, \
     tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, view
 from .relation import PENETRATING, state_in
@@ -298,7 +299,7 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
     """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``.
     The two bodies of an event are placed side by side as the rows of a World of two
     (``rows``, one pair), for :func:`polycontact._kernels.contact_geometry.geometry_into`."""
-    pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb = events
+    pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb, at_start = events
     base, tables, frames = world
     fa = np.empty(lmax + 1, np.int64)
     fb = np.empty(lmax + 1, np.int64)
@@ -327,8 +328,13 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
         ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
         t = times[k]
         eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
-        pair[2][0] = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k], t,
-                              eps, (xy[:n1], xy[n1:n1 + n2], scratch))
+        if at_start[k]:  # penetrating at t = 0, as the search classified the stored rows
+            place(r1, ca[k], ma[k], t, xy[:n1])
+            place(r2, cb[k], mb[k], t, xy[n1:n1 + n2])
+            pair[2][0] = PENETRATING
+        else:
+            pair[2][0] = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k],
+                                  t, eps, (xy[:n1], xy[n1:n1 + n2], scratch))
         pair[3][0] = eps
         out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
         while True:
@@ -344,11 +350,12 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
 @njit(cache=True, nogil=True, parallel=True)
 def event_geometry(events, base, tables, frames, vmax, lmax, ulps, chunks):
     """The contact point and normal of each event of ``events`` = ``(pa, pb, times, ca,
-    cb, ta, tb, la, lb, eps_rel, ma, mb)``: bodies ``pa[k]`` and ``pb[k]`` at
+    cb, ta, tb, la, lb, eps_rel, ma, mb, at_start)``: bodies ``pa[k]`` and ``pb[k]`` at
     ``times[k]``, each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]``
     (``tb[k]``) with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact
-    search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``) and
-    described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
+    search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``; a pair
+    that ``at_start[k]`` says the search found penetrating at t = 0 is not classified
+    again) and described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
     normals where the depth is left undecided. ``base``, ``tables``, ``frames``: as for
     :func:`sweep_search`, the bodies turned by those turns. In parallel chunks."""
     n = events[0].shape[0]
