@@ -42,13 +42,18 @@ print(got == [1] * 50 + [2] * 50 + [0] * 50)
 @pytest.mark.slow  # compiles from an empty cache
 @pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="compiled code only")
 def test_scratch_views_compiled_first_from_a_kernel_without_reference_counting(tmp_path):
+    assert _printed(CODE, tmp_path)[:3] == ["1", "[5, 5, 5, 5, 5]", "True"]
+
+
+def _printed(code: str, cache: Path) -> list[str]:
+    """The lines ``code`` prints, run in a subprocess compiling into the empty ``cache``."""
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    env.update(NUMBA_CACHE_DIR=str(tmp_path),
+    env.update(NUMBA_CACHE_DIR=str(cache),
                PYTHONPATH=os.pathsep.join([str(SRC), env.get("PYTHONPATH", "")]))
-    out = subprocess.run([sys.executable, "-c", CODE], capture_output=True, text=True,
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=env, timeout=900)
     assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.split("\n")[:3] == ["1", "[5, 5, 5, 5, 5]", "True"]
+    return out.stdout.split("\n")
 
 
 SWEEP_FIRST = """
@@ -80,10 +85,5 @@ def test_broad_phase_compiled_first_from_the_swept_search_keeps_its_arrays(tmp_p
     # the World's swept search runs without reference counting; the broad-phase helper
     # that returns its argument is inlined, so a reference-counted caller compiled
     # after it still owns the arrays it gets back
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
-    env.update(NUMBA_CACHE_DIR=str(tmp_path),
-               PYTHONPATH=os.pathsep.join([str(SRC), env.get("PYTHONPATH", "")]))
-    out = subprocess.run([sys.executable, "-c", SWEEP_FIRST], capture_output=True,
-                         text=True, env=env, timeout=900)
-    assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.split("\n")[:4] == ["[[0, 1]] [0.5]", "True True", "True", "hit 2.0"]
+    assert _printed(SWEEP_FIRST, tmp_path)[:4] == ["[[0, 1]] [0.5]", "True True", "True",
+                                                   "hit 2.0"]
