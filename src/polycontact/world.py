@@ -1629,9 +1629,9 @@ class World:
         self._check_motions(ids, motion, step)
         pos = self._pos[ids]
         cand = swept_pairs(pos, motion, self._rad[ids], step)
-        met = np.zeros(n, np.bool_)
-        met[cand.reshape(-1)] = True
-        bodies = ids[np.flatnonzero(met)]  # (in the pairs, each once, in order)
+        paired = np.zeros(n, np.bool_)
+        paired[cand.reshape(-1)] = True
+        bodies = ids[np.flatnonzero(paired)]  # (in the pairs, each once, in order)
         self._sweep_frames(bodies)
         tint, tflt, tio, tfo = self._frames[:4]
         box = self._box
