@@ -15,6 +15,9 @@ within the tolerance of the input's linework. Where it is not:
   snap-rounded onto that grid, which moves each vertex by less than a grid step.
 
 Every vertex of a repaired shape lies within the tolerance of the input's linework.
+Far from the origin (1e3 and more, features a thousand times smaller) GEOS's overlay can
+misread the loops' crossings into another region: a repair whose region differs from
+GEOS's reading of the loops moved exactly to their corner is refused.
 """
 
 from __future__ import annotations
@@ -73,7 +76,34 @@ def repaired(rings: Sequence[np.ndarray], why: str,
     if off > eps:
         raise InvalidShapeError(f"cannot repair: {why}; the repair moves the outline by "
                                 f"{off:.3g}, beyond the tolerance {eps:.3g}")
+    near = _read_about_corner(rings)
+    if near is not None and (shapely.symmetric_difference(poly, near).area
+                             > 2.0 * eps * (poly.length + near.length)):
+        raise InvalidShapeError(f"cannot repair: {why}; GEOS reads another region from the "
+                                "loops moved exactly to their corner (far from the origin its "
+                                "overlay can misread their crossings)")
     return poly, grid if snapped else 0.0, note
+
+
+def _read_about_corner(rings: Sequence[np.ndarray]) -> Any:
+    """``make_valid(method="structure")`` of the loops moved to the lower corner of their
+    box and moved back, or None when that move is not exact (Sterbenz: every
+    coordinate within a factor 2 of the corner's) or moves nothing. About the corner
+    GEOS's overlay reads the crossings of far-off loops (1e3 from the origin and more,
+    features a thousand times smaller) as they are: a repair whose region differs from
+    that reading by more than a band of the tolerance along both outlines is refused."""
+    import shapely
+
+    pts = [r for r in rings if len(r)]
+    if not pts:
+        return None
+    corner = np.min([r.min(axis=0) for r in pts], axis=0)
+    local = [r - corner for r in rings]
+    if not corner.any() or not all(np.array_equal(q + corner, r) for q, r in zip(local, rings)):
+        return None
+    read = shapely.make_valid(shapely.Polygon(local[0], local[1:]), method="structure",
+                              keep_collapsed=False)
+    return shapely.affinity.translate(read, *corner)
 
 
 def _structure(rings: Sequence[np.ndarray], grid: float, why: str) -> tuple[Any, bool]:
