@@ -1607,6 +1607,7 @@ class World:
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]
         """
+        from ._kernels.impact import HIT, INITIALLY_PENETRATING
         from ._kernels.world_sweep import sweep_search, turned_frames
 
         step = finite_number(dt, "dt", minimum=0.0)
@@ -1657,11 +1658,12 @@ class World:
         events = ((a, b, times, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
                    self._rad[a], self._rad[b],
                    RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j],
-                   code[order] == 2),  # (penetrating at the start)
+                   code[order] == INITIALLY_PENETRATING),
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
                   (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
                   ROUNDING_FACTOR)
-        hit = np.where(code[order] == 2, 0.0, np.where(code[order] == 1, t_hit[order], np.nan))
+        hit = np.where(code[order] == INITIALLY_PENETRATING, 0.0,
+                       np.where(code[order] == HIT, t_hit[order], np.nan))
         return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
                      events)
 
