@@ -87,20 +87,24 @@ def repaired(rings: Sequence[np.ndarray], why: str,
 
 def _read_about_corner(rings: Sequence[np.ndarray]) -> Any:
     """``make_valid(method="structure")`` of the loops moved to the lower corner of their
-    box and moved back, or None when that move is not exact (Sterbenz: every
-    coordinate within a factor 2 of the corner's) or moves nothing. About the corner
-    GEOS's overlay reads the crossings of far-off loops (1e3 from the origin and more,
-    features a thousand times smaller) as they are: a repair whose region differs from
-    that reading by more than a band of the tolerance along both outlines is refused."""
+    box and moved back, or None when that moves nothing. Each coordinate moves only
+    where the move is exact for every vertex (Sterbenz: within a factor 2 of the
+    corner's; checked), so the loops read are the caller's. About the corner GEOS's
+    overlay reads the crossings of far-off loops (1e3 from the origin and more, features
+    a thousand times smaller) as they are: a repair whose region differs from that
+    reading by more than a band of the tolerance along both outlines is refused."""
     import shapely
 
     pts = [r for r in rings if len(r)]
     if not pts:
         return None
     corner = np.min([r.min(axis=0) for r in pts], axis=0)
-    local = [r - corner for r in rings]
-    if not corner.any() or not all(np.array_equal(q + corner, r) for q, r in zip(local, rings)):
+    for c in range(2):  # (a coordinate whose move would round stays where it is)
+        if not all(np.array_equal((r[:, c] - corner[c]) + corner[c], r[:, c]) for r in pts):
+            corner[c] = 0.0
+    if not corner.any():
         return None
+    local = [r - corner for r in rings]
     read = shapely.make_valid(shapely.Polygon(local[0], local[1:]), method="structure",
                               keep_collapsed=False)
     return shapely.affinity.translate(read, *corner)

@@ -301,9 +301,12 @@ def test_a_far_off_ring_geos_misreads_is_refused_not_repaired_wrongly():
     # area 0.0489, and the repair made 0.0518 of it; moved exactly to its corner GEOS
     # reads two polygons (one of them of 1e-3 the area): the repair refuses
     ring = np.array([(0.0, 0.0), (0.4, 0.6), (0.3, 0.5), (0.6, 0.8), (0.0, 0.0), (0.4, 0.7),
-                     (0.1, 0.0)]) + 1e9
-    with pytest.raises(InvalidShapeError, match="cannot repair: .*moved exactly to their corner"):
-        Shape(ring, repair=True)
+                     (0.1, 0.0)])
+    # (also far out in x alone, y near the origin)
+    for offset in ((1e9, 1e9), (1e9, 0.001)):
+        with pytest.raises(InvalidShapeError,
+                           match="cannot repair: .*moved exactly to their corner"):
+            Shape(ring + offset, repair=True)
 
 
 def test_a_repair_snaps_what_geos_leaves_meeting(monkeypatch):
