@@ -6,7 +6,10 @@ import numpy as np
 import pytest
 
 from polycontact import Shape
-from polycontact._kernels.impact_batch import pack_rings, pair_bodies, ring_bodies, table_sizes
+from polycontact._kernels.advance import edge_table
+from polycontact._kernels.impact import pack_body
+from polycontact._kernels.impact_batch import body_tables, pack_rings, pair_bodies, ring_bodies, \
+    table_sizes
 from polycontact.relation import RING_ARGS
 
 
@@ -43,6 +46,36 @@ def test_table_sizes_give_the_most_vertices_of_the_bodies_that_get_a_table():
     assert widest == 5
     assert np.diff(f_off).tolist() == [11 * 3 - 1, 0, 11 * 4 - 1, 11 * 5 - 1]
     assert np.diff(i_off).tolist() == [7 * 3 + 2, 0, 7 * 4 + 3, 7 * 5 + 2]
+
+
+def test_body_tables_are_each_bodys_pack_body_bit_for_bit():
+    """The tables built in place, body after body with one scratch (a wide body before
+    narrower ones, a body with holes, bodies left out), are the arrays ``pack_body``
+    makes for each body alone."""
+    rng = np.random.default_rng(5)
+    shapes = [Shape(np.c_[np.cos(t), np.sin(t)] * rng.uniform(0.5, 1.0, (len(t), 1)) * 10.0
+                    ** rng.uniform(-6, 6) + rng.uniform(-1e3, 1e3, 2))
+              for t in (np.sort(rng.uniform(0, 2 * np.pi, n)) for n in (40, 3, 12, 7, 25))]
+    shapes.insert(2, Shape([(0, 0), (6, 0), (6, 6), (0, 6)],
+                           [[(1, 1), (2, 1), (2, 2), (1, 2)], [(3, 3), (5, 3), (5, 5)]]))
+    xy = np.concatenate([s.packed[0] for s in shapes])
+    rows = np.r_[0, np.cumsum([len(s.packed[0]) for s in shapes])].astype(np.int64)
+    starts = np.concatenate([s.packed[1] for s in shapes]).astype(np.int64)
+    st_off = np.r_[0, np.cumsum([len(s.packed[1]) for s in shapes])].astype(np.int64)
+    centroids = np.array([s.centroid for s in shapes])
+    radii = np.array([s.bounding_radius for s in shapes])
+    wanted = np.array([True, True, True, False, True, True])
+    f_off, i_off, _ = table_sizes(rows, st_off, wanted)
+    floats, ints = np.full(f_off[-1], np.nan), np.full(i_off[-1], -7, np.int64)
+    body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, 0, len(shapes),
+                floats, ints)
+    for u, s in enumerate(shapes):
+        if not wanted[u]:
+            continue
+        r = s.packed[0] - centroids[u]
+        f, i = pack_body(r, s.packed[1], centroids[u], radii[u], edge_table(r, s.packed[1]))
+        assert np.array_equal(floats[f_off[u]:f_off[u + 1]].view(np.int64), f.view(np.int64))
+        assert np.array_equal(ints[i_off[u]:i_off[u + 1]], i)
 
 
 def test_ring_bodies_measure_and_pack_rings_as_shape_does():

@@ -58,8 +58,27 @@ def edge_table(r, starts):
     ([1, 2, 3, 0], (7, 3), 2.0)
     """
     n = r.shape[0]
-    nxt = np.empty(n, np.int64)
-    r_len = np.empty(n)
+    out = (np.empty(n, np.int64), np.empty((2 * n - 1, 3), np.int64),
+           np.empty((2 * n - 1, 4)), np.empty(n))
+    edge_table_into(r, starts, out, table_scratch(n))
+    return out
+
+
+@njit(cache=True, nogil=True)
+def table_scratch(n):
+    """Scratch of :func:`edge_table_into` for bodies of up to ``n`` vertices."""
+    return np.empty((2 * n - 1, 2), np.int64), np.empty(2 * n), np.empty(2 * n)
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def edge_table_into(r, starts, out, scratch):
+    """:func:`edge_table` of the body ``(r, starts)`` written into ``out`` = ``(nxt,
+    links, circles, r_len)``, arrays of its shapes (n, (2n − 1, 3), (2n − 1, 4), n),
+    with no allocation: views of a caller's buffers. ``scratch``: :func:`table_scratch`
+    of at least n vertices."""
+    nxt, links, circles, r_len = out
+    span, px, py = scratch                   # span[k]: node k's edges span[k, 0]:span[k, 1]
+    n = r.shape[0]
     for k in range(starts.shape[0] - 1):
         s = starts[k]
         e = starts[k + 1]
@@ -67,11 +86,9 @@ def edge_table(r, starts):
             nxt[j] = j + 1 if j + 1 < e else s
             r_len[j] = np.sqrt(r[j, 0] * r[j, 0] + r[j, 1] * r[j, 1])
     size = 2 * n - 1
-    links = np.full((size, 3), -1, np.int64)
-    circles = np.empty((size, 4))
-    span = np.empty((size, 2), np.int64)     # the node's edges: span[k, 0]:span[k, 1]
-    px = np.empty(2 * n)
-    py = np.empty(2 * n)
+    for k in range(size):
+        for c in range(3):
+            links[k, c] = -1
     span[0, 0] = 0
     span[0, 1] = n
     count = 1
@@ -107,10 +124,9 @@ def edge_table(r, starts):
             span[count + 1, 0] = m
             span[count + 1, 1] = b
             count += 2
-    return nxt, links, circles, r_len
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _smallest_circle(px, py, m, seed):
     """Centre of the smallest circle holding the points ``px[:m], py[:m]`` (Welzl's
     incremental algorithm, expected O(m) after a pseudo-random shuffle seeded by

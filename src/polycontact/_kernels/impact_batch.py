@@ -23,8 +23,8 @@ import math
 import numpy as np
 
 from .jit import njit
-from .advance import edge_table
-from .impact import pack_body
+from .advance import edge_table_into, table_scratch
+from .packs import vector, view
 from .rings import raw_ring
 
 
@@ -51,19 +51,33 @@ def table_sizes(rows, st_off, wanted):
     return f_off, i_off, widest
 
 
-@njit(cache=True, nogil=True)
-def _body_into(xy, rows, starts, st_off, centroids, radii, u, f_out, i_out):
-    """Body u's ``pack_body`` arrays, written into ``f_out`` and ``i_out``."""
+@njit(cache=True, nogil=True, _nrt=False)
+def _body_into(xy, rows, starts, st_off, centroids, radii, u, f_out, fo, i_out, io, scratch):
+    """Body u's ``pack_body`` arrays, written into ``f_out`` from ``fo`` and ``i_out``
+    from ``io`` (the tables built in place, no allocation; ``scratch``:
+    :func:`polycontact._kernels.advance.table_scratch` of at least its vertices)."""
     r0 = rows[u]
     n = rows[u + 1] - r0
-    r = np.empty((n, 2))
+    s0 = st_off[u]
+    k = st_off[u + 1] - s0
+    m = 2 * n - 1
+    f_out[fo] = centroids[u, 0]
+    f_out[fo + 1] = centroids[u, 1]
+    f_out[fo + 2] = radii[u]
+    r = view(f_out, fo + 3, n, 2, np.float64)
     for i in range(n):
         r[i, 0] = xy[r0 + i, 0] - centroids[u, 0]
         r[i, 1] = xy[r0 + i, 1] - centroids[u, 1]
-    st = starts[st_off[u] : st_off[u + 1]]
-    f, ints = pack_body(r, st, centroids[u], radii[u], edge_table(r, st))
-    f_out[:] = f
-    i_out[:] = ints
+    i_out[io] = n
+    i_out[io + 1] = k
+    i_out[io + 2] = m
+    for q in range(k):
+        i_out[io + 3 + q] = starts[s0 + q]
+    table = (vector(i_out, io + 3 + k, n, np.int64),
+             view(i_out, io + 3 + k + n, m, 3, np.int64),
+             view(f_out, fo + 3 + 2 * n, m, 4, np.float64),
+             vector(f_out, fo + 3 + 2 * n + 4 * m, n, np.float64))
+    edge_table_into(r, vector(i_out, io + 3, k, np.int64), table, scratch)
 
 
 @njit(cache=True, nogil=True)
@@ -75,11 +89,15 @@ def body_tables(xy, rows, starts, st_off, centroids, radii, f_off, i_off, u0, u1
     ``impacts_chunk`` reads them; the caller splits the bodies over threads.
     ``centroids`` (U, 2) and ``radii`` (U,): each body's area centroid and bounding
     radius. Bodies given no room (not wanted by :func:`table_sizes`) are skipped."""
+    widest = 1
+    for u in range(u0, u1):
+        widest = max(widest, rows[u + 1] - rows[u])
+    scratch = table_scratch(widest)
     for u in range(u0, u1):
         if f_off[u + 1] == f_off[u]:
             continue
-        _body_into(xy, rows, starts, st_off, centroids, radii, u,
-                   floats[f_off[u] : f_off[u + 1]], ints[i_off[u] : i_off[u + 1]])
+        _body_into(xy, rows, starts, st_off, centroids, radii, u, floats, f_off[u], ints,
+                   i_off[u], scratch)
 
 
 @njit(cache=True, nogil=True)

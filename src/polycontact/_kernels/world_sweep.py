@@ -34,11 +34,11 @@ import numpy as np
 from numba import prange
 
 from .jit import njit
-from .advance import edge_table
+from .advance import edge_table_into, table_scratch
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
 from .impact import INITIALLY_PENETRATING, place, query_intervals, query_search, state_at, \
     tolerance_at, work_floats
-from .packs import scratch_floats, state_scratch_views, view
+from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
 from .world import body_view
 
@@ -52,27 +52,31 @@ def frame_tables(base, bodies, tables):
     set by the caller (n vertices: n + 3 (2n − 1) ints, 4 (2n − 1) floats)."""
     bxy, ls, lo, nl, cen = base
     tint, tflt, tio, tfo = tables
+    widest = 1
+    loops = 1
+    for k in range(bodies.shape[0]):
+        b = bodies[k]
+        widest = max(widest, ls[lo[b] + nl[b]] - ls[lo[b]])
+        loops = max(loops, nl[b])
+    r_buf = np.empty((widest, 2))
+    st_buf = np.empty(loops + 1, np.int64)
+    r_len = np.empty(widest)
+    scratch = table_scratch(widest)
     for k in range(bodies.shape[0]):
         b = bodies[k]
         f = ls[lo[b]]
         n = ls[lo[b] + nl[b]] - f
-        r = np.empty((n, 2))
+        r = r_buf[:n]
         for i in range(n):
             r[i, 0] = bxy[f + i, 0] - cen[b, 0]
             r[i, 1] = bxy[f + i, 1] - cen[b, 1]
-        st = np.empty(nl[b] + 1, np.int64)
         for q in range(nl[b] + 1):
-            st[q] = ls[lo[b] + q] - f
-        nxt, links, circles, _ = edge_table(r, st)
+            st_buf[q] = ls[lo[b] + q] - f
         m = 2 * n - 1
         io = tio[b]
-        fo = tfo[b]
-        tint[io:io + n] = nxt
-        for q in range(m):
-            for c in range(3):
-                tint[io + n + 3 * q + c] = links[q, c]
-            for c in range(4):
-                tflt[fo + 4 * q + c] = circles[q, c]
+        table = (vector(tint, io, n, np.int64), view(tint, io + n, m, 3, np.int64),
+                 view(tflt, tfo[b], m, 4, np.float64), r_len[:n])
+        edge_table_into(r, st_buf[:nl[b] + 1], table, scratch)
 
 
 @njit(cache=True, nogil=True)
