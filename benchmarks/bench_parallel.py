@@ -9,6 +9,9 @@ Paths (size, then the ``--quick`` size):
   call, each body staying in or leaving its grid cell);
 - ``geometry``: the contact geometry of that World's contacts (``Contacts.distances``:
   normals, points, overlaps of every pair in one compiled pass);
+- ``sweep``: ``World.sweep`` of that World, every body moving a tenth of its size in the
+  step and turning by up to 0.2 radian (bench_step's step): the pairs that meet, their
+  times and states;
 - ``classify_many``: 10⁶ pairs (10⁵) of such 12-gons as (P, N, 2) arrays, each ring
   against a copy moved by up to 0.8 (most pairs overlap);
 - ``distances``: the signed distances of 10⁵ of those pairs (10⁴), given as Shapes;
@@ -82,6 +85,9 @@ PARALLEL = [
     ("polycontact._kernels.poses", "pose_rows"),
     ("polycontact._kernels.poses", "pose_checks"),
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
+    ("polycontact._kernels.world_sweep", "turned_frames"),
+    ("polycontact._kernels.world_sweep", "sweep_search"),
+    ("polycontact._kernels.world_sweep", "event_geometry"),
     ("polycontact._kernels.contact_geometry", "boundary_gaps"),
     ("polycontact._kernels.relation_many", "many_distances"),
     ("polycontact._kernels.impact_batch", "body_tables"),
@@ -237,6 +243,26 @@ class Geometry(WorldPath):
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
         c = self.contacts
         return c.distances, c.normals, c.points, c.overlap_areas
+
+
+class Sweep(WorldPath):
+    """``World.sweep`` of that World, each body moving a tenth of its size in the step
+    (a random heading) and turning by up to 0.2 radian, as in bench_step."""
+
+    name = "sweep"
+
+    def __init__(self, w: WorldPaths) -> None:
+        super().__init__(w)
+        rng = np.random.default_rng(2)
+        n = len(w.ids)
+        self.dt = 0.01
+        heading = rng.uniform(0.0, 2.0 * np.pi, n)
+        self.vel = 0.12 / self.dt * np.c_[np.cos(heading), np.sin(heading)]
+        self.spin = rng.uniform(-0.2, 0.2, n) / self.dt
+
+    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+        ev = self.w.world.sweep(self.dt, self.vel, self.spin)
+        return ev.pairs, ev.times, ev.states
 
 
 class ClassifyMany(Path):
@@ -510,7 +536,7 @@ def main() -> None:
                     "contacts,time_of_impact_many,time_of_impact_many_rows,"
                     "time_of_impact_many_arrays,nfp_table,"
                     "nfp_table_workers,classify_many,set_poses,first_impacts,distances,"
-                    "geometry,dask")
+                    "geometry,sweep,dask")
     ap.add_argument("--json", metavar="OUT", help="write the figures to this file")
     args = ap.parse_args()
     most = int(numba.config.NUMBA_NUM_THREADS)
@@ -530,7 +556,7 @@ def main() -> None:
               ["contacts", "time_of_impact_many", "time_of_impact_many_rows",
                "time_of_impact_many_arrays", "nfp_table", "nfp_table_workers",
                "classify_many", "set_poses", "first_impacts",
-               "distances", "geometry", "dask"])
+               "distances", "geometry", "sweep", "dask"])
     head = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "command": " ".join(["python", *sys.argv]), "machine": machine(),
             "cpus": os.cpu_count(), "numba_threads": most,
@@ -548,10 +574,10 @@ def main() -> None:
     for name in chosen:
         if name == "dask":
             continue
-        if name in ("contacts", "set_poses", "geometry"):
+        if name in ("contacts", "set_poses", "geometry", "sweep"):
             world = world or WorldPaths(SIZES["contacts"][q])
             path: Path = {"contacts": Contacts, "set_poses": SetPoses,
-                          "geometry": Geometry}[name](world)
+                          "geometry": Geometry, "sweep": Sweep}[name](world)
         elif name in ("classify_many", "distances"):
             path = ClassifyMany(SIZES[name][q], name == "distances")
         elif name in ("time_of_impact_many", "time_of_impact_many_rows"):

@@ -511,17 +511,18 @@ class Sweep:
 def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarray]:
     """Point and normal of pair k of a Sweep's events by :func:`polycontact.classify`
     (for bodies too large for the compiled depth)."""
-    (pa, pb, times, ca, cb, ta, tb, _, _, _, ma, mb, _), (bxy, ls, lo, nl, cen) = ev[:2]
+    (ei, ej, times, _), (ids, pos, ang, _, _, motion, _), (bxy, ls, lo, nl, cen) = ev[:3]
     shapes = []
-    for b, c, turn, m in ((pa[k], ca[k], ta[k], ma[k]), (pb[k], cb[k], tb[k], mb[k])):
+    for row in (ei[k], ej[k]):
+        b, c, turn, m = ids[row], pos[row], ang[row], motion[row]
         st = ls[lo[b] : lo[b] + nl[b] + 1]
         r = bxy[st[0] : st[-1]] - cen[b]
         cs, sn = np.cos(turn), np.sin(turn)
         xy = np.c_[r[:, 0] * cs - r[:, 1] * sn, r[:, 0] * sn + r[:, 1] * cs] + c
         loops = [xy[st[q] - st[0] : st[q + 1] - st[0]] for q in range(len(st) - 1)]
-        motion = Motion(velocity=(m[0], m[1]), acceleration=(m[2], m[3]),
+        moving = Motion(velocity=(m[0], m[1]), acceleration=(m[2], m[3]),
                         angular_velocity=m[4], angular_acceleration=m[5])
-        shapes.append(Shape._trusted(loops).at(motion, float(times[k])))
+        shapes.append(Shape._trusted(loops).at(moving, float(times[k])))
     r = classify(shapes[0], shapes[1])
     point = r.point if r.point is not None else np.full(2, np.nan)
     normal = r.normal if r.normal is not None else np.full(2, np.nan)
@@ -1629,7 +1630,8 @@ class World:
             raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
         self._check_motions(ids, motion, step)
         pos = self._pos[ids]
-        cand = swept_pairs(pos, motion, self._rad[ids], step)
+        rad = self._rad[ids]
+        cand = swept_pairs(pos, motion, rad, step)
         paired = np.zeros(n, np.bool_)
         paired[cand.reshape(-1)] = True
         bodies = ids[np.flatnonzero(paired)]  # (in the pairs, each once, in order)
@@ -1655,17 +1657,17 @@ class World:
         i, j = pi[order], pj[order]
         a, b = ids[i], ids[j]
         times = t_contact[order]
-        events = ((a, b, times, self._pos[a], self._pos[b], self._ang[a], self._ang[b],
-                   self._rad[a], self._rad[b],
-                   RELATIVE_TOLERANCE * np.maximum(extent[a], extent[b]), motion[i], motion[j],
-                   code[order] == INITIALLY_PENETRATING),
+        codes = code[order]
+        start = codes == INITIALLY_PENETRATING
+        # what the points and normals come from, if asked: the events as rows of the
+        # bodies, and the bodies as they stand now (the World may move them after)
+        events = ((i, j, times, start),
+                  (ids, pos, self._ang[ids], rad, extent[ids], motion, RELATIVE_TOLERANCE),
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
                   (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
                   ROUNDING_FACTOR)
-        hit = np.where(code[order] == INITIALLY_PENETRATING, 0.0,
-                       np.where(code[order] == HIT, t_hit[order], np.nan))
-        return Sweep(np.stack([a, b], axis=1), times, state[order], hit, code[order], step,
-                     events)
+        hit = np.where(start, 0.0, np.where(codes == HIT, t_hit[order], np.nan))
+        return Sweep(np.stack([a, b], axis=1), times, state[order], hit, codes, step, events)
 
     def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float) -> None:
         """Refuse motions that would carry a body's coordinates, its points' speeds or

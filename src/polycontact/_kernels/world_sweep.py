@@ -299,11 +299,12 @@ def sweep_search(pi, pj, movers, base, tables, frames, rows, settings, vmax, lma
 
 
 @njit(cache=True, nogil=True)
-def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
+def _event_range(events, movers, world, vmax, lmax, ulps, k0, k1, point, normal):
     """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``.
     The two bodies of an event are placed side by side as the rows of a World of two
     (``rows``, one pair), for :func:`polycontact._kernels.contact_geometry.geometry_into`."""
-    pa, pb, times, ca, cb, ta, tb, la, lb, eps_rel, ma, mb, at_start = events
+    ei, ej, times, at_start = events
+    ids, pos, ang, rad, extent, motion, rel = movers
     base, tables, frames = world
     fa = np.empty(lmax + 1, np.int64)
     fb = np.empty(lmax + 1, np.int64)
@@ -321,8 +322,10 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
     rest = (np.empty(1), np.empty((1, 2)), np.empty(1, np.int8), np.empty(1, np.int64),
             np.empty(1, np.int64))
     for k in range(k0, k1):
-        r1, s1, _ = _turned(pa[k], base, tables, frames, fa)
-        r2, s2, _ = _turned(pb[k], base, tables, frames, fb)
+        i = ei[k]
+        j = ej[k]
+        r1, s1, _ = _turned(ids[i], base, tables, frames, fa)
+        r2, s2, _ = _turned(ids[j], base, tables, frames, fb)
         n1 = r1.shape[0]
         n2 = r2.shape[0]
         nl[0] = s1.shape[0] - 1
@@ -331,14 +334,17 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
         ls[:nl[0] + 1] = s1
         ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
         t = times[k]
-        eps = tolerance_at(ca[k], ma[k], la[k], cb[k], mb[k], lb[k], t, eps_rel[k], ulps)
+        eps_rel = rel * max(extent[i], extent[j])
+        eps = tolerance_at(pos[i], motion[i], rad[i], pos[j], motion[j], rad[j], t, eps_rel,
+                           ulps)
         if at_start[k]:  # penetrating at t = 0, as the search classified the stored rows
-            place(r1, ca[k], ma[k], t, xy[:n1])
-            place(r2, cb[k], mb[k], t, xy[n1:n1 + n2])
+            place(r1, pos[i], motion[i], t, xy[:n1])
+            place(r2, pos[j], motion[j], t, xy[n1:n1 + n2])
             pair[2][0] = PENETRATING
         else:
-            pair[2][0] = state_at((r1, s1, ca[k], la[k]), ma[k], (r2, s2, cb[k], lb[k]), mb[k],
-                                  t, eps, (xy[:n1], xy[n1:n1 + n2], scratch))
+            pair[2][0] = state_at((r1, s1, pos[i], rad[i]), motion[i],
+                                  (r2, s2, pos[j], rad[j]), motion[j], t, eps,
+                                  (xy[:n1], xy[n1:n1 + n2], scratch))
         pair[3][0] = eps
         out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
         while True:
@@ -352,23 +358,26 @@ def _event_range(events, world, vmax, lmax, ulps, k0, k1, point, normal):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def event_geometry(events, base, tables, frames, vmax, lmax, ulps, chunks):
-    """The contact point and normal of each event of ``events`` = ``(pa, pb, times, ca,
-    cb, ta, tb, la, lb, eps_rel, ma, mb, at_start)``: bodies ``pa[k]`` and ``pb[k]`` at
-    ``times[k]``, each moving from its centroid ``ca[k]`` (``cb[k]``) and turn ``ta[k]``
-    (``tb[k]``) with ``ma[k]`` (``mb[k]``), classified there with the time-of-impact
-    search's tolerance (``eps_rel[k]``, bounding radii ``la``, ``lb``, ``ulps``; a pair
-    that ``at_start[k]`` says the search found penetrating at t = 0 is not classified
-    again) and described by :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN
-    normals where the depth is left undecided. ``base``, ``tables``, ``frames``: as for
+def event_geometry(events, movers, base, tables, frames, vmax, lmax, ulps, chunks):
+    """The contact point and normal of each event of ``events`` = ``(ei, ej, times,
+    at_start)``: bodies ``ids[ei[k]]`` and ``ids[ej[k]]`` at ``times[k]``, of ``movers``
+    = ``(ids, pos, ang, rad, extent, motion, rel)``, rows in the order of ``ids``: each
+    body moving from its centroid ``pos`` and turn ``ang`` with its kernel vector
+    ``motion``; classified there with the time-of-impact search's tolerance (``rel``
+    times the larger ``extent`` of the two, bounding radii ``rad``, ``ulps``; a pair that
+    ``at_start[k]`` says the search found penetrating at t = 0 is not classified again)
+    and described by
+    :func:`polycontact._kernels.contact_geometry.pair_geometry_into`; NaN normals where
+    the depth is left undecided. ``base``, ``tables``, ``frames``: as for
     :func:`sweep_search`, the bodies turned by those turns. In parallel chunks."""
     n = events[0].shape[0]
     point = np.full((n, 2), np.nan)
     normal = np.full((n, 2), np.nan)
     if chunks == 1:
-        _event_range(events, (base, tables, frames), vmax, lmax, ulps, 0, n, point, normal)
+        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, 0, n, point,
+                     normal)
         return point, normal
     for c in prange(chunks):
-        _event_range(events, (base, tables, frames), vmax, lmax, ulps, n * c // chunks,
-                     n * (c + 1) // chunks, point, normal)
+        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps,
+                     n * c // chunks, n * (c + 1) // chunks, point, normal)
     return point, normal
