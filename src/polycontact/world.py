@@ -30,7 +30,8 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import weakref
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, cast
@@ -90,6 +91,9 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
 _GRID_WORK = 0.3  # moving a body to another cell of the grid (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
+_TURN_ROOMS = 2  # rooms for a sweep's turned frames that a World keeps (see _turn_room)
+#: A room for a sweep's turned frames: rows, their lengths, circles.
+_Room = tuple[np.ndarray, np.ndarray, np.ndarray]
 _BODY_WORK = 6.0  # a body's broad-phase query and the classification of its pairs
 
 
@@ -529,6 +533,11 @@ def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarra
     return point, normal
 
 
+def _no_owner() -> None:
+    """The owner of a room of turned frames that no Sweep reads."""
+    return None
+
+
 def _angle(angle: Any) -> float:
     return finite_number(angle, "angle")
 
@@ -756,6 +765,8 @@ class World:
         self._emax = 0.0  # an upper bound of the bodies' tolerances (never lowered)
         self._origin: np.ndarray | None = None
         self._frames: Any = None  # the sweep's body-frame tables (see _sweep_frames)
+        # rooms for the sweep's turned frames, each with the Sweep that reads it
+        self._turn_pool: list[tuple[Callable[[], object], _Room]] = []
         self._keys = np.full(64, -1, np.int64)
         self._heads = np.full(64, -1, np.int64)
         self._filled = 0
@@ -1628,9 +1639,9 @@ class World:
         if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)) \
                 or max_iterations < 1:
             raise ValueError(f"max_iterations: expected an integer >= 1, got {max_iterations!r}")
-        self._check_motions(ids, motion, step)
         pos = self._pos[ids]
         rad = self._rad[ids]
+        self._check_motions(ids, motion, step, pos, rad)
         cand = swept_pairs(pos, motion, rad, step)
         paired = np.zeros(n, np.bool_)
         paired[cand.reshape(-1)] = True
@@ -1643,7 +1654,8 @@ class World:
         pj = np.ascontiguousarray(cand[:, 1])
         base = (self._bxy, self._ls, self._lo, self._nl, self._cen)
         tables = (tint, tflt, tio, tfo)
-        frames = turned_frames(base, tables, bodies, self._ang, _chunks(len(bodies), _POSE_WORK))
+        slot, frames = self._turn_room(len(tflt))
+        turned_frames(base, tables, bodies, self._ang, frames, _chunks(len(bodies), _POSE_WORK))
         code, t_hit, t_contact, state = sweep_search(
             pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base, tables,
             frames, (self._xy, self._ls, self._lo, self._nl),
@@ -1667,31 +1679,61 @@ class World:
                   (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
                   ROUNDING_FACTOR)
         hit = np.where(start, 0.0, np.where(codes == HIT, t_hit[order], np.nan))
-        return Sweep(np.stack([a, b], axis=1), times, state[order], hit, codes, step, events)
+        out = Sweep(np.stack([a, b], axis=1), times, state[order], hit, codes, step, events)
+        self._turn_pool[slot] = (weakref.ref(out), frames)  # (its points read them)
+        return out
 
-    def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float) -> None:
+    def _turn_room(self, circles: int) -> tuple[int, _Room]:
+        """Room for a sweep's turned frames (the World's rows, and ``circles`` floats;
+        see :func:`polycontact._kernels.world_sweep.turned_frames`), and its slot in the
+        pool: a room that no live Sweep reads (its points may be asked for later), else
+        a new one. Two rooms take turns in a loop of sweeps; a new one of some hundred
+        megabytes would cost more in page faults than the turning itself."""
+        rows = len(self._bxy)
+        free = [k for k, (owner, _) in enumerate(self._turn_pool) if owner() is None]
+        for k in free:
+            room = self._turn_pool[k][1]
+            if len(room[1]) >= rows and len(room[2]) >= circles:
+                return k, room
+        room = (np.empty((rows, 2)), np.empty(rows), np.empty(circles))
+        if free:
+            k = free[0]
+        elif len(self._turn_pool) < _TURN_ROOMS:
+            k = len(self._turn_pool)
+            self._turn_pool.append((_no_owner, room))
+        else:  # every room read by a live Sweep: the World lets go of one (its Sweep keeps it)
+            k = 0
+        self._turn_pool[k] = (_no_owner, room)
+        return k, room
+
+    def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float, pos: np.ndarray,
+                       rad: np.ndarray) -> None:
         """Refuse motions that would carry a body's coordinates, its points' speeds or
         accelerations beyond the kernels' range within the step (as
         :func:`polycontact.time_of_impact` does), naming the argument that carries them
-        (the largest term of the bound) and the body's row."""
+        (the largest term of the bound) and the body's row (``pos``, ``rad``: the
+        bodies' centroids and bounding radii, rows as ``ids``)."""
+        from ._kernels.world_sweep import motion_maxima
+
         if not len(ids):
             return
-        rad = self._rad[ids]
+        # the bounds below with each term's largest value (a larger one for the angular
+        # speed within the step): rounding is monotone, so when these hold, every body's
+        # do (the usual case, decided in one compiled pass)
         with np.errstate(over="ignore", invalid="ignore"):
-            v = np.hypot(motion[:, 0], motion[:, 1])
-            acc = np.hypot(motion[:, 2], motion[:, 3])
-            w, alpha = np.abs(motion[:, 4]), np.abs(motion[:, 5])
-            w_max = w + alpha * dt
-            base = np.abs(self._pos[ids]).max(axis=1, initial=0.0) + rad
-            # the bounds below with each term's largest value: rounding is monotone, so
-            # when these hold, every body's do (the usual case, decided in a few passes)
-            bv, ba, bw, bal, br, bwm, bb = (float(x.max())
-                                            for x in (v, acc, w, alpha, rad, w_max, base))
+            bv, ba, bw, bal, br, bb = motion_maxima(motion, pos, rad,
+                                                    _chunks(len(ids), _POSE_WORK)).tolist()
+            bwm = bw + bal * dt
             if (bb + bv * dt + 0.5 * ba * dt * dt <= COORDINATE_LIMIT
                     and bv + ba * dt + bwm * br <= COORDINATE_LIMIT
                     and ba + bal * br + bwm * bwm * br <= COORDINATE_LIMIT
                     and bw + bal * dt <= COORDINATE_LIMIT):
                 return
+            v = np.hypot(motion[:, 0], motion[:, 1])
+            acc = np.hypot(motion[:, 2], motion[:, 3])
+            w, alpha = np.abs(motion[:, 4]), np.abs(motion[:, 5])
+            w_max = w + alpha * dt
+            base = np.abs(pos).max(axis=1, initial=0.0) + rad
             # the index of the argument a term comes from (-1: the pose, not an argument)
             vel, accel, ang_vel, ang_accel = (np.full(len(ids), i) for i in range(4))
             pose = np.full(len(ids), -1)

@@ -452,9 +452,9 @@ def test_sweep_does_not_move_the_bodies_and_reports_contacts_at_the_start():
 
 
 def test_a_sweeps_points_are_of_the_step_it_swept_whatever_the_world_did_after(monkeypatch):
-    """Read after the World moved, removed and added bodies, a sweep's points and normals
-    are those read at once, the pair that the compiled depth leaves to classify (two
-    interlocking 48-gon gears) included."""
+    """Read after other sweeps, and after the World moved, removed and added bodies, a
+    sweep's points and normals are those read at once, the pair that the compiled depth
+    leaves to classify (two interlocking 48-gon gears) included."""
     t = np.arange(48) * 2 * np.pi / 48
     r = np.where(np.arange(48) % 2 == 0, 1.0, 0.8)
     gear = np.c_[r * np.cos(t), r * np.sin(t)]
@@ -465,6 +465,10 @@ def test_a_sweeps_points_are_of_the_step_it_swept_whatever_the_world_did_after(m
     now = world.sweep(1.0, vel, spin)
     want = now.points.copy(), now.normals.copy()
     later = world.sweep(1.0, vel, spin)
+    world.set_poses(ids, [(0.2, 0.1), (1.5, 0.0), (5.0, 1.0)], [1.0, 2.0, -1.0])
+    kept = [world.sweep(1.0, -vel, -spin) for _ in range(2)]
+    for _ in range(3):
+        world.sweep(0.5, vel, -spin)
     world.set_poses(ids[1:], [(40.0, 3.0), (-7.0, 9.0)], [2.0, -1.0])
     world.remove(int(ids[0]))
     world.add_many([gear] * 3, [(0.0, 0.0), (1.0, 0.0), (9.0, 9.0)])
@@ -475,6 +479,7 @@ def test_a_sweeps_points_are_of_the_step_it_swept_whatever_the_world_did_after(m
     assert later.pairs.tolist() == now.pairs.tolist() and [0, 1] in now.pairs.tolist()
     assert np.array_equal(later.points, want[0]) and np.array_equal(later.normals, want[1])
     assert classified == [now.pairs.tolist().index([0, 1])]
+    assert all(np.isfinite(s.points).all() for s in kept)
 
 
 def test_sweep_in_parallel_chunks_equals_one_chunk(monkeypatch):

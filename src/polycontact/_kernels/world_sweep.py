@@ -43,6 +43,35 @@ from .relation import PENETRATING, state_in
 from .world import body_view
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def motion_maxima(motion, pos, rad, chunks):
+    """The largest value over the bodies of each term of the sweep's motion bounds:
+    ``(speed, acceleration, |ω|, |α|, radius, reach)``, from each body's kernel vector
+    ``motion`` (rows ``vx, vy, ax, ay, ω, α``), centroid ``pos`` and bounding radius
+    ``rad``; ``reach`` is the larger |coordinate| of the centroid plus the radius. In
+    parallel chunks (``chunks`` = 1: serial).
+
+    >>> motion_maxima(np.array([[3.0, 4, 0, 0, -2, 0], [1, 0, 0, 1, 0, 0.5]]),
+    ...               np.array([[0.0, -7], [1, 1]]), np.array([1.0, 2.0]), 1).tolist()
+    [5.0, 1.0, 2.0, 0.5, 2.0, 8.0]
+    """
+    n = motion.shape[0]
+    part = np.zeros((chunks, 6))
+    for c in prange(chunks):
+        for k in range(n * c // chunks, n * (c + 1) // chunks):
+            part[c, 0] = max(part[c, 0], math.hypot(motion[k, 0], motion[k, 1]))
+            part[c, 1] = max(part[c, 1], math.hypot(motion[k, 2], motion[k, 3]))
+            part[c, 2] = max(part[c, 2], abs(motion[k, 4]))
+            part[c, 3] = max(part[c, 3], abs(motion[k, 5]))
+            part[c, 4] = max(part[c, 4], rad[k])
+            part[c, 5] = max(part[c, 5], max(abs(pos[k, 0]), abs(pos[k, 1])) + rad[k])
+    out = np.zeros(6)
+    for c in range(chunks):
+        for q in range(6):
+            out[q] = max(out[q], part[c, q])
+    return out
+
+
 @njit(cache=True, nogil=True)
 def frame_tables(base, bodies, tables):
     """Build the circle tree of each body of ``bodies`` about its base rows (``base`` =
@@ -113,20 +142,17 @@ def _turn_body(b, turn, base, tables, frames):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def turned_frames(base, tables, bodies, ang, chunks):
+def turned_frames(base, tables, bodies, ang, frames, chunks):
     """Every body of ``bodies`` turned by its angle ``ang[b]``, once for all the pairs it
-    is in: ``(rt, lt, ct)``, its rows about its centroid
-    and their lengths (laid out as the base rows) and its circles (as ``tables``' floats,
-    from ``tfo[b]``). ``base``, ``tables``: as for :func:`frame_tables`. In parallel
+    is in, written into ``frames`` = ``(rt, lt, ct)``: its rows about its centroid and
+    their lengths (laid out as the base rows: at least as many) and its circles (as
+    ``tables``' floats, from ``tfo[b]``: at least as many); other bodies' places are
+    left as they are. ``base``, ``tables``: as for :func:`frame_tables`. In parallel
     chunks (``chunks`` = 1: serial)."""
-    bxy = base[0]
-    tflt = tables[1]
-    frames = (np.empty_like(bxy), np.empty(bxy.shape[0]), np.empty_like(tflt))
     n = bodies.shape[0]
     for c in prange(chunks):
         for k in range(n * c // chunks, n * (c + 1) // chunks):
             _turn_body(bodies[k], ang[bodies[k]], base, tables, frames)
-    return frames
 
 
 @njit(cache=True, nogil=True, inline="always")
