@@ -88,6 +88,7 @@ PARALLEL = [
     ("polycontact._kernels.world_sweep", "motion_maxima"),
     ("polycontact._kernels.world_sweep", "turned_frames"),
     ("polycontact._kernels.world_sweep", "sweep_search"),
+    ("polycontact._kernels.world_sweep", "sweep_events"),
     ("polycontact._kernels.world_sweep", "event_geometry"),
     ("polycontact._kernels.contact_geometry", "boundary_gaps"),
     ("polycontact._kernels.relation_many", "many_distances"),

@@ -91,6 +91,7 @@ _BODY_ARRAYS: dict[str, tuple[tuple[int, ...], Any, Any]] = {
 _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-bound)
 _GRID_WORK = 0.3  # moving a body to another cell of the grid (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
+_EVENT_WORK = 0.05  # gathering a sweep's event from its pair (memory-bound)
 _TURN_ROOMS = 2  # rooms for a sweep's turned frames that a World keeps (see _turn_room)
 #: A room for a sweep's turned frames: rows, their lengths, circles.
 _Room = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -1619,8 +1620,7 @@ class World:
         >>> s.normals.round(6).tolist()
         [[1.0, 0.0]]
         """
-        from ._kernels.impact import HIT, INITIALLY_PENETRATING
-        from ._kernels.world_sweep import sweep_search, turned_frames
+        from ._kernels.world_sweep import sweep_events, sweep_search, turned_frames
 
         step = finite_number(dt, "dt", minimum=0.0)
         ids = self.ids
@@ -1664,13 +1664,15 @@ class World:
             self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
         met = np.flatnonzero(state > 0)
         # by time, then by pair: the candidate pairs come sorted by pair, and a stable
-        # sort keeps that order among equal times
-        order = met[np.argsort(t_contact[met], kind="stable")]
-        i, j = pi[order], pj[order]
-        a, b = ids[i], ids[j]
-        times = t_contact[order]
-        codes = code[order]
-        start = codes == INITIALLY_PENETRATING
+        # sort keeps that order among equal times; the many pairs met at the start
+        # need no sort
+        when = t_contact[met]
+        at_zero = when == 0.0
+        later = met[~at_zero]
+        order = np.concatenate([met[at_zero],
+                                later[np.argsort(when[~at_zero], kind="stable")]])
+        pairs, i, j, times, states, hit, codes, start = sweep_events(
+            order, pi, pj, ids, (code, t_hit, t_contact, state), _chunks(len(order), _EVENT_WORK))
         # what the points and normals come from, if asked: the events as rows of the
         # bodies, and the bodies as they stand now (the World may move them after)
         events = ((i, j, times, start),
@@ -1678,8 +1680,7 @@ class World:
                   (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
                   (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
                   ROUNDING_FACTOR)
-        hit = np.where(start, 0.0, np.where(codes == HIT, t_hit[order], np.nan))
-        out = Sweep(np.stack([a, b], axis=1), times, state[order], hit, codes, step, events)
+        out = Sweep(pairs, times, states, hit, codes, step, events)
         self._turn_pool[slot] = (weakref.ref(out), frames)  # (its points read them)
         return out
 

@@ -36,7 +36,7 @@ from numba import prange
 from .jit import njit
 from .advance import edge_table_into, table_scratch
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
-from .impact import INITIALLY_PENETRATING, place, query_intervals, query_search, state_at, \
+from .impact import HIT, INITIALLY_PENETRATING, place, query_intervals, query_search, state_at, \
     tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
@@ -322,6 +322,40 @@ def sweep_search(pi, pj, movers, base, tables, frames, rows, settings, vmax, lma
         _search_range(pi, pj, movers, (base, tables, frames, rows), settings,
                       _search_buffers(vmax, lmax), n * c // chunks, n * (c + 1) // chunks, out)
     return out
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def sweep_events(order, pi, pj, ids, found, chunks):
+    """A sweep's events, the candidate pairs ``order[k]`` in turn (bodies ``ids[pi[p]]``
+    and ``ids[pj[p]]`` of pair p; ``found`` = ``(code, t_hit, t_contact, state)``, what
+    :func:`sweep_search` found of each): ``(pairs, i, j, times, states, hit, codes,
+    start)``, the bodies' ids as rows, their rows in ``ids``, the first contact's time,
+    the state, the first penetration's time (0 at the start, NaN without one), the
+    search's code, and whether it found the pair penetrating at the start. In parallel
+    chunks (``chunks`` = 1: serial)."""
+    code, t_hit, t_contact, state = found
+    n = order.shape[0]
+    pairs = np.empty((n, 2), np.int64)
+    i = np.empty(n, np.int64)
+    j = np.empty(n, np.int64)
+    times = np.empty(n)
+    states = np.empty(n, state.dtype)
+    hit = np.empty(n)
+    codes = np.empty(n, code.dtype)
+    start = np.empty(n, np.bool_)
+    for c in prange(chunks):
+        for k in range(n * c // chunks, n * (c + 1) // chunks):
+            p = order[k]
+            i[k] = pi[p]
+            j[k] = pj[p]
+            pairs[k, 0] = ids[pi[p]]
+            pairs[k, 1] = ids[pj[p]]
+            times[k] = t_contact[p]
+            states[k] = state[p]
+            codes[k] = code[p]
+            start[k] = code[p] == INITIALLY_PENETRATING
+            hit[k] = 0.0 if start[k] else (t_hit[p] if code[p] == HIT else np.nan)
+    return pairs, i, j, times, states, hit, codes, start
 
 
 @njit(cache=True, nogil=True)
