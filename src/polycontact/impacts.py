@@ -1030,6 +1030,19 @@ STRIP_MEMBER_SECONDS = 100e-9
 PARTNER_SECONDS = 20e-9
 
 
+def time_order(times: np.ndarray) -> np.ndarray:
+    """The order of a stable sort of ``times`` (non-negative, or NaN last): the zeros
+    first, as they come, then the others sorted. Most pairs of a crowded step meet at
+    time 0: they need no sort.
+
+    >>> time_order(np.array([0.5, 0.0, 0.2, 0.0, 0.5])).tolist()
+    [1, 3, 2, 0, 4]
+    """
+    zero = times == 0.0
+    later = np.flatnonzero(~zero)
+    return np.concatenate([np.flatnonzero(zero), later[np.argsort(times[later], kind="stable")]])
+
+
 def swept_pairs(centroids: np.ndarray, motions: np.ndarray, radii: np.ndarray,
                 t_max: float, threads: int | None = None) -> np.ndarray:
     """The pairs of bodies whose swept boxes meet over [0, ``t_max``] (the swept broad
@@ -1238,7 +1251,7 @@ def first_impacts(
                      [0.0, t_hi[met], reached[met]],
                      np.where(contact[met] >= 0.0, contact[met], math.inf))
     # (the pairs come sorted by (i, j): a stable sort by time sorts by (time, i, j))
-    order = np.argsort(when, kind="stable")
+    order = time_order(when)
     chosen = met[order]
     return PairImpacts(np.ascontiguousarray(pairs[chosen], dtype=np.int64), when[order],
                        code[chosen].astype(np.int8), lambda k: make(int(chosen[k])))

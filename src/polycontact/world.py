@@ -43,7 +43,8 @@ from ._checks import finite_number, one_value, points, real_array
 from ._checks import point as point_arg
 from .motion import Motion
 from .relation import Relation, classify
-from .impacts import PairImpact, PairImpacts, first_impact, first_impacts, swept_pairs
+from .impacts import PairImpact, PairImpacts, first_impact, first_impacts, swept_pairs, \
+    time_order
 from .limits import (BROAD_PHASE_INFLATION, CONTACT_RESOLUTION, COORDINATE_LIMIT, MAX_ITERATIONS,
                      RELATIVE_TOLERANCE, ROUNDING_ULPS, SAMPLES, TIME_TOLERANCE)
 from .shape import Shape, ShapeLike, as_shape, frozen_ints
@@ -1664,13 +1665,8 @@ class World:
             self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
         met = np.flatnonzero(state > 0)
         # by time, then by pair: the candidate pairs come sorted by pair, and a stable
-        # sort keeps that order among equal times; the many pairs met at the start
-        # need no sort
-        when = t_contact[met]
-        at_zero = when == 0.0
-        later = met[~at_zero]
-        order = np.concatenate([met[at_zero],
-                                later[np.argsort(when[~at_zero], kind="stable")]])
+        # sort keeps that order among equal times
+        order = met[time_order(t_contact[met])]
         pairs, i, j, times, states, hit, codes, start = sweep_events(
             order, pi, pj, ids, (code, t_hit, t_contact, state), _chunks(len(order), _EVENT_WORK))
         # what the points and normals come from, if asked: the events as rows of the

@@ -26,7 +26,7 @@ from polycontact import ImpactStatus, InvalidShapeError, Motion, Shape
 from polycontact._kernels.swept import swept_boxes
 from polycontact.broad_phase import intervals_array
 from polycontact.impacts import (candidate_pairs, event_time, first_impact, first_impacts,
-                                 time_of_impact_many)
+                                 time_of_impact_many, time_order)
 from polycontact.limits import BROAD_PHASE_INFLATION, MAX_SLICES, SWEPT_ROUNDING_ULPS
 
 SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
@@ -512,6 +512,13 @@ def test_swept_bounds_never_drop_a_pair_the_pairwise_call_searches(swarm):
         for j in range(i + 1, len(shapes)):
             if len(intervals_array(shapes[i], moves[i], shapes[j], moves[j], t_max)):
                 assert (i, j) in found
+
+
+@given(st.lists(st.sampled_from([0.0, -0.0, 0.25, 0.5, 1e-300, 3.0, math.inf, math.nan]),
+                max_size=40))
+def test_time_order_is_a_stable_sort_by_time(times):
+    t = np.array(times)
+    assert time_order(t).tolist() == np.argsort(t, kind="stable").tolist()
 
 
 @examples(200)
