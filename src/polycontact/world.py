@@ -814,6 +814,13 @@ class World:
         """The container, or None."""
         return self._container
 
+    def __getstate__(self) -> dict[str, Any]:
+        """What pickling keeps: everything but the rooms of the sweeps' turned frames
+        (scratch, each weakly tied to the Sweep that reads it)."""
+        state = self.__dict__.copy()
+        state["_turn_pool"] = []
+        return state
+
     # -- bodies ----------------------------------------------------------------------
     def __len__(self) -> int:
         return len(self._records)

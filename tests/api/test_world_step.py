@@ -5,6 +5,7 @@ and Shapely, at scales 1e-6..1e6 and away from the origin."""
 from __future__ import annotations
 
 import math
+import pickle
 import runpy
 import sys
 from pathlib import Path
@@ -480,6 +481,18 @@ def test_a_sweeps_points_are_of_the_step_it_swept_whatever_the_world_did_after(m
     assert np.array_equal(later.points, want[0]) and np.array_equal(later.normals, want[1])
     assert classified == [now.pairs.tolist().index([0, 1])]
     assert all(np.isfinite(s.points).all() for s in kept)
+
+
+def test_a_world_pickles_after_a_sweep_and_sweeps_alike():
+    world = pc.World()
+    world.add_many([body(t, 1.0, "shape") for t in range(4)],
+                   [(0.0, 0.0), (1.2, 0.3), (2.5, 0.0), (9.0, 9.0)])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0], [-1.0, 0.5], [0.0, 0.0]])
+    first = world.sweep(1.0, vel, [0.5, 0.0, -1.0, 0.0])
+    again = pickle.loads(pickle.dumps(world))
+    second = again.sweep(1.0, vel, [0.5, 0.0, -1.0, 0.0])
+    for name in ("pairs", "times", "states", "points", "normals"):
+        assert np.array_equal(getattr(first, name), getattr(second, name)), name
 
 
 def test_sweep_in_parallel_chunks_equals_one_chunk(monkeypatch):
