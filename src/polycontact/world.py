@@ -535,7 +535,12 @@ def _event_by_shapes(ev: tuple[Any, ...], k: int) -> tuple[np.ndarray, np.ndarra
     return point, normal
 
 
-def _no_owner() -> None:
+def _taken() -> bool:
+    """The owner of a room of turned frames taken by a sweep that is running."""
+    return True
+
+
+def _free() -> None:
     """The owner of a room of turned frames that no Sweep reads."""
     return None
 
@@ -1668,28 +1673,34 @@ class World:
         base = (self._bxy, self._ls, self._lo, self._nl, self._cen)
         tables = (tint, tflt, tio, tfo)
         slot, frames = self._turn_room(len(tflt))
-        turned_frames(base, tables, bodies, self._ang, frames, _chunks(len(bodies), _POSE_WORK))
-        code, t_hit, t_contact, state = sweep_search(
-            pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base, tables,
-            frames, (self._xy, self._ls, self._lo, self._nl),
-            (step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, ROUNDING_FACTOR,
-             CONTACT_RESOLUTION, int(max_iterations)),
-            self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
-        met = np.flatnonzero(state > 0)
-        # by time, then by pair: the candidate pairs come sorted by pair, and a stable
-        # sort keeps that order among equal times
-        order = met[time_order(t_contact[met])]
-        pairs, i, j, times, states, hit, codes, start = sweep_events(
-            order, pi, pj, ids, (code, t_hit, t_contact, state), _chunks(len(order), _EVENT_WORK))
-        # what the points and normals come from, if asked: the events as rows of the
-        # bodies, and the bodies as they stand now (the World may move them after)
-        events = ((i, j, times, start),
-                  (ids, pos, self._ang[ids], rad, extent[ids], motion, RELATIVE_TOLERANCE),
-                  (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
-                  (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
-                  ROUNDING_FACTOR)
-        out = Sweep(pairs, times, states, hit, codes, step, events)
-        self._turn_pool[slot] = (weakref.ref(out), frames)  # (its points read them)
+        owner: Callable[[], object] = _free  # (the room let go if no Sweep is made)
+        try:
+            turned_frames(base, tables, bodies, self._ang, frames,
+                          _chunks(len(bodies), _POSE_WORK))
+            code, t_hit, t_contact, state = sweep_search(
+                pi, pj, (ids, self._pos, self._ang, self._rad, extent, motion), base, tables,
+                frames, (self._xy, self._ls, self._lo, self._nl),
+                (step, BROAD_PHASE_INFLATION, tol, RELATIVE_TOLERANCE, ROUNDING_FACTOR,
+                 CONTACT_RESOLUTION, int(max_iterations)),
+                self._vmax, self._lmax, _chunks(len(pi), _GEOMETRY_WORK))
+            met = np.flatnonzero(state > 0)
+            # by time, then by pair: the candidate pairs come sorted by pair, and a stable
+            # sort keeps that order among equal times
+            order = met[time_order(t_contact[met])]
+            pairs, i, j, times, states, hit, codes, start = sweep_events(
+                order, pi, pj, ids, (code, t_hit, t_contact, state),
+                _chunks(len(order), _EVENT_WORK))
+            # what the points and normals come from, if asked: the events as rows of the
+            # bodies, and the bodies as they stand now (the World may move them after)
+            events = ((i, j, times, start),
+                      (ids, pos, self._ang[ids], rad, extent[ids], motion, RELATIVE_TOLERANCE),
+                      (self._bxy, self._ls, self._lo.copy(), self._nl.copy(), self._cen),
+                      (tint, tflt, tio.copy(), tfo.copy()), frames, self._vmax, self._lmax,
+                      ROUNDING_FACTOR)
+            out = Sweep(pairs, times, states, hit, codes, step, events)
+            owner = weakref.ref(out)  # (its points read the room)
+        finally:
+            self._turn_pool[slot] = (owner, frames)
         return out
 
     def _turn_room(self, circles: int) -> tuple[int, _Room]:
@@ -1700,19 +1711,21 @@ class World:
         megabytes would cost more in page faults than the turning itself."""
         rows = len(self._bxy)
         free = [k for k, (owner, _) in enumerate(self._turn_pool) if owner() is None]
-        for k in free:
+        fits = [k for k in free if len(self._turn_pool[k][1][1]) >= rows
+                and len(self._turn_pool[k][1][2]) >= circles]
+        if fits:
+            k = fits[0]
             room = self._turn_pool[k][1]
-            if len(room[1]) >= rows and len(room[2]) >= circles:
-                return k, room
-        room = (np.empty((rows, 2)), np.empty(rows), np.empty(circles))
-        if free:
-            k = free[0]
-        elif len(self._turn_pool) < _TURN_ROOMS:
-            k = len(self._turn_pool)
-            self._turn_pool.append((_no_owner, room))
-        else:  # every room read by a live Sweep: the World lets go of one (its Sweep keeps it)
-            k = 0
-        self._turn_pool[k] = (_no_owner, room)
+        else:
+            room = (np.empty((rows, 2)), np.empty(rows), np.empty(circles))
+            if free:
+                k = free[0]
+            elif len(self._turn_pool) < _TURN_ROOMS:
+                k = len(self._turn_pool)
+                self._turn_pool.append((_taken, room))
+            else:  # every room read by a live Sweep: the World lets go of one (its Sweep
+                k = 0  # keeps it)
+        self._turn_pool[k] = (_taken, room)  # (until its Sweep is made)
         return k, room
 
     def _check_motions(self, ids: np.ndarray, motion: np.ndarray, dt: float, pos: np.ndarray,
