@@ -1049,22 +1049,50 @@ def swept_pairs(centroids: np.ndarray, motions: np.ndarray, radii: np.ndarray,
     phase of :func:`first_impacts` and ``World.sweep``): each body's centroid
     (``centroids``, (N, 2)) follows its motion (``motions``, rows ``vx, vy, ax, ay,
     omega, alpha``) and its bounding circle (``radii``, (N,)) goes with it, in boxes of
-    time slices (:func:`polycontact._kernels.swept.swept_boxes`); the pairs of
-    :func:`box_pairs`, on at most ``threads`` threads.
+    time slices (:func:`swept_boxes`); the pairs of :func:`box_pairs`, on at most
+    ``threads`` threads.
 
     >>> swept_pairs(np.array([[0.0, 0], [3, 0], [0, 30]]),
     ...             np.array([[1.0, 0, 0, 0, 0, 0], [0] * 6, [0] * 6]),
     ...             np.array([0.8, 0.8, 0.8]), 5.0).tolist()
     [[0, 1]]
     """
-    from ._kernels.swept import swept_boxes
-
     n = len(centroids)
     if n < 2:
         return np.empty((0, 2), np.int64)
-    boxes, owner = swept_boxes(centroids, motions, radii, t_max, MAX_SLICES,
-                               BROAD_PHASE_INFLATION, SWEPT_ROUNDING_ULPS * 2.0**-52)
+    boxes, owner = swept_boxes(centroids, motions, radii, t_max, threads)
     return box_pairs(boxes, owner, n, threads)
+
+
+def swept_boxes(centroids: np.ndarray, motions: np.ndarray, radii: np.ndarray,
+                t_max: float, threads: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The space–time boxes of the swept broad phase: ``(boxes, owner)``, each body's
+    boxes over the time slices of [0, ``t_max``] (at most
+    :data:`~polycontact.limits.MAX_SLICES`) holding its bounding circle as its centroid
+    follows its motion (:func:`polycontact._kernels.swept.boxes_into`: rows ``(x_lo,
+    x_hi, y_lo, y_hi, t_lo, t_hi)``, and the body each bounds), the bodies shared among
+    at most ``threads`` threads (arguments as for :func:`swept_pairs`).
+
+    >>> boxes, owner = swept_boxes(np.array([[0.0, 0]]), np.array([[0.0] * 6]),
+    ...                            np.array([1.0]), 2.0)
+    >>> owner.tolist(), boxes[0, 4:].tolist()
+    ([0], [0.0, 2.0])
+    """
+    from ._kernels.swept import boxes_into, slice_starts
+
+    first = slice_starts(motions, radii, t_max, MAX_SLICES)
+    boxes = np.empty((first[-1], 6))
+    owner = np.empty(first[-1], np.int64)
+    ulps = SWEPT_ROUNDING_ULPS * 2.0**-52
+    map_work(lambda i0, i1: boxes_into(centroids, motions, radii, t_max, first,
+                                       BROAD_PHASE_INFLATION, ulps, i0, i1, boxes, owner),
+             len(radii), BOX_SECONDS, threads)
+    return boxes, owner
+
+
+#: Seconds to bound one body's path in its boxes: the unit of work of
+#: :func:`swept_boxes`' share among threads.
+BOX_SECONDS = 50e-9
 
 
 def box_pairs(boxes: np.ndarray, owner: np.ndarray, n_bodies: int,

@@ -23,11 +23,9 @@ from profiles import examples
 
 import polycontact as pc
 from polycontact import ImpactStatus, InvalidShapeError, Motion, Shape
-from polycontact._kernels.swept import swept_boxes
 from polycontact.broad_phase import intervals_array
 from polycontact.impacts import (candidate_pairs, event_time, first_impact, first_impacts,
-                                 time_of_impact_many, time_order)
-from polycontact.limits import BROAD_PHASE_INFLATION, MAX_SLICES, SWEPT_ROUNDING_ULPS
+                                 swept_boxes, time_of_impact_many, time_order)
 
 SQ = Shape([(0, 0), (1, 0), (1, 1), (0, 1)])
 SQ_RINGS = np.array([[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]] * 2)
@@ -528,8 +526,7 @@ def test_swept_boxes_hold_each_bounding_circle_at_every_time(swarm, frac):
     cent = np.array([s.centroid for s in shapes])
     m = np.array([mo.array for mo in moves])
     rad = np.array([s.bounding_radius for s in shapes])
-    boxes, owner = swept_boxes(cent, m, rad, t_max, MAX_SLICES, BROAD_PHASE_INFLATION,
-                               SWEPT_ROUNDING_ULPS * 2.0**-52)
+    boxes, owner = swept_boxes(cent, m, rad, t_max)
     t = frac * t_max
     for k, (s, mo) in enumerate(zip(shapes, moves)):
         translation, _ = mo.pose(t)

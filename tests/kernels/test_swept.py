@@ -8,8 +8,16 @@ from hypothesis import given
 from hypothesis import strategies as st
 from profiles import examples
 
-from polycontact._kernels.swept import swept_boxes
+from polycontact._kernels.swept import boxes_into, slice_starts
 from polycontact.impacts import box_pairs
+
+
+def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
+    """Every body's boxes, in one range: ``(boxes, owner)``."""
+    first = slice_starts(m, radius, t_max, max_slices)
+    boxes, owner = np.empty((first[-1], 6)), np.empty(first[-1], np.int64)
+    boxes_into(c, m, radius, t_max, first, inflate, ulps, 0, len(c), boxes, owner)
+    return boxes, owner
 
 
 def test_swept_boxes_of_a_parabola_hold_its_apex():
@@ -43,6 +51,19 @@ def test_swept_boxes_of_a_path_that_overflows_are_the_whole_plane():
     with np.errstate(all="ignore"):
         boxes, _ = swept_boxes(c, m, np.array([1.0]), 1e10, 1, 0.0, 0.0)
     assert boxes[0, :4].tolist() == [-np.inf, np.inf, -np.inf, np.inf]
+
+
+def test_boxes_written_by_ranges_of_bodies_are_those_of_one_range():
+    rng = np.random.default_rng(3)
+    c = rng.uniform(-5, 5, (30, 2))
+    m = np.c_[rng.normal(0, 3, (30, 4)), np.zeros((30, 2))]
+    radius = rng.uniform(0.1, 1.0, 30)
+    first = slice_starts(m, radius, 1.5, 16)
+    whole = swept_boxes(c, m, radius, 1.5, 16, 1e-3, 1e-12)
+    boxes, owner = np.full((first[-1], 6), np.nan), np.full(first[-1], -1, np.int64)
+    for i0, i1 in ((17, 30), (0, 5), (5, 17)):
+        boxes_into(c, m, radius, 1.5, first, 1e-3, 1e-12, i0, i1, boxes, owner)
+    assert np.array_equal(boxes, whole[0]) and np.array_equal(owner, whole[1])
 
 
 def _all_pairs(boxes: np.ndarray, owner: np.ndarray) -> list[list[int]]:

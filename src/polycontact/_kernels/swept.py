@@ -6,7 +6,7 @@ centroid, and its centroid follows ``c(t) = c0 + v t + a t²/2``. Over a time sl
 ``[t0, t1]`` each coordinate of that path is a parabola, so its range is spanned by the
 slice's ends and the apex ``t* = −v/a`` when it falls inside; the box of that range
 grown by ``L`` (widened as the pairwise broad phase widens the radii, see
-:func:`swept_boxes`) holds the body for the whole slice, whatever its spin. Each body
+:func:`boxes_into`) holds the body for the whole slice, whatever its spin. Each body
 gets enough slices that its centroid moves at most about ``L`` per slice (at most
 ``max_slices``), so the boxes hug the path. Two bodies can touch at
 time t only if the boxes of the slices holding t overlap in x, in y and in time:
@@ -43,42 +43,50 @@ def _coordinate_range(c, v, a, t0, t1):
 
 
 @njit(cache=True, nogil=True)
-def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
-    """Space–time boxes bounding each body over ``[0, t_max]``.
+def slice_starts(m, radius, t_max, max_slices):
+    """Where each body's space–time boxes start among all (N + 1,), from its motion
+    vector ``m[i]`` = ``[vx, vy, ax, ay, ω, α]`` and bounding radius ``radius[i]``: body
+    i gets ``k_i = clamp(ceil(travel_i / radius_i), 1, max_slices)`` slices of ``[0,
+    t_max]`` (``travel_i = |v| t_max + |a| t_max²/2`` bounds its centroid's path
+    length), its boxes ``first[i]:first[i + 1]`` (:func:`boxes_into`).
 
-    ``c`` (N, 2) centroids at t = 0, ``m`` (N, 6) motion vectors ``[vx, vy, ax, ay, ω,
-    α]``, ``radius`` (N,) bounding radii. Body i gets ``k_i = clamp(ceil(travel_i /
-    radius_i), 1, max_slices)`` slices of ``[0, t_max]`` (``travel_i = |v| t_max +
-    |a| t_max²/2`` bounds its centroid's path length). Each box is grown by the radius
-    times ``1 + inflate`` and by ``ulps`` times the body's reach ``radius + Σ_x,y (|c0| +
-    |v| t_max + |a| t_max²/2)``: the terms whose sum over both bodies, times 16 units of
-    2**-52, the pairwise broad phase adds to the sum of the radii
-    (:func:`polycontact._kernels.broad_phase.rounding_allowance`); ``ulps`` above that
-    covers the rounding of the centre distance there and of the boxes here. Two bodies
-    whose inflated circles the pairwise broad phase sees meeting at some t thus have
-    boxes that meet in x, y and time (slice ends are computed one way for every body,
-    so the slices tile ``[0, t_max]``).
-
-    Returns ``(boxes, owner)``: ``boxes[k] = (x_lo, x_hi, y_lo, y_hi, t_lo, t_hi)`` and
-    the body it bounds.
+    >>> slice_starts(np.array([[0.0] * 6, [3.0, 4, 0, 0, 0, 0]]), np.array([1.0, 1.0]),
+    ...              1.0, 16).tolist()
+    [0, 1, 6]
     """
-    n = c.shape[0]
-    counts = np.empty(n, np.int64)
-    total = 0
+    n = m.shape[0]
+    first = np.empty(n + 1, np.int64)
+    first[0] = 0
     for i in range(n):
         travel = np.sqrt(m[i, 0] ** 2 + m[i, 1] ** 2) * t_max + \
             0.5 * np.sqrt(m[i, 2] ** 2 + m[i, 3] ** 2) * t_max * t_max
         k = 1
         if radius[i] > 0.0 and travel > radius[i]:
             k = int(min(float(max_slices), np.ceil(travel / radius[i])))
-        k = max(1, min(k, max_slices))
-        counts[i] = k
-        total += k
-    boxes = np.empty((total, 6))
-    owner = np.empty(total, np.int64)
-    b = 0
-    for i in range(n):
-        k = counts[i]
+        first[i + 1] = first[i] + max(1, min(k, max_slices))
+    return first
+
+
+@njit(cache=True, nogil=True)
+def boxes_into(c, m, radius, t_max, first, inflate, ulps, i0, i1, boxes, owner):
+    """Space–time boxes bounding bodies ``i0`` to ``i1 - 1`` over ``[0, t_max]``, written
+    into ``boxes`` and ``owner`` from ``first[i]`` (:func:`slice_starts`, whose slices
+    they are): ``boxes[k] = (x_lo, x_hi, y_lo, y_hi, t_lo, t_hi)`` and the body it
+    bounds; the caller may split the bodies among threads.
+
+    ``c`` (N, 2) centroids at t = 0, ``m`` (N, 6) motion vectors ``[vx, vy, ax, ay, ω,
+    α]``, ``radius`` (N,) bounding radii. Each box is grown by the radius times ``1 +
+    inflate`` and by ``ulps`` times the body's reach ``radius + Σ_x,y (|c0| + |v| t_max
+    + |a| t_max²/2)``: the terms whose sum over both bodies, times 16 units of 2**-52,
+    the pairwise broad phase adds to the sum of the radii
+    (:func:`polycontact._kernels.broad_phase.rounding_allowance`); ``ulps`` above that
+    covers the rounding of the centre distance there and of the boxes here. Two bodies
+    whose inflated circles the pairwise broad phase sees meeting at some t thus have
+    boxes that meet in x, y and time (slice ends are computed one way for every body,
+    so the slices tile ``[0, t_max]``)."""
+    for i in range(i0, i1):
+        k = first[i + 1] - first[i]
+        b = first[i]
         vx, vy, ax, ay = m[i, 0], m[i, 1], m[i, 2], m[i, 3]
         reach = radius[i] + abs(c[i, 0]) + abs(c[i, 1]) + \
             (abs(vx) + abs(vy)) * t_max + 0.5 * (abs(ax) + abs(ay)) * t_max * t_max
@@ -103,7 +111,6 @@ def swept_boxes(c, m, radius, t_max, max_slices, inflate, ulps):
             boxes[b, 5] = t1
             owner[b] = i
             b += 1
-    return boxes, owner
 
 
 @njit(cache=True, nogil=True)
