@@ -1714,17 +1714,15 @@ class World:
         fits = [k for k in free if len(self._turn_pool[k][1][1]) >= rows
                 and len(self._turn_pool[k][1][2]) >= circles]
         if fits:
-            k = fits[0]
-            room = self._turn_pool[k][1]
+            k, room = fits[0], self._turn_pool[fits[0]][1]
         else:
             room = (np.empty((rows, 2)), np.empty(rows), np.empty(circles))
-            if free:
-                k = free[0]
-            elif len(self._turn_pool) < _TURN_ROOMS:
-                k = len(self._turn_pool)
+            # a free room too small, else a new slot, else (every room read by a live
+            # Sweep, which keeps it) the first slot
+            n = len(self._turn_pool)
+            k = free[0] if free else (n if n < _TURN_ROOMS else 0)
+            if k == n:
                 self._turn_pool.append((_taken, room))
-            else:  # every room read by a live Sweep: the World lets go of one (its Sweep
-                k = 0  # keeps it)
         self._turn_pool[k] = (_taken, room)  # (until its Sweep is made)
         return k, room
 
@@ -1739,9 +1737,10 @@ class World:
 
         if not len(ids):
             return
-        # the bounds below with each term's largest value (a larger one for the angular
-        # speed within the step): rounding is monotone, so when these hold, every body's
-        # do (the usual case, decided in one compiled pass)
+        # the bounds below with an upper bound of each term over the bodies (see
+        # motion_maxima; for the angular speed within the step, the largest |w| plus the
+        # largest |alpha| dt): rounding is monotone, so when these hold, every body's do
+        # (the usual case, decided in one compiled pass)
         with np.errstate(over="ignore", invalid="ignore"):
             bv, ba, bw, bal, br, bb = motion_maxima(motion, pos, rad,
                                                     _chunks(len(ids), _POSE_WORK)).tolist()

@@ -45,22 +45,24 @@ from .world import body_view
 
 @njit(cache=True, nogil=True, parallel=True)
 def motion_maxima(motion, pos, rad, chunks):
-    """The largest value over the bodies of each term of the sweep's motion bounds:
+    """Upper bounds, over the bodies, of each term of the sweep's motion bounds:
     ``(speed, acceleration, |ω|, |α|, radius, reach)``, from each body's kernel vector
     ``motion`` (rows ``vx, vy, ax, ay, ω, α``), centroid ``pos`` and bounding radius
-    ``rad``; ``reach`` is the larger |coordinate| of the centroid plus the radius. In
-    parallel chunks (``chunks`` = 1: serial).
+    ``rad``. The speed and the acceleration are bounded by ``|x| + |y|`` of their
+    vectors (never below their length, however a library rounds ``hypot``), the rest are
+    the largest values; ``reach`` is the larger |coordinate| of the centroid plus the
+    radius. In parallel chunks (``chunks`` = 1: serial).
 
     >>> motion_maxima(np.array([[3.0, 4, 0, 0, -2, 0], [1, 0, 0, 1, 0, 0.5]]),
     ...               np.array([[0.0, -7], [1, 1]]), np.array([1.0, 2.0]), 1).tolist()
-    [5.0, 1.0, 2.0, 0.5, 2.0, 8.0]
+    [7.0, 1.0, 2.0, 0.5, 2.0, 8.0]
     """
     n = motion.shape[0]
     part = np.zeros((chunks, 6))
     for c in prange(chunks):
         for k in range(n * c // chunks, n * (c + 1) // chunks):
-            part[c, 0] = max(part[c, 0], math.hypot(motion[k, 0], motion[k, 1]))
-            part[c, 1] = max(part[c, 1], math.hypot(motion[k, 2], motion[k, 3]))
+            part[c, 0] = max(part[c, 0], abs(motion[k, 0]) + abs(motion[k, 1]))
+            part[c, 1] = max(part[c, 1], abs(motion[k, 2]) + abs(motion[k, 3]))
             part[c, 2] = max(part[c, 2], abs(motion[k, 4]))
             part[c, 3] = max(part[c, 3], abs(motion[k, 5]))
             part[c, 4] = max(part[c, 4], rad[k])
