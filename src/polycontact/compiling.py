@@ -57,9 +57,9 @@ FAMILIES: dict[str, tuple[str, ...]] = {
                        "fits.select_contacts"),
     "entrance block": ("validate.first_defect",),
     "many moving bodies": ("swept.slice_starts", "swept.boxes_into", "swept.sweep_strips",
-                           "swept.impacts_chunk", "impact_batch.body_tables", "impact_batch.suspect_bodies",
-                           "impact_batch.pair_bodies", "impact_batch.ring_bodies",
-                           "impact_batch.pack_rings"),
+                           "swept.impacts_chunk", "impact_batch.body_tables",
+                           "impact_batch.suspect_bodies", "impact_batch.pair_bodies",
+                           "impact_batch.ring_bodies", "impact_batch.pack_rings"),
     "no-fit polygon table": ("nfp_batch.nfp_pairs",),
 }
 

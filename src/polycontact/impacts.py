@@ -1029,6 +1029,10 @@ STRIP_MEMBER_SECONDS = 100e-9
 #: Seconds per pair of boxes found, to sort and keep each body's partners once.
 PARTNER_SECONDS = 20e-9
 
+#: Seconds to bound one body's path in its boxes: the unit of work of
+#: :func:`swept_boxes`' share among threads.
+BOX_SECONDS = 50e-9
+
 
 def time_order(times: np.ndarray) -> np.ndarray:
     """The order of a stable sort of ``times`` (non-negative, or NaN last): the zeros
@@ -1088,11 +1092,6 @@ def swept_boxes(centroids: np.ndarray, motions: np.ndarray, radii: np.ndarray,
                                        BROAD_PHASE_INFLATION, ulps, i0, i1, boxes, owner),
              len(radii), BOX_SECONDS, threads)
     return boxes, owner
-
-
-#: Seconds to bound one body's path in its boxes: the unit of work of
-#: :func:`swept_boxes`' share among threads.
-BOX_SECONDS = 50e-9
 
 
 def box_pairs(boxes: np.ndarray, owner: np.ndarray, n_bodies: int,
