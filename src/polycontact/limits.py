@@ -178,9 +178,10 @@ THREAD_WORK = 2e-3
 
 #: Least work of one Dask task (seconds): a task costs the scheduler and the transfers
 #: about a millisecond, and the results a round trip, so a task of this much work loses
-#: under 1 % to them; tasks are made larger only to keep at most four per worker thread
-#: in whole rounds (:func:`polycontact.distributed.task_size`).
-TASK_SECONDS = 0.2
+#: about 2 % to them, while a table of 1.5 s of work still fills 16 workers (tasks of
+#: 0.2 s would leave nine of them idle); tasks are made larger only to keep at most
+#: four per worker thread in whole rounds (:func:`polycontact.distributed.task_size`).
+TASK_SECONDS = 0.05
 
 # -- files and the command line ------------------------------------------------------
 

@@ -965,6 +965,56 @@ def _remote_states(client: Any, packs: tuple[Any, ...], tol: float,
     return states, tols
 
 
+def _remote_arrays(client: Any, arr_a: np.ndarray, arr_b: np.ndarray, tol: float,
+                   chunk_size: int | None, threads: int) -> RelationBatch | None:
+    """:func:`_classify_arrays` in tasks on the cluster of ``client``: each task checks
+    and classifies its slice of the two ring arrays in one kernel pass, as locally, so
+    the calling process only copies the arrays (on ``threads`` threads) and sends them.
+    None if some ring is not certified valid as given (the caller then decides and
+    explains through ``Shape``, here)."""
+    from ._cluster import run_spans
+    from ._kernels import relation_many as km
+
+    copy_a = np.empty(arr_a.shape)
+    copy_b = np.empty(arr_b.shape)
+
+    def copy(p0: int, p1: int) -> None:
+        copy_a[p0:p1] = arr_a[p0:p1]
+        copy_b[p0:p1] = arr_b[p0:p1]
+
+    _split(len(arr_a), copy, threads)
+    out = km.raw_states_outputs(len(arr_a))
+
+    def tasks_of(spans: list[tuple[int, int]]) -> tuple[Any, list[Any]]:
+        return None, [(copy_a[p0:p1], copy_b[p0:p1]) for p0, p1 in spans]
+
+    with closing(run_spans(client, _ring_states_task, len(arr_a), tasks_of, tol,
+                           chunk_size=chunk_size, family="ring arrays")) as results:
+        for p0, p1, part in results:
+            for whole, got in zip(out, part):
+                whole[p0:p1] = got
+    states, eps, used_a, sign_a, used_b, sign_b = out
+    if (states < 0).any():
+        return None
+    return RelationBatch(
+        states, eps,
+        lambda: (*_ring_pack(copy_a, used_a, sign_a), *_ring_pack(copy_b, used_b, sign_b)),
+        threads,
+    )
+
+
+def _ring_states_task(_: Any, task: tuple[np.ndarray, np.ndarray],
+                      tol: float) -> tuple[np.ndarray, ...]:
+    """One task of :func:`_remote_arrays`: the checks and states of its pairs of rings
+    (:func:`polycontact._kernels.relation_many.raw_states`)."""
+    from ._kernels import relation_many as km
+
+    xa, xb = task
+    out: tuple[np.ndarray, ...] = km.raw_states(xa, xb, tol, *RING_ARGS,
+                                                km.raw_states_outputs(len(xa)))
+    return out
+
+
 def _pack_slice(pack: tuple[Any, ...], p0: int, p1: int) -> tuple[Any, ...]:
     """The bodies ``p0:p1`` of a ``pack_bodies`` result ``(xy, ls, bs, sign)``, packed
     alone (their rows, loop starts and body starts renumbered from 0)."""
@@ -991,7 +1041,9 @@ def classify_many(
     The pairs are shared among threads (the compiled kernels release the GIL), as many
     as the threading policy of :doc:`conventions` gives; the signed distances, on first
     access, run in parallel too. With a Dask client the pairs run as tasks on the
-    cluster instead, after the same checks here, with the same result.
+    cluster instead, after the same checks here, with the same result (ring arrays are
+    checked in the tasks, in the pass that classifies them; a ring they cannot certify
+    is decided here, with the error a local call gives).
 
     Parameters
     ----------
@@ -1033,8 +1085,9 @@ def classify_many(
     remote = current_client(client)
     arr_a = raw_ring_array(shapes_a)
     arr_b = raw_ring_array(shapes_b)
-    if remote is None and arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
-        batch = _classify_arrays(arr_a, arr_b, tol, n_threads)
+    if arr_a is not None and arr_b is not None and len(arr_a) == len(arr_b):
+        batch = (_classify_arrays(arr_a, arr_b, tol, n_threads) if remote is None else
+                 _remote_arrays(remote, arr_a, arr_b, tol, chunk_size, n_threads))
         if batch is not None:
             return batch
     pa = _pack_ring_array(arr_a, "shapes_a") if arr_a is not None else pack_bodies(

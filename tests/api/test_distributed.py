@@ -5,6 +5,7 @@ loses nothing; tasks are sized from a first one."""
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -110,8 +111,8 @@ def test_classify_many_on_the_cluster_is_identical(client):
 
 
 def test_ring_arrays_on_the_cluster_are_checked_and_copied_at_the_call(client):
-    # packed in one kernel pass (not ring by ring in Python), refused as locally when a
-    # ring is invalid, and never read after the call
+    # checked and classified in one kernel pass in the tasks (not ring by ring in Python
+    # here), refused as locally when a ring is invalid, and never read after the call
     a = np.array([SQUARE] * 6, dtype=float) + np.arange(6)[:, None, None] * 3.0
     b = a + 0.5
     bad = a.copy()
@@ -125,6 +126,13 @@ def test_ring_arrays_on_the_cluster_are_checked_and_copied_at_the_call(client):
     a += 100.0  # the caller reuses its array before reading the distances
     assert batch.states.tolist() == [2] * 6
     assert batch.distances.tolist() == pytest.approx([-0.5] * 6)
+    # a repeated vertex: a valid ring the tasks' one-pass check leaves to Shape, here
+    again = a.copy()
+    again[2] = again[2][[0, 1, 1, 2]]
+    remote = pc.classify_many(again, b, client=client)
+    local = here(lambda: pc.classify_many(again, b))
+    assert np.array_equal(remote.states, local.states)
+    assert np.array_equal(remote.distances, local.distances)
 
 
 def impact_pairs(count: int, seed: int) -> tuple[list, list, list, list]:
@@ -340,19 +348,65 @@ def test_tasks_are_sized_from_a_first_task(client):
 
 
 def test_task_sizes_fill_whole_rounds_of_worker_threads():
-    # at least TASK_SECONDS of work per task, at most four tasks per worker thread, and
-    # where there are more tasks than threads a whole number of rounds (five tasks of
-    # 0.2 s on four threads would take 0.4 s; four of 0.25 s take 0.25 s)
-    assert pd.task_size(10**6, 1e-6, 4) == 250_000
-    assert pd.task_size(10**8, 1e-6, 4) == 10**8 // 16  # four per worker thread
+    # at least TASK_SECONDS (0.05 s) of work per task, at most four tasks per worker
+    # thread, and where there are more tasks than threads a whole number of rounds (five
+    # tasks of 0.05 s on four threads would take 0.1 s; four of 0.0625 s take 0.0625 s)
+    assert pd.task_size(10**6, 1e-6, 4) == 10**6 // 16  # 1 s: four per worker thread
+    assert pd.task_size(10**8, 1e-6, 4) == 10**8 // 16
     assert pd.task_size(9 * 10**4, 3e-5, 2) == 9 * 10**4 // 8  # 2.7 s: four rounds
-    assert pd.task_size(9 * 10**4, 3e-5, 16) == math.ceil(9 * 10**4 / 13)  # 13 of 0.2 s
+    assert pd.task_size(9 * 10**4, 3e-5, 16) == math.ceil(9 * 10**4 / 48)  # three rounds
+    assert pd.task_size(70_000, 2e-5, 16) == 70_000 // 16  # 1.4 s still fills 16 workers
+    assert pd.task_size(2500, 1e-4, 16) == 500  # 0.25 s: five tasks of 0.05 s
     assert pd.task_size(1000, 1e-6, 4) == 1000  # 1 ms: one task
     assert pd.task_size(10, 1.0, 4) == 1  # never an empty task
 
 
 def _total(_, task):
     return int(np.sum(task))
+
+
+def test_large_task_data_goes_to_the_workers_apart_from_the_graph(client, monkeypatch):
+    # a task's data over SCATTER_BYTES is scattered to a worker (not sent through the
+    # scheduler in the graph), the task runs on it, and the workers let it go once the
+    # task is done; smaller data travels in the graph
+    from polycontact import _cluster
+
+    scattered = []
+    scatter = client.scatter
+
+    def spy(data, **kwargs):
+        scattered.append(kwargs.get("broadcast", False))
+        return scatter(data, **kwargs)
+
+    monkeypatch.setattr(client, "scatter", spy)
+    rows = _cluster.SCATTER_BYTES // 8  # one task's worth of float64 at the threshold
+    size = rows + 5  # items per task: just over the threshold
+    values = np.arange(3 * size, dtype=np.float64)
+
+    def tasks_of(spans):
+        return None, [values[p0:p1] for p0, p1 in spans]
+
+    parts = list(pd.run_spans(client, _float_total, len(values), tasks_of, chunk_size=size))
+    assert sorted((p0, p1) for p0, p1, _ in parts) == [(0, size), (size, 2 * size),
+                                                        (2 * size, 3 * size)]
+    assert sum(r for *_, r in parts) == values.sum()
+    assert scattered == [True, False, False, False]  # what all share, then each large task
+    scattered.clear()
+    small = list(pd.run_spans(client, _float_total, 1000, tasks_of, chunk_size=400))
+    assert len(small) == 3 and scattered == [True]
+
+    def held(dask_worker=None):
+        return len(dask_worker.data)
+
+    for _ in range(100):  # the release reaches the workers shortly after the results
+        if sum(client.run(held).values()) == 0:
+            break
+        time.sleep(0.05)
+    assert sum(client.run(held).values()) == 0
+
+
+def _float_total(_, task):
+    return float(np.sum(task))
 
 
 def test_poses_and_motions_given_to_the_cluster_are_checked_before_any_task(client):
