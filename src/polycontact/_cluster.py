@@ -24,10 +24,6 @@ PLUGIN_NAME = "polycontact-warmup"
 #: Items of the first task of :func:`run_spans`, which measures the work per item.
 PROBE_ITEMS = 256
 
-#: Bytes of a task's own data above which it is scattered to a worker rather than sent
-#: in the task graph (through the scheduler, which warns of graphs over 10 MB).
-SCATTER_BYTES = 2**20
-
 Tasks = Callable[[list[tuple[int, int]]], tuple[Any, list[Any]]]
 
 
@@ -121,7 +117,6 @@ def run_spans(
     early (an error, or Ctrl-C in the caller) cancels the tasks not yet finished.
     """
     import distributed
-    from dask.sizeof import sizeof
 
     if not count:
         return
@@ -148,25 +143,13 @@ def run_spans(
         shared, tasks = tasks_of(spans)
         [shared_future] = client.scatter([shared], broadcast=True, hash=False)
         futures.append(shared_future)
-        # a task's own data, where it is large, goes straight to a worker (the workers
-        # in turn), not through the scheduler in the task graph, and the task is
-        # submitted as soon as its data is there: it runs, where its data is, while the
-        # next task's is sent
-        submitted: list[Any] = []
-        sent: dict[int, Any] = {}  # the scattered data, let go as its task finishes
-        for k, task in enumerate(tasks):
-            if sizeof(task) > SCATTER_BYTES:
-                [task] = sent[k] = client.scatter([task], hash=False)
-                futures.append(task)
-            submitted.append(client.submit(fn, shared_future, task, *args, pure=False))
-            futures.append(submitted[-1])
+        submitted = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
+        futures.extend(submitted)
         index = {f.key: k for k, f in enumerate(submitted)}
         for f in as_completed(submitted):
             result = f.result()
             k = index[f.key]
             f.release()
-            if k in sent:
-                sent.pop(k)[0].release()
             yield *spans[k], result
     finally:
         client.cancel(futures)

@@ -19,8 +19,7 @@ to the local one. This module offers what they share (from
   item, the others get at least :data:`~polycontact.limits.TASK_SECONDS` of work each,
   at most four per worker thread, in whole rounds of one per worker thread
   (:func:`task_size`); what every task needs is sent to
-  every worker once, a task's own data over a megabyte straight to a worker, and the
-  results come back as they finish.
+  every worker once, and the results come back as they finish.
 - :func:`map_batches` calls any function on aligned slices of sequences that way.
 
 Examples

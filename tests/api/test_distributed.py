@@ -5,7 +5,6 @@ loses nothing; tasks are sized from a first one."""
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -363,50 +362,6 @@ def test_task_sizes_fill_whole_rounds_of_worker_threads():
 
 def _total(_, task):
     return int(np.sum(task))
-
-
-def test_large_task_data_goes_to_the_workers_apart_from_the_graph(client, monkeypatch):
-    # a task's data over SCATTER_BYTES is scattered to a worker (not sent through the
-    # scheduler in the graph), the task runs on it, and the workers let it go once the
-    # task is done; smaller data travels in the graph
-    from polycontact import _cluster
-
-    scattered = []
-    scatter = client.scatter
-
-    def spy(data, **kwargs):
-        scattered.append(kwargs.get("broadcast", False))
-        return scatter(data, **kwargs)
-
-    monkeypatch.setattr(client, "scatter", spy)
-    rows = _cluster.SCATTER_BYTES // 8  # one task's worth of float64 at the threshold
-    size = rows + 5  # items per task: just over the threshold
-    values = np.arange(3 * size, dtype=np.float64)
-
-    def tasks_of(spans):
-        return None, [values[p0:p1] for p0, p1 in spans]
-
-    parts = list(pd.run_spans(client, _float_total, len(values), tasks_of, chunk_size=size))
-    assert sorted((p0, p1) for p0, p1, _ in parts) == [(0, size), (size, 2 * size),
-                                                        (2 * size, 3 * size)]
-    assert sum(r for *_, r in parts) == values.sum()
-    assert scattered == [True, False, False, False]  # what all share, then each large task
-    scattered.clear()
-    small = list(pd.run_spans(client, _float_total, 1000, tasks_of, chunk_size=400))
-    assert len(small) == 3 and scattered == [True]
-
-    def held(dask_worker=None):
-        return len(dask_worker.data)
-
-    for _ in range(100):  # the release reaches the workers shortly after the results
-        if sum(client.run(held).values()) == 0:
-            break
-        time.sleep(0.05)
-    assert sum(client.run(held).values()) == 0
-
-
-def _float_total(_, task):
-    return float(np.sum(task))
 
 
 def test_poses_and_motions_given_to_the_cluster_are_checked_before_any_task(client):
