@@ -717,14 +717,6 @@ class World:
         The region bodies must stay in (holes are defects to avoid). Without one,
         nothing is outside.
 
-    Notes
-    -----
-    A World is used by one thread at a time: its calls run in parallel inside, but two
-    threads calling one World at once (a sweep while another thread moves bodies, or
-    two sweeps) can each read the other's half-done work. Give each thread its own
-    World, or hold a lock around the calls (and around reading the ``Contacts`` and
-    ``Sweep`` it returns, which compute their arrays on first access).
-
     Examples
     --------
     >>> import polycontact as pc
@@ -734,6 +726,14 @@ class World:
     ([5.0, 5.0], 1)
     >>> w.move(i, (0, 0), angle=0.5); w.remove(i); len(w)
     0
+
+    Notes
+    -----
+    A World is used by one thread at a time: its calls run in parallel inside, but two
+    threads calling one World at once (a sweep while another thread moves bodies, or
+    two sweeps) can each read the other's half-done work. Give each thread its own
+    World, or hold a lock around the calls (and around reading the ``Contacts`` and
+    ``Sweep`` it returns, which compute their arrays on first access).
     """
 
     # the per-body arrays (see _BODY_ARRAYS)
