@@ -149,6 +149,28 @@ def test_distinct_pairs_groups_equal_bodies_and_tolerances_only():
     assert slot.tolist() == [0, 1, 0, 2, 0, 3]
 
 
+@given(st.lists(st.integers(0, 3), min_size=1, max_size=60),
+       st.lists(st.sampled_from([1e-9, 2e-9]), min_size=60, max_size=60))
+@examples(30)
+def test_distinct_pairs_equal_a_grouping_by_full_comparison(which, tolerances):
+    # many repeats of four bodies (two of equal key, one with a -0.0 coordinate), in
+    # any order: each pair joins the group of the first pair equal to it in full
+    x, ls, bs, f = _bodies_of_equal_key()
+    x = x.copy()
+    x[8] = [-0.0, 0.0]  # (body 2: body 0 with a negative zero)
+    batch = (x, ls, bs, f, x, ls, bs, f)
+    pairs = np.array(which)
+    eps = np.array(tolerances[: len(which)])
+    first, slot = kd.distinct_pairs(batch, pairs, eps, kd.pair_keys(batch, pairs, eps))
+
+    def same(p, q):
+        return kd._samebody(x, ls, bs, f, pairs[p], pairs[q]) and eps[p] == eps[q]
+
+    want = [next(q for q in range(k + 1) if same(q, k)) for k in range(len(pairs))]
+    assert first.tolist() == sorted(set(want))
+    assert [first[s] for s in slot.tolist()] == want
+
+
 def test_batch_depth_beyond_its_memory_budget_is_refused(monkeypatch):
     monkeypatch.setattr(limits, "MAX_SUM_VERTICES", 3)
     # (40-gons: two small bodies take the contact segments, which build no sums)

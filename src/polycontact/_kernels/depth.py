@@ -557,47 +557,55 @@ def pair_keys(batch, pairs, eps):
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _key_slot(key, mask):
+    """The first slot of ``key`` in a table of ``mask + 1`` slots: its bits mixed (the
+    finalizer of MurmurHash3), so that near keys spread over the table."""
+    h = np.uint64(np.float64(key + 0.0).view(np.uint64))  # (-0.0 as 0.0)
+    h ^= h >> np.uint64(33)
+    h *= np.uint64(0xFF51AFD7ED558CCD)
+    h ^= h >> np.uint64(33)
+    return np.int64(h & np.uint64(mask))
+
+
 @njit(cache=True, nogil=True)
 def _grouped(batch, ids, eps, keys, both):
     """Groups of equal items ``ids[k]`` of a packed batch, found by their ``keys``
-    (equal items have equal keys) and compared in full within a run of equal keys:
+    (equal items have equal keys) and compared in full where keys are equal:
     ``(first, slot)``, ``first`` the positions k of the first item of each group in
     increasing order, ``slot[k]`` the position in ``first`` of item k's group. Items are
-    bodies A (``both`` False) or pairs of bodies A and B with tolerances ``eps``."""
+    bodies A (``both`` False) or pairs of bodies A and B with tolerances ``eps``.
+
+    One pass in order over a hash table of the groups met so far (open addressing,
+    linear probing, at most half full): each item is compared with the groups of its
+    key only, so the pass takes O(n) expected, and an item joins the first group it
+    equals (two groups are never equal)."""
     xa, lsa, bsa, fa, xb, lsb, bsb, fb = batch
     n = ids.shape[0]
-    order = np.argsort(keys, kind="mergesort")  # equal keys stay in order: first is first
-    rep = np.empty(n, np.int64)  # the first k' equal to k
-    reps = np.empty(n, np.int64)  # the distinct ones of the current run
-    g = 0
-    while g < n:
-        e = g + 1
-        while e < n and keys[order[e]] == keys[order[g]]:
-            e += 1
-        m = 0
-        for u in range(g, e):
-            k = order[u]
-            rep[k] = k
-            for v in range(m):
-                r = reps[v]
-                if _samebody(xa, lsa, bsa, fa, ids[r], ids[k]) and (not both or (
-                        eps[r] == eps[k] and _samebody(xb, lsb, bsb, fb, ids[r], ids[k]))):
-                    rep[k] = r
-                    break
-            if rep[k] == k:
-                reps[m] = k
-                m += 1
-        g = e
+    size = 16
+    while size < 2 * n:
+        size *= 2
+    mask = size - 1
+    table = np.full(size, -1, np.int64)  # the position of each group's first item
     slot = np.empty(n, np.int64)
     first = np.empty(n, np.int64)
     m = 0
     for k in range(n):
-        if rep[k] == k:
-            slot[k] = m
-            first[m] = k
-            m += 1
-        else:
-            slot[k] = slot[rep[k]]
+        h = _key_slot(keys[k], mask)
+        while True:
+            r = table[h]
+            if r < 0:
+                table[h] = k
+                slot[k] = m
+                first[m] = k
+                m += 1
+                break
+            if keys[r] == keys[k] and _samebody(xa, lsa, bsa, fa, ids[r], ids[k]) and (
+                    not both or (eps[r] == eps[k]
+                                 and _samebody(xb, lsb, bsb, fb, ids[r], ids[k]))):
+                slot[k] = slot[r]
+                break
+            h = (h + 1) & mask
     return first[:m].copy(), slot
 
 
@@ -606,8 +614,8 @@ def distinct_pairs(batch, pairs, eps, keys):
     """The distinct pairs among ``pairs`` of a packed batch (as :func:`pair_keys`, whose
     ``keys`` they are): ``(first, slot)``, ``first`` the positions k of the first pair
     of each group of equal pairs (equal bodies and tolerance), in increasing order, and
-    ``slot[k]`` the position in ``first`` of pair k's group. O(n log n) for n pairs, plus
-    a comparison of the bodies per pair whose key another pair shares."""
+    ``slot[k]`` the position in ``first`` of pair k's group. O(n) expected for n pairs,
+    plus a comparison of the bodies per pair whose key another pair shares."""
     return _grouped(batch, pairs, eps, keys, True)
 
 
@@ -618,7 +626,7 @@ def distinct_bodies(x, ls, bs, f, ids):
     ``slot[k]`` the position in ``first`` of the body equal to ``ids[k]``.
 
     Bodies are grouped by a weighted sum of their coordinates (equal bodies have equal
-    sums), then compared in full within a group: O(n log n) for n bodies, plus the
+    sums), then compared in full within a group: O(n) expected for n bodies, plus the
     comparisons, one per body unless different bodies share a sum.
     """
     n = ids.shape[0]
