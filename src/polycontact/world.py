@@ -1455,7 +1455,7 @@ class World:
         gap = finite_number(margin, "margin", minimum=0.0)
         alive = self._alive()
         pairs, states, used = k.contact_pairs(
-            self._grid(), self._bodies(), tol, alive, self._next, gap,
+            self._grid(), self._bodies(), (self._pos, self._rad), tol, alive, self._next, gap,
             k.CLASSIFIED if gap > 0.0 else k.TOUCHING, self._vmax, self._lmax,
             _chunks(len(alive), _BODY_WORK))
         if gap > 0.0:

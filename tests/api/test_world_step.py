@@ -325,6 +325,37 @@ def test_margin_lists_every_pair_within_it_and_no_other(spec, frame, margin):
             assert ((bodies[x].id, bodies[y].id) in got) == want
 
 
+@pytest.mark.parametrize("scale", SCALES)
+@pytest.mark.parametrize("shift", [0.0, 1e3, 1e9])
+def test_pairs_whose_bounding_circles_nearly_touch_are_classified_as_classify_does(
+        scale, shift):
+    # regular 16-gons tip to tip along the line of their centres: the gap between the
+    # tips is the gap between the bounding circles, set to multiples of the tolerance
+    t = 2.0 * np.pi * np.arange(16) / 16
+    gon = pc.Shape(np.column_stack((np.cos(t), np.sin(t))) * scale)
+    world = pc.World()
+    origin = np.array([shift, -shift]) * scale
+    probe = world.add(gon, origin)
+    placed = world.body(probe).shape
+    e = pc.classify(placed, placed.moved((3 * scale, 0))).tolerance
+    world.remove(probe)
+    factors = [0.0, 0.5, 0.99, 1.01, 2.0, 3.5, 100.0]
+    for k, f in enumerate(factors):
+        centre = origin + (0.0, 5.0 * scale * k)
+        world.add(gon, centre)
+        world.add(gon, centre + (2.0 * scale + f * e, 0.0))
+    bodies = world.bodies()
+    for margin in (0.0, 3.0 * e):
+        got = {tuple(p) for p in world.contacts(margin=margin).pairs.tolist()}
+        for x in range(0, len(bodies), 2):
+            r = pc.classify(bodies[x].shape, bodies[x + 1].shape)
+            at_margin = abs(r.distance - margin) <= 1e-9 * margin
+            if margin and r.state is pc.State.SEPARATE and at_margin:
+                continue  # at the margin, to the rounding: either answer
+            want = r.state is not pc.State.SEPARATE or r.distance <= margin
+            assert ((bodies[x].id, bodies[x + 1].id) in got) == want
+
+
 def test_geometry_in_parallel_chunks_equals_one_chunk(monkeypatch):
     rng = np.random.default_rng(4)
     items = [body(int(t), 1.0, "shape") for t in rng.integers(0, len(TEMPLATES), 60)]

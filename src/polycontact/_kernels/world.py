@@ -345,9 +345,31 @@ def body_view(xy, ls, lo, nl, b, buf):
     return xy[first : ls[lo[b] + m]], buf[: m + 1]
 
 
-#: What :func:`contact_pairs` returns: the candidate pairs unclassified, the pairs in
-#: contact or penetrating, or every candidate pair classified.
-CANDIDATES = 0
+#: Units of 2**-52 of the terms of a bounding-circle test (the centres' coordinates and
+#: paths, the radii) allowed for its rounding: a body's stored rows lie within its
+#: bounding radius of its centre up to the rounding of their placing (a few units of
+#: those terms), and the test's few operations round by a few units each.
+APART_ULPS = 64.0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def circles_reach(ca, la, cb, lb, travel, inflate):
+    """The distance of the centres ``ca`` and ``cb`` beyond which the bounding circles
+    of radii ``la`` and ``lb`` are provably apart: their sum inflated by twice the
+    relative ``inflate``, and :data:`APART_ULPS` of the terms of the centres' paths
+    (``travel``: what motions add to them) for the rounding.
+
+    >>> import numpy as np
+    >>> float(circles_reach(np.zeros(2), 1.0, np.array([3.0, 0.0]), 1.0, 0.0, 0.0)) > 2.0
+    True
+    """
+    big = la + lb
+    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + big
+    return big * (1.0 + 2.0 * inflate) + APART_ULPS * 2.0**-52 * terms
+
+
+#: What :func:`contact_pairs` returns: the pairs in contact or penetrating, or every
+#: candidate pair classified.
 TOUCHING = 1
 CLASSIFIED = 2
 
@@ -357,18 +379,24 @@ CLASSIFIED = 2
 # updates would cost a large part of a pair's classification. Nothing in it may
 # allocate: the buffers are passed in.
 @njit(cache=True, nogil=True, _nrt=False)
-def _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers):
+def _pairs_into(grid, bodies, circles, settings, alive, k0, k1, out, cap, buffers):
     """The pairs that the live bodies ``alive[k0:k1]`` find in the broad phase, with
     their states and tolerances, into ``out`` = ``(pi, pj, states, used)`` up to ``cap``
     of them; returns how many there are (those beyond ``cap`` counted, not written).
 
-    ``settings`` = ``(tol, emax, margin, n_ids, mode)`` (see :func:`contact_pairs`);
-    ``buffers`` = ``(cand, scratch, ba, bb)``: the grid's candidates, the state kernel's
-    scratch and the loop starts of the two bodies. Body i finds j when their boxes come
-    within the pair's tolerance plus ``margin``, j on a higher level than i's or on the
-    same level with j > i (so each pair once); the pair is ``(min, max)``.
+    ``circles`` = ``(centres, radii)``: each body's bounding circle (every stored row
+    within its radius of its centre, up to the rounding of the placing); ``settings`` =
+    ``(tol, emax, margin, n_ids, mode)`` (see :func:`contact_pairs`); ``buffers`` =
+    ``(cand, scratch, ba, bb)``: the grid's candidates, the state kernel's scratch and
+    the loop starts of the two bodies. Body i finds j when their boxes come within the
+    pair's tolerance plus ``margin``, j on a higher level than i's or on the same level
+    with j > i (so each pair once); the pair is ``(min, max)``. A pair whose bounding
+    circles lie farther apart than its tolerance plus ``margin`` (beyond the rounding,
+    :func:`circles_reach`) is passed over unclassified: it is separate, with a gap over
+    ``margin``, and neither mode lists it.
     """
     xy, ls, lo, nl, box, eps = bodies
+    cen, rad = circles
     tol, emax, margin, n_ids, mode = settings
     level = grid[3]
     oi, oj, ost, oe = out
@@ -391,13 +419,16 @@ def _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers):
             a = min(i, j)
             b = max(i, j)
             e = tol if tol >= 0.0 else max(eps[a], eps[b])
-            state = -1
-            if mode != CANDIDATES:
-                ya, sa = body_view(xy, ls, lo, nl, a, ba)
-                yb, sb = body_view(xy, ls, lo, nl, b, bb)
-                state = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
-                if mode == TOUCHING and state == 0:
-                    continue
+            gx = cen[b, 0] - cen[a, 0]
+            gy = cen[b, 1] - cen[a, 1]
+            if math.sqrt(gx * gx + gy * gy) > circles_reach(cen[a], rad[a], cen[b], rad[b],
+                                                            0.0, 0.0) + e + margin:
+                continue
+            ya, sa = body_view(xy, ls, lo, nl, a, ba)
+            yb, sb = body_view(xy, ls, lo, nl, b, bb)
+            state = state_in(ya, sa, 1.0, yb, sb, 1.0, e, scratch)
+            if mode == TOUCHING and state == 0:
+                continue
             if n < cap:
                 oi[n] = a
                 oj[n] = b
@@ -408,24 +439,26 @@ def _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers):
 
 
 @njit(cache=True, nogil=True)
-def _chunk_pairs(grid, bodies, settings, alive, k0, k1, out, cap, vmax, lmax):
+def _chunk_pairs(grid, bodies, circles, settings, alive, k0, k1, out, cap, vmax, lmax):
     """:func:`_pairs_into` with its buffers, for bodies of up to ``vmax`` vertices and
     ``lmax`` loops."""
     buffers = (np.empty(settings[3], np.int64), state_scratch(2 * vmax),
                np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
-    return _pairs_into(grid, bodies, settings, alive, k0, k1, out, cap, buffers)
+    return _pairs_into(grid, bodies, circles, settings, alive, k0, k1, out, cap, buffers)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def contact_pairs(grid, bodies, tol, alive, n_ids, margin, mode, vmax, lmax, chunks):
+def contact_pairs(grid, bodies, circles, tol, alive, n_ids, margin, mode, vmax, lmax, chunks):
     """The pairs of live bodies whose boxes come within their tolerance plus
     ``margin``, classified by the state kernel, in parallel chunks of ``alive``
     (``chunks`` = 1: serial, no thread start): ``(pairs (P, 2), states (P,) int8,
     tolerances (P,))``, the pairs ``(i, j)`` with i < j, sorted. ``mode``:
-    :data:`CANDIDATES` (every such pair, states -1), :data:`TOUCHING` (those in contact
-    or penetrating) or :data:`CLASSIFIED` (every such pair). ``tol`` < 0: each pair's
+    :data:`TOUCHING` (those in contact or penetrating) or :data:`CLASSIFIED` (every
+    such pair, but those whose bounding circles are farther apart than their tolerance
+    plus ``margin``: separate, by more than ``margin``). ``tol`` < 0: each pair's
     default tolerance, the larger of its bodies' ``eps``. ``grid`` and ``bodies`` are
-    the World's records (see the module's docstring); ``n_ids`` bounds the ids.
+    the World's records (see the module's docstring), ``circles`` = ``(centres,
+    radii)`` the bodies' bounding circles; ``n_ids`` bounds the ids.
 
     Each chunk writes its pairs into a buffer of its own, sized for four per body (a
     chunk that finds more is run again into the output once the counts are known);
@@ -450,16 +483,16 @@ def contact_pairs(grid, bodies, tol, alive, n_ids, margin, mode, vmax, lmax, chu
     be = np.empty((chunks, cap))
     count = np.zeros(chunks, np.int64)
     if chunks == 1:
-        m = _chunk_pairs(grid, bodies, settings, alive, 0, n, (bi[0], bj[0], bs[0], be[0]),
-                         cap, vmax, lmax)
+        m = _chunk_pairs(grid, bodies, circles, settings, alive, 0, n,
+                         (bi[0], bj[0], bs[0], be[0]), cap, vmax, lmax)
         if m <= cap:
             return sorted_pairs(bi[0, :m], bj[0, :m], bs[0, :m], be[0, :m], n_ids, 1)
         out = (np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
                np.empty(m))
-        _chunk_pairs(grid, bodies, settings, alive, 0, n, out, m, vmax, lmax)
+        _chunk_pairs(grid, bodies, circles, settings, alive, 0, n, out, m, vmax, lmax)
         return sorted_pairs(out[0], out[1], out[2], out[3], n_ids, 1)
     for c in prange(chunks):
-        count[c] = _chunk_pairs(grid, bodies, settings, alive, n * c // chunks,
+        count[c] = _chunk_pairs(grid, bodies, circles, settings, alive, n * c // chunks,
                                 n * (c + 1) // chunks, (bi[c], bj[c], bs[c], be[c]), cap,
                                 vmax, lmax)
     start = np.zeros(chunks + 1, np.int64)
@@ -479,7 +512,7 @@ def contact_pairs(grid, bodies, tol, alive, n_ids, margin, mode, vmax, lmax, chu
             states[s0:s1] = bs[c, : s1 - s0]
             used[s0:s1] = be[c, : s1 - s0]
         else:
-            _chunk_pairs(grid, bodies, settings, alive, n * c // chunks,
+            _chunk_pairs(grid, bodies, circles, settings, alive, n * c // chunks,
                          n * (c + 1) // chunks,
                          (pi[s0:s1], pj[s0:s1], states[s0:s1], used[s0:s1]), s1 - s0,
                          vmax, lmax)

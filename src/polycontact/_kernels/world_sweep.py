@@ -40,7 +40,7 @@ from .impact import HIT, INITIALLY_PENETRATING, place, query_intervals, query_se
     tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
-from .world import body_view
+from .world import body_view, circles_reach
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -176,11 +176,6 @@ def _turned(b, base, tables, frames, st):
                                          view(ct, tfo[b], m, 4, np.float64), lt[f:f + n])
 
 
-#: Units of 2**-52 of the terms of the centres' paths allowed for the rounding of
-#: :func:`_circles_apart` (its few operations round by a few units each).
-_APART_ULPS = 64.0
-
-
 @njit(cache=True, nogil=True)
 def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
     """Whether the bounding circles provably stay apart over [0, t_max], with the margin
@@ -202,7 +197,7 @@ def _circles_apart(ca, ma, la, cb, mb, lb, t_max, inflate):
     px = dx + vx * t
     py = dy + vy * t
     acc = 0.5 * math.sqrt(ax * ax + ay * ay) * t_max * t_max
-    r = _circles_reach(ca, la, cb, lb, math.sqrt(v2) * t_max + acc, inflate)
+    r = circles_reach(ca, la, cb, lb, math.sqrt(v2) * t_max + acc, inflate)
     return math.sqrt(px * px + py * py) - acc > r
 
 
@@ -213,18 +208,7 @@ def _circles_meet_at_start(ca, la, cb, lb, inflate):
     starts at 0, they do."""
     dx = cb[0] - ca[0]
     dy = cb[1] - ca[1]
-    return math.sqrt(dx * dx + dy * dy) <= _circles_reach(ca, la, cb, lb, 0.0, inflate)
-
-
-@njit(cache=True, nogil=True)
-def _circles_reach(ca, la, cb, lb, travel, inflate):
-    """The distance of the centres (``ca``, ``cb``) beyond which bounding circles of
-    radii ``la`` and ``lb`` are apart with more than the margin of ``exact_query``'s broad
-    phase: the radii inflated twice as much, and :data:`_APART_ULPS` of the terms of the
-    centres' paths (``travel``: what the motions add to them) for the rounding."""
-    big = la + lb
-    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + big
-    return big * (1.0 + 2.0 * inflate) + _APART_ULPS * 2.0**-52 * terms
+    return math.sqrt(dx * dx + dy * dy) <= circles_reach(ca, la, cb, lb, 0.0, inflate)
 
 
 @njit(cache=True, nogil=True, inline="always")
