@@ -79,7 +79,6 @@ import polycontact as pc
 PARALLEL = [
     ("polycontact._kernels.world", "contact_pairs"),
     ("polycontact._kernels.world", "container_states"),
-    ("polycontact._kernels.world", "left_cells"),
     ("polycontact._kernels.world", "regrid"),
     ("polycontact._kernels.packs", "unpack_shapes"),
     ("polycontact._kernels.poses", "pose_rows"),

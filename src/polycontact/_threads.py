@@ -72,7 +72,10 @@ def chunks(count: int, work: float = 1.0) -> int:
     classifications each (:data:`PAIR_SECONDS`): 1 (serial, no thread start) when the
     work needs one thread, else four per useful thread (so that threads that finish
     early take no more than a quarter of their share of waiting)."""
-    n = useful(requested(None), count * work * PAIR_SECONDS)
+    seconds = count * work * PAIR_SECONDS
+    if seconds < 2.0 * THREAD_WORK:  # (one thread, however many there are)
+        return 1
+    n = useful(requested(None), seconds)
     return 1 if n == 1 else 4 * n
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -61,7 +61,9 @@ __all__ = ["World", "WorldBody", "Contacts", "Query", "Sweep"]
 _SCAN_BODIES = 64
 
 
+@cache
 def _k() -> Any:
+    """The World's kernels, imported on first use (loading them takes a while)."""
     from ._kernels import world
 
     return world
@@ -1030,7 +1032,9 @@ class World:
         if placed and count:
             _, emax = pose_rows(ids, (np.ascontiguousarray(p), a), self._bodies(),
                                 (self._bxy, self._cen), (RELATIVE_TOLERANCE, ROUNDING_ULPS),
-                                (self._pos, self._ang, self._ver), _chunks(count, _POSE_WORK))
+                                (self._pos, self._ang, self._ver),
+                                (self._keys, self._slot, np.zeros(2), np.empty(0, np.bool_)),
+                                _chunks(count, _POSE_WORK))
             self._emax = max(self._emax, float(emax))  # (the poses stored by pose_rows)
         else:
             self._pos[ids] = p
@@ -1250,12 +1254,14 @@ class World:
             every = len(idx) == len(self._records)
             self._xy = np.empty_like(self._xy) if every else self._xy.copy()
             self._shared = False
-        chunks = _chunks(len(idx), _POSE_WORK)
+        out = np.empty(len(idx), np.bool_)
         _, emax = pose_rows(idx, (pos, ang), self._bodies(), (self._bxy, self._cen),
                             (RELATIVE_TOLERANCE, ROUNDING_ULPS),
-                            (self._pos, self._ang, self._ver), chunks)
+                            (self._pos, self._ang, self._ver),
+                            (self._keys, self._slot, self._origin, out),
+                            _chunks(len(idx), _POSE_WORK))
         self._emax = max(self._emax, float(emax))
-        left = _k().left_cells(idx, self._keys, self._slot, self._box, self._origin, chunks)
+        left = idx[out]
         made, done = _k().regrid(left, self._keys, self._heads, self._nxt, self._prv,
                                  self._slot, self._level, self._lvl_count, self._box,
                                  self._origin, self._filled, _chunks(len(left), _GRID_WORK))

@@ -6,7 +6,8 @@ holes clockwise) with the base's area centroid ``cen``, and the rows ``xy`` wher
 stands: ``xy = pos + R(angle) (bxy - cen)``, element by element as
 :func:`polycontact._kernels.world.place` computes it, so that a pose set here and one
 set body by body give the same bits. Each body's box, default tolerance and cell of the
-broad-phase grid follow its rows; a body whose new box stays in its cell costs the grid
+broad-phase grid follow its rows: the pass that writes the rows also marks the bodies
+whose box has left their cell, and a body whose new box stays in its cell costs the grid
 nothing (:func:`polycontact._kernels.world.regrid`).
 
 The centroid is :attr:`polycontact.Shape.centroid`'s formula with NumPy's summation
@@ -23,6 +24,7 @@ from numba import prange
 
 from .jit import njit
 from .tolerance import box_extent_magnitude, tolerance_for
+from .world import cell_key
 
 #: NumPy's pairwise summation: runs of up to this many terms are summed in 8 lanes.
 _BLOCK = 128
@@ -153,7 +155,7 @@ def centroids(xy, ls, bs, cen, rad):
 
 
 @njit(cache=True, nogil=True)
-def _pose_range(ids, poses, bodies, base, tolerance, store, k0, k1):
+def _pose_range(ids, poses, bodies, base, tolerance, store, cells, k0, k1):
     """:func:`pose_rows` for ``ids[k0:k1]``; returns the largest |coordinate| and the
     largest tolerance written."""
     pos, ang = poses
@@ -161,6 +163,7 @@ def _pose_range(ids, poses, bodies, base, tolerance, store, k0, k1):
     bxy, cen = base
     rel, ulps = tolerance
     pos_out, ang_out, ver = store
+    keys, slot, origin, left = cells
     big = 0.0
     emax = 0.0
     for k in range(k0, k1):
@@ -198,13 +201,15 @@ def _pose_range(ids, poses, bodies, base, tolerance, store, k0, k1):
         box[b, 3] = y1
         extent, magnitude = box_extent_magnitude(x0, x1, y0, y1)
         eps[b] = tolerance_for(extent, magnitude, rel, ulps)
+        if left.shape[0]:
+            left[k] = not (slot[b] >= 0 and keys[slot[b]] == cell_key(box, b, origin)[1])
         big = max(big, magnitude)
         emax = max(emax, eps[b])
     return big, emax
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def pose_rows(ids, poses, bodies, base, tolerance, store, chunks):
+def pose_rows(ids, poses, bodies, base, tolerance, store, cells, chunks):
     """Rows, boxes (``x0, x1, y0, y1``) and default tolerances of the bodies ``ids`` at
     the poses ``poses`` = ``(pos (P, 2), ang (P,))`` (row k for body ``ids[k]``; ``ang``
     empty: each body keeps its angle), written into the World's ``bodies`` record
@@ -213,16 +218,19 @@ def pose_rows(ids, poses, bodies, base, tolerance, store, chunks):
     rows turned about its base centroid and moved so that the centroid goes to the
     position (``base`` = ``(bxy, cen)``: the rows as added and each body's centroid).
     ``tolerance`` = ``(rel, ulps)``: the default tolerance's terms
-    (:func:`polycontact._kernels.tolerance.tolerance_for`). In parallel chunks
-    (``chunks`` = 1: serial, no thread start). Returns the largest |coordinate| and the
-    largest tolerance written."""
+    (:func:`polycontact._kernels.tolerance.tolerance_for`). ``cells`` = ``(keys, slot,
+    origin, left)``: the grid's table of cells, each body's slot in it and the grid's
+    origin; ``left[k]`` (bool, (P,)) is set when body ``ids[k]``'s new box is out of its
+    cell (empty ``left``: not looked at), the bodies :func:`polycontact._kernels.world.regrid`
+    has to move. In parallel chunks (``chunks`` = 1: serial, no thread start). Returns
+    the largest |coordinate| and the largest tolerance written."""
     n = ids.shape[0]
     if chunks == 1:
-        return _pose_range(ids, poses, bodies, base, tolerance, store, 0, n)
+        return _pose_range(ids, poses, bodies, base, tolerance, store, cells, 0, n)
     big = np.zeros(chunks)
     emax = np.zeros(chunks)
     for c in prange(chunks):
-        big[c], emax[c] = _pose_range(ids, poses, bodies, base, tolerance, store,
+        big[c], emax[c] = _pose_range(ids, poses, bodies, base, tolerance, store, cells,
                                       n * c // chunks, n * (c + 1) // chunks)
     return big.max(), emax.max()
 

@@ -93,7 +93,7 @@ def _slot(keys, key):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _cell_key(box, b, origin):
+def cell_key(box, b, origin):
     """The level index of body ``b``'s box and the hash key of the cell that holds it."""
     idx = _level(box[b, 0], box[b, 1], box[b, 2], box[b, 3])
     c = math.ldexp(1.0, int(idx) - _LEVEL_OFFSET)
@@ -105,7 +105,7 @@ def _cell_key(box, b, origin):
 @njit(cache=True, nogil=True)
 def grid_insert(keys, heads, nxt, prv, slot, level, lvl_count, box, origin, b):
     """Put body ``b`` (its box set) in its cell; returns 1 if a new cell was made."""
-    idx, key = _cell_key(box, b, origin)
+    idx, key = cell_key(box, b, origin)
     h = _slot(keys, key)
     made = 0
     if keys[h] == -1:
@@ -183,7 +183,7 @@ def _regrid_probe(ids, keys, slot, level, box, origin, k0, k1, moves):
     rows of ``moves`` (see :func:`regrid`)."""
     for k in range(k0, k1):
         b = ids[k]
-        idx, key = _cell_key(box, b, origin)
+        idx, key = cell_key(box, b, origin)
         moves[k, 0] = slot[b]
         moves[k, 1] = level[b]
         moves[k, 2] = idx
@@ -212,7 +212,7 @@ def _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, insert):
 @njit(cache=True, nogil=True, parallel=True)
 def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled, chunks):
     """Move each body of ``ids`` (boxes already set, and each out of its cell: see
-    :func:`left_cells`) to the cell of its box, in a table holding ``filled`` cells;
+    :func:`polycontact._kernels.poses.pose_rows`) to the cell of its box, in a table holding ``filled`` cells;
     stops before it would be more than half full. Returns (cells made, bodies done).
 
     The same table and lists as :func:`grid_remove` then :func:`grid_insert` of each
@@ -253,41 +253,6 @@ def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, fill
     for c in prange(chunks):
         _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, True)
     return made, n
-
-
-@njit(cache=True, nogil=True)
-def _left(ids, keys, slot, box, origin, k0, k1, out):
-    """The bodies of ``ids[k0:k1]`` out of their cell, into ``out``; how many."""
-    n = 0
-    for k in range(k0, k1):
-        b = ids[k]
-        if not (slot[b] >= 0 and keys[slot[b]] == _cell_key(box, b, origin)[1]):
-            out[n] = b
-            n += 1
-    return n
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def left_cells(ids, keys, slot, box, origin, chunks):
-    """The bodies of ``ids`` (boxes already set) whose box is no longer in their cell of
-    the grid, in the order of ``ids``: the only ones :func:`regrid` has to move (a body
-    that stays costs the grid nothing). In ``chunks`` parallel chunks."""
-    n = ids.shape[0]
-    part = np.empty(n, np.int64)
-    if chunks == 1:
-        return part[: _left(ids, keys, slot, box, origin, 0, n, part)]
-    count = np.zeros(chunks, np.int64)
-    for c in prange(chunks):
-        k0 = n * c // chunks
-        count[c] = _left(ids, keys, slot, box, origin, k0, n * (c + 1) // chunks, part[k0:])
-    start = np.zeros(chunks + 1, np.int64)
-    for c in range(chunks):
-        start[c + 1] = start[c] + count[c]
-    out = np.empty(start[chunks], np.int64)
-    for c in prange(chunks):
-        k0 = n * c // chunks
-        out[start[c] : start[c + 1]] = part[k0 : k0 + count[c]]
-    return out
 
 
 @njit(cache=True, nogil=True)
