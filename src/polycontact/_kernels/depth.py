@@ -559,13 +559,17 @@ def pair_keys(batch, pairs, eps):
 
 @njit(cache=True, nogil=True, inline="always")
 def _key_slot(key, mask):
-    """The first slot of ``key`` in a table of ``mask + 1`` slots: its bits mixed (the
-    finalizer of MurmurHash3), so that near keys spread over the table."""
-    h = np.uint64(np.float64(key + 0.0).view(np.uint64))  # (-0.0 as 0.0)
-    h ^= h >> np.uint64(33)
-    h *= np.uint64(0xFF51AFD7ED558CCD)
-    h ^= h >> np.uint64(33)
-    return np.int64(h & np.uint64(mask))
+    """The first slot of ``key`` in a table of ``mask + 1`` slots: its bits mixed by the
+    finalizer of MurmurHash3 (the constants as signed 64-bit integers), so that keys
+    that differ in any bit spread over the table. Compiled, the products wrap in int64;
+    in plain Python they do not, a different hash as good."""
+    h = int(np.float64(key + 0.0).view(np.int64))  # (-0.0 as 0.0)
+    h ^= h >> 33
+    h *= -49064778989728563
+    h ^= h >> 33
+    h *= -4265267296055464877
+    h ^= h >> 33
+    return h & mask
 
 
 @njit(cache=True, nogil=True)
