@@ -317,7 +317,7 @@ def body_view(xy, ls, lo, nl, b, buf):
 APART_ULPS = 64.0
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def circles_reach(ca, la, cb, lb, travel, inflate):
     """The distance of the centres ``ca`` and ``cb`` beyond which the bounding circles
     of radii ``la`` and ``lb`` are provably apart: their sum inflated by twice the
