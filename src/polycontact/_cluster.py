@@ -24,6 +24,10 @@ PLUGIN_NAME = "polycontact-warmup"
 #: Items of the first task of :func:`run_spans`, which measures the work per item.
 PROBE_ITEMS = 256
 
+#: Times :func:`run_spans` runs a task again when the scheduler has forgotten it (a
+#: worker that died took what it needed) before the batch fails.
+RESUBMITS = 3
+
 Tasks = Callable[[list[tuple[int, int]]], tuple[Any, list[Any]]]
 
 
@@ -113,8 +117,10 @@ def run_spans(
     have that many items; else a first task of :data:`PROBE_ITEMS` items measures the
     work per item and :func:`task_size` sizes the others. With a ``family`` (a name),
     every worker runs that first task once when it starts or joins (:func:`warm`), so
-    that it loads the kernels the tasks use before any is timed. Closing the generator
-    early (an error, or Ctrl-C in the caller) cancels the tasks not yet finished.
+    that it loads the kernels the tasks use before any is timed. A task the scheduler
+    cancels (a dead worker held what it needed) is run again, at most
+    :data:`RESUBMITS` times. Closing the generator early (an error, or Ctrl-C in the
+    caller) cancels the tasks not yet finished.
     """
     import distributed
 
@@ -146,9 +152,24 @@ def run_spans(
         submitted = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
         futures.extend(submitted)
         index = {f.key: k for k, f in enumerate(submitted)}
-        for f in as_completed(submitted):
-            result = f.result()
+        tries = [0] * len(tasks)
+        done = as_completed(submitted)
+        for f in done:
             k = index[f.key]
+            try:
+                result = f.result()
+            except distributed.client.FutureCancelledError:
+                # The scheduler forgot the task: a worker that died took with it what
+                # the task needed. Run it again, the shared data sent again.
+                tries[k] += 1
+                if tries[k] > RESUBMITS:
+                    raise
+                [shared_future] = client.scatter([shared], broadcast=True, hash=False)
+                again = client.submit(fn, shared_future, tasks[k], *args, pure=False)
+                futures.extend((shared_future, again))
+                index[again.key] = k
+                done.add(again)
+                continue
             f.release()
             yield *spans[k], result
     finally:

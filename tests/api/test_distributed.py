@@ -303,6 +303,27 @@ def test_a_killed_worker_loses_no_entry(client, tmp_path):
     client.wait_for_workers(2)  # the nanny restarts it
 
 
+def test_a_task_the_scheduler_forgets_is_run_again(client, tmp_path):
+    # a task cancelled on the scheduler (as when a dead worker held what it needed)
+    pieces = [turned(p, 0) for p in PIECES]
+    local = here(lambda: pc.nfp_table(pieces, ANGLES, progress=False))
+    cancelled = []
+
+    def cancel_one(done, total):
+        if not cancelled:
+            keys = [key for key, state in list(client.futures.items())
+                    if str(key).startswith("_compute_chunk") and state.status == "pending"]
+            if keys:
+                client.cancel([distributed.Future(keys[-1], client)])
+                cancelled.append(keys[-1])
+
+    remote = pc.nfp_table(pieces, ANGLES, client=client, progress=cancel_one, chunk_size=5,
+                          cache=tmp_path)
+    assert cancelled
+    for key in local:
+        assert same_entry(local[key], remote[key])
+
+
 async def _exit() -> None:
     import asyncio
     import os
