@@ -122,6 +122,8 @@ def run_spans(
     :data:`RESUBMITS` times. Closing the generator early (an error, or Ctrl-C in the
     caller) cancels the tasks not yet finished.
     """
+    from concurrent.futures import CancelledError
+
     import distributed
 
     if not count:
@@ -158,7 +160,7 @@ def run_spans(
             k = index[f.key]
             try:
                 result = f.result()
-            except distributed.client.FutureCancelledError:
+            except CancelledError:  # (distributed's FutureCancelledError is one)
                 # The scheduler forgot the task: a worker that died took with it what
                 # the task needed. Run it again, the shared data sent again.
                 tries[k] += 1
