@@ -212,8 +212,9 @@ def _regrid_lists(ids, moves, heads, nxt, prv, slot, level, c, chunks, insert):
 @njit(cache=True, nogil=True, parallel=True)
 def regrid(ids, keys, heads, nxt, prv, slot, level, lvl_count, box, origin, filled, chunks):
     """Move each body of ``ids`` (boxes already set, and each out of its cell: see
-    :func:`polycontact._kernels.poses.pose_rows`) to the cell of its box, in a table holding ``filled`` cells;
-    stops before it would be more than half full. Returns (cells made, bodies done).
+    :func:`polycontact._kernels.poses.pose_rows`) to the cell of its box, in a table
+    holding ``filled`` cells; stops before it would be more than half full. Returns
+    (cells made, bodies done).
 
     The same table and lists as :func:`grid_remove` then :func:`grid_insert` of each
     body in turn, in ``chunks`` parallel chunks: the cells' keys and slots are looked up
@@ -333,6 +334,21 @@ def circles_reach(ca, la, cb, lb, travel, inflate):
     return big * (1.0 + 2.0 * inflate) + APART_ULPS * 2.0**-52 * terms
 
 
+@njit(cache=True, nogil=True)
+def circles_apart(ca, la, cb, lb, gap, inflate):
+    """Whether the bounding circles of radii ``la`` and ``lb`` about ``ca`` and ``cb``
+    (inflated by the relative ``inflate``) lie provably more than ``gap`` apart, beyond
+    the rounding (:func:`circles_reach` of motionless centres).
+
+    >>> import numpy as np
+    >>> bool(circles_apart(np.zeros(2), 1.0, np.array([3.0, 0.0]), 1.0, 0.5, 0.0))
+    True
+    """
+    dx = cb[0] - ca[0]
+    dy = cb[1] - ca[1]
+    return math.sqrt(dx * dx + dy * dy) > circles_reach(ca, la, cb, lb, 0.0, inflate) + gap
+
+
 #: What :func:`contact_pairs` returns: the pairs in contact or penetrating, or every
 #: candidate pair classified.
 TOUCHING = 1
@@ -384,10 +400,7 @@ def _pairs_into(grid, bodies, circles, settings, alive, k0, k1, out, cap, buffer
             a = min(i, j)
             b = max(i, j)
             e = tol if tol >= 0.0 else max(eps[a], eps[b])
-            gx = cen[b, 0] - cen[a, 0]
-            gy = cen[b, 1] - cen[a, 1]
-            if math.sqrt(gx * gx + gy * gy) > circles_reach(cen[a], rad[a], cen[b], rad[b],
-                                                            0.0, 0.0) + e + margin:
+            if circles_apart(cen[a], rad[a], cen[b], rad[b], e + margin, 0.0):
                 continue
             ya, sa = body_view(xy, ls, lo, nl, a, ba)
             yb, sb = body_view(xy, ls, lo, nl, b, bb)

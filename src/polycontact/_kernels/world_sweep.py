@@ -40,7 +40,7 @@ from .impact import HIT, INITIALLY_PENETRATING, place, query_intervals, query_se
     tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
-from .world import body_view, circles_reach
+from .world import body_view, circles_apart, circles_reach
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -206,9 +206,7 @@ def _circles_meet_at_start(ca, la, cb, lb, inflate):
     """Whether the bounding circles may overlap at t = 0, with the margin of
     :func:`_circles_apart`: where the first interval of ``exact_query``'s broad phase
     starts at 0, they do."""
-    dx = cb[0] - ca[0]
-    dy = cb[1] - ca[1]
-    return math.sqrt(dx * dx + dy * dy) <= circles_reach(ca, la, cb, lb, 0.0, inflate)
+    return not circles_apart(ca, la, cb, lb, 0.0, inflate)
 
 
 @njit(cache=True, nogil=True, inline="always")
