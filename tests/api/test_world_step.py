@@ -20,6 +20,7 @@ from kernels.test_contact_geometry import offset
 
 import polycontact as pc
 import polycontact.world as world_module
+from polycontact.limits import CONTACT_RESOLUTION
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -454,6 +455,34 @@ def test_sweep_agrees_with_time_of_impact_on_every_pair(spec, frame, moves, dt):
             if code == 2:
                 assert s.times[k] == 0.0 and s.penetration_times[k] == 0.0
             assert abs(math.hypot(*s.normals[k]) - 1.0) <= 1e-9
+
+
+@pytest.mark.parametrize("scale", SCALES)
+@pytest.mark.parametrize("shift", [0.0, 1e9])
+@pytest.mark.parametrize("turn", [False, True])
+def test_a_pair_that_ends_the_step_within_the_contact_resolution_is_reported(scale, shift,
+                                                                          turn):
+    """Two squares whose gap along the line of their centres closes to a third of the
+    contact resolution at the end of the step, by a slide or by an eighth of a turn that
+    brings a corner round: the sweep reports the touch as time_of_impact does (the line
+    of the centres proves nothing within the tolerances)."""
+    h = scale
+    square = [(-h, -h), (h, -h), (h, h), (-h, h)]
+    gap = CONTACT_RESOLUTION * 2.0 * math.sqrt(2.0) * h / 3.0
+    if turn:
+        x, v, w = h + math.sqrt(2.0) * h + gap, 0.0, math.pi / 4.0
+    else:
+        x, v, w = 2.0 * h + 0.5 * h + gap, -0.5 * h, 0.0
+    origin = np.array([shift * scale, 0.0])
+    world = pc.World()
+    world.add_many([square, square], [origin, origin + (x, 0.0)], [0.0, 0.0])
+    s = world.sweep(1.0, [(0.0, 0.0), (v, 0.0)], [0.0, w])
+    bodies = world.bodies()
+    imp = pc.time_of_impact(bodies[0].shape, pc.Motion(), bodies[1].shape,
+                            pc.Motion(velocity=(v, 0.0), angular_velocity=w), t_max=1.0)
+    assert imp.first_contact is not None
+    assert s.pairs.tolist() == [[0, 1]]
+    assert s.states[0] == (2 if imp.status is pc.ImpactStatus.HIT else 1)
 
 
 def test_sweep_finds_a_thin_spinning_body_that_passes_through_another():

@@ -18,7 +18,10 @@ their relative margin of 1e-12 over the rounding of the turn). A pair whose boun
 circles overlap at the start is classified there once, as the bodies stand (the bodies
 at t = 0 are their stored rows): if it penetrates it is reported as ``exact_query``
 reports it, without turning anything; if not, the search starts from there without
-classifying it again.
+classifying it again. A pair whose bodies the line of their centres at t = 0 keeps
+apart over the whole step, each body's reach along it taken over its turn, beyond the
+tolerance and the contact resolution (:func:`_axis_apart`), is not searched: the search
+would report nothing.
 
 At the first contact time of a pair (time 0 when it touches or penetrates at the
 start), both bodies are placed and classified (a pair found penetrating at the start is
@@ -36,11 +39,11 @@ from numba import prange
 from .jit import njit
 from .advance import edge_table_into, table_scratch
 from .contact_geometry import geometry_buffers, geometry_into, grown_buffers
-from .impact import HIT, INITIALLY_PENETRATING, place, query_intervals, query_search, state_at, \
-    tolerance_at, work_floats
+from .impact import HIT, INITIALLY_PENETRATING, LAM_PER_EPS, place, query_intervals, \
+    query_search, state_at, tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
-from .world import body_view, circles_apart, circles_reach
+from .world import APART_ULPS, body_view, circles_apart, circles_reach
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -209,6 +212,92 @@ def _circles_meet_at_start(ca, la, cb, lb, inflate):
     return not circles_apart(ca, la, cb, lb, 0.0, inflate)
 
 
+@njit(cache=True, nogil=True)
+def _turn_range(m, t_max):
+    """The least and the greatest angle a body with motion row ``m`` (``[vx, vy, ax, ay,
+    ω, α]``) has turned through over [0, ``t_max``]: of ``ω t + α t²/2``, 0 included."""
+    w = m[4]
+    al = m[5]
+    end = (w + 0.5 * al * t_max) * t_max
+    lo = min(0.0, end)
+    hi = max(0.0, end)
+    if al != 0.0:
+        ts = -w / al
+        if 0.0 < ts < t_max:
+            top = 0.5 * w * ts
+            lo = min(lo, top)
+            hi = max(hi, top)
+    return lo, hi
+
+
+@njit(cache=True, nogil=True)
+def _turned_support(r, rl, ux, uy, m, t_max):
+    """The greatest projection on (ux, uy) of the vertices ``r`` (about the centre they
+    turn about; ``rl``: their lengths) as the body turns over [0, ``t_max``]: a vertex
+    reaches its length where the turn takes it through the direction, else the larger
+    projection of the turn's two ends."""
+    lo, hi = _turn_range(m, t_max)
+    full = hi - lo >= math.pi
+    c = math.cos(lo)
+    s = math.sin(lo)
+    ax = c * ux + s * uy  # the direction as the body sees it at the turn's two ends
+    ay = c * uy - s * ux
+    c = math.cos(hi)
+    s = math.sin(hi)
+    bx = c * ux + s * uy
+    by = c * uy - s * ux
+    best = -np.inf
+    for i in range(r.shape[0]):
+        x = r[i, 0]
+        y = r[i, 1]
+        if full or (bx * y - by * x >= 0.0 and x * ay - y * ax >= 0.0):
+            p = rl[i]
+        else:
+            p = max(x * ax + y * ay, x * bx + y * by)
+        best = max(best, p)
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _axis_apart(a, ma, b, mb, t_max, margin):
+    """Whether two bodies provably stay more than ``margin`` apart over [0, ``t_max``],
+    beyond the rounding: along the line of their centres at t = 0, the centres' distance
+    less what the motions take off it and the bodies' :func:`_turned_support` on either
+    side. ``a``, ``b`` = ``(r, lengths, centre, radius)``; ``ma``, ``mb``: motion rows.
+
+    >>> import numpy as np
+    >>> sq = np.array([[-1.0, -1], [1, -1], [1, 1], [-1, 1]])
+    >>> rl = np.full(4, np.sqrt(2.0))
+    >>> spin = np.array([0.0, 0, 0, 0, 0.5, 0])
+    >>> [bool(_axis_apart((sq, rl, np.zeros(2), 1.5), spin,
+    ...                   (sq, rl, np.array([x, 0.0]), 1.5), spin, 1.0, 0.0)) for x in (2.5, 3.0)]
+    [False, True]
+    """
+    ra, la, ca, rad_a = a
+    rb, lb, cb, rad_b = b
+    dx = cb[0] - ca[0]
+    dy = cb[1] - ca[1]
+    d = math.sqrt(dx * dx + dy * dy)
+    if d == 0.0:
+        return False
+    ux = dx / d
+    uy = dy / d
+    vx = mb[0] - ma[0]
+    vy = mb[1] - ma[1]
+    ax = mb[2] - ma[2]
+    ay = mb[3] - ma[3]
+    gap = d + min(0.0, (vx * ux + vy * uy) * t_max) \
+        + min(0.0, 0.5 * (ax * ux + ay * uy) * t_max * t_max)
+    # what the motions add to the terms: the centres' paths and the vertices' arcs
+    travel = (math.sqrt(vx * vx + vy * vy) + 0.5 * math.sqrt(ax * ax + ay * ay) * t_max
+              + (abs(ma[4]) + 0.5 * abs(ma[5]) * t_max) * rad_a
+              + (abs(mb[4]) + 0.5 * abs(mb[5]) * t_max) * rad_b) * t_max
+    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + rad_a + rad_b
+    gap -= margin + APART_ULPS * 2.0**-52 * terms
+    return gap > _turned_support(ra, la, ux, uy, ma, t_max) \
+        + _turned_support(rb, lb, -ux, -uy, mb, t_max)
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _search_buffers(vmax, lmax):
     """The scratch of :func:`_search_range` for bodies of up to ``vmax`` vertices and
@@ -258,11 +347,22 @@ def _search_range(pi, pj, movers, world, settings, buffers, k0, k1, out):
                 t_contact[k] = 0.0
                 state[k] = 2
                 continue
-        n = query_intervals(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate, work)
         r1, s1, e1 = _turned(a, base, tables, frames, sa)
         r2, s2, e2 = _turned(b, base, tables, frames, sb)
-        query = (t_max, inflate, time_tol, rel_k, ulps, resolution * (rad[a] + rad[b]),
-                 max_iter, 0)
+        # about half the pairs whose circles meet and whose bodies do not are kept apart
+        # by the line of their centres: then the search, whose contacts come within the
+        # tolerance and the contact resolution of the end, reports nothing
+        lam = resolution * (rad[a] + rad[b])
+        eps = tolerance_at(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, rel_k, ulps)
+        if _axis_apart((r1, e1[3], pos[a], rad[a]), ma, (r2, e2[3], pos[b], rad[b]), mb,
+                       t_max, lam + (1.0 + LAM_PER_EPS) * eps):
+            code[k] = 0
+            t_hi[k] = -1.0
+            t_contact[k] = -1.0
+            state[k] = 0
+            continue
+        n = query_intervals(pos[a], ma, rad[a], pos[b], mb, rad[b], t_max, inflate, work)
+        query = (t_max, inflate, time_tol, rel_k, ulps, lam, max_iter, 0)
         got = query_search((r1, s1, pos[a], rad[a]), e1, ma, (r2, s2, pos[b], rad[b]), e2, mb,
                            n, query, work, at_start)
         c = got[0]
