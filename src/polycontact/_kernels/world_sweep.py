@@ -221,12 +221,10 @@ def _turn_range(m, t_max):
     end = (w + 0.5 * al * t_max) * t_max
     lo = min(0.0, end)
     hi = max(0.0, end)
-    if al != 0.0:
-        ts = -w / al
-        if 0.0 < ts < t_max:
-            top = 0.5 * w * ts
-            lo = min(lo, top)
-            hi = max(hi, top)
+    if (w < 0.0 < al or al < 0.0 < w) and abs(w) < abs(al) * t_max:  # it turns back
+        top = -0.5 * w * (w / al)
+        lo = min(lo, top)
+        hi = max(hi, top)
     return lo, hi
 
 
