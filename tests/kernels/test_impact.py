@@ -4,6 +4,7 @@ Small inputs: this file also runs with NUMBA_DISABLE_JIT=1 (see .ci/run).
 """
 
 import math
+import warnings
 
 import numpy as np
 import shapely
@@ -210,6 +211,18 @@ def test_query_in_two_steps_answers_as_exact_query(va, wa, vb, gap, dy):
     if whole[1] != ki.INITIALLY_PENETRATING:
         n = ki.query_intervals(a_[2], ma, a_[3], b_[2], mb, b_[3], query[0], query[1], work)
         assert ki.query_search(a_, ea, ma, b_, eb, mb, n, query, work, True) == whole[1:]
+
+
+def test_a_speed_too_small_to_bound_the_window_leaves_it_unbounded_without_overflow():
+    """A subnormal speed far from the origin: the window over which the tolerances stay
+    local is longer than any float, and local_end says so without overflowing."""
+    still = np.zeros(6)
+    crawl = np.array([5e-324, 0.0, 0.0, 5e-324, 0.0, 0.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        end = ki.local_end(np.array([1e300, 0.0]), crawl, 1.0, np.array([1e300, 3.0]), still,
+                           1.0, 0.0)
+    assert end == np.inf
 
 
 def test_exact_search_reports_the_budget():
