@@ -120,10 +120,12 @@ def local_end(ca, ma, la, cb, mb, lb, t):
         for k in range(2):
             acc = abs(m[2 + k])
             lin = abs(m[k]) + acc * t
-            den = lin + np.sqrt(lin * lin + 2.0 * acc * mag)
-            # (a window past 2**1022 is left unbounded: its quotient nears the float range)
-            if den > mag * 2.0**-1021:
-                w = min(w, 2.0 * mag / den)
+            if lin > 0.0 or acc > 0.0:
+                den = lin + np.sqrt(lin * lin + 2.0 * acc * mag)
+                # (a window past 2**1022 is left unbounded: its quotient nears the float
+                # range)
+                if den > mag * 2.0**-1021:
+                    w = min(w, 2.0 * mag / den)
     return t + w
 
 
