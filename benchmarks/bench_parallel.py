@@ -84,6 +84,7 @@ PARALLEL = [
     ("polycontact._kernels.poses", "pose_rows"),
     ("polycontact._kernels.poses", "pose_checks"),
     ("polycontact._kernels.contact_geometry", "pair_geometry"),
+    ("polycontact._kernels.contact_geometry", "caller_features"),
     ("polycontact._kernels.world_sweep", "motion_maxima"),
     ("polycontact._kernels.world_sweep", "turned_frames"),
     ("polycontact._kernels.world_sweep", "sweep_search"),

@@ -95,6 +95,7 @@ _POSE_WORK = 0.25  # placing a body (a 12-gon) and updating its box (memory-boun
 _GRID_WORK = 0.3  # moving a body to another cell of the grid (memory-bound)
 _GEOMETRY_WORK = 8.0  # the geometry of a penetrating pair, a pair's swept search
 _EVENT_WORK = 0.05  # gathering a sweep's event from its pair (memory-bound)
+_NUMBERING_WORK = 0.1  # a pair's carrying vertex and edge in the caller's numbering
 _TURN_ROOMS = 2  # rooms for a sweep's turned frames that a World keeps (see _turn_room)
 #: A room for a sweep's turned frames: rows, their lengths, circles.
 _Room = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -697,10 +698,8 @@ def _contact_geometry(store: tuple[Any, ...], pairs: np.ndarray, states: np.ndar
         side[k], vert[k], edge[k] = got[4:7]
         if not area[k] > 0.0:
             cen[k] = point[k]
-    owner = np.where(side == 0, pi, pj)
-    other = np.where(side == 0, pj, pi)
-    vertices = kg.caller_numbering(ls, lo, nl, lmap, vmap, owner, vert, 0)
-    edges = kg.caller_numbering(ls, lo, nl, lmap, vmap, other, edge, 1)
+    vertices, edges = kg.caller_features(ls, lo, nl, lmap, vmap, (pi, pj), (side, vert, edge),
+                                         _chunks(len(pi), _NUMBERING_WORK))
     for arr in (dist, normal, point, area, cen, side, vertices, edges):
         arr.flags.writeable = False
     return dist, normal, point, area, cen, side, vertices, edges
