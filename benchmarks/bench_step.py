@@ -24,7 +24,7 @@ about 0.6, each body meeting a few neighbours), N = 10³, 10⁴, 10⁵. One step
   meet and their times, then with the points and normals read too.
 
 Peer: pymunk's ``Space.step`` (detection and solver) on the same scene, each star as a
-body of its 6 convex kites (pymunk takes convex shapes only), measured on 5 successive
+body of its 6 convex kites (pymunk takes convex shapes only), measured on successive
 steps after a first one. pymunk is in the ``bench`` extra.
 """
 
