@@ -1,6 +1,6 @@
 """A World inside a simulation loop: poses as arrays, the geometry of every contact, and
 swept steps, each checked against the pairwise calls (``classify``, ``time_of_impact``)
-and Shapely, at scales 1e-6..1e6 and away from the origin."""
+and Shapely, at scales 1e-9..1e9 and up to 1e7 sizes away from the origin."""
 
 from __future__ import annotations
 
@@ -35,8 +35,8 @@ TEMPLATES = [
       zip(np.linspace(0, 2 * math.pi, 10, endpoint=False), [1.5, 0.7] * 5)], []),  # star
 ]
 
-SCALES = [1e-6, 1e-3, 1.0, 1e3, 1e6]
-OFFSETS = [0.0, 1e3]
+SCALES = [1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e6, 1e9]
+OFFSETS = [0.0, 1e3, 1e7]  # (in sizes of the bodies)
 
 
 def body(t: int, scale: float, form: str):
