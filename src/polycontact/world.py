@@ -698,7 +698,7 @@ def _contact_geometry(store: tuple[Any, ...], pairs: np.ndarray, states: np.ndar
         side[k], vert[k], edge[k] = got[4:7]
         if not area[k] > 0.0:
             cen[k] = point[k]
-    vertices, edges = kg.caller_features(ls, lo, nl, lmap, vmap, (pi, pj), (side, vert, edge),
+    vertices, edges = kg.caller_features(ls, lo, lmap, vmap, (pi, pj), (side, vert, edge),
                                          _chunks(len(pi), _NUMBERING_WORK))
     for arr in (dist, normal, point, area, cen, side, vertices, edges):
         arr.flags.writeable = False

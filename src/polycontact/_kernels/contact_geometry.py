@@ -451,20 +451,20 @@ def penetration_finish(xa, sa, xb, sb, e, d, dx, dy):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def caller_features(ls, lo, nl, lmap, vmap, pairs, rows, chunks):
+def caller_features(ls, lo, lmap, vmap, pairs, rows, chunks):
     """The carrying vertices and edges of :func:`pair_geometry` in the caller's
     numbering: ``(vertices, edges)``, each ``(loop, index)`` per pair, (-1, -1) where a
     row is -1 or was made by a repair. ``pairs`` = ``(pi, pj)``, the bodies of each
     pair; ``rows`` = ``(side, vertex, edge)`` as :func:`pair_geometry` gives them (the
     vertex is of pi[k] for side 0, of pj[k] for side 1, the edge of the other body);
-    ``ls``, ``lo``, ``nl``: the World's loop starts and each body's first loop entry and
-    loop count; ``lmap``, ``vmap``: each loop entry's and each row's map (column 0 the
-    vertex, 1 the edge from it). In parallel chunks (``chunks`` = 1: serial).
+    ``ls``, ``lo``: the World's loop starts and each body's first loop entry; ``lmap``,
+    ``vmap``: each loop entry's and each row's map (column 0 the vertex, 1 the edge from
+    it). In parallel chunks (``chunks`` = 1: serial).
 
     >>> import numpy as np
-    >>> ls, one = np.array([0, 4, 8]), np.array([1, 1])
+    >>> ls = np.array([0, 4, 8])
     >>> vmap = np.array([[q, q] for q in (3, 0, 1, 2, 0, 1, 2, 3)])
-    >>> got = caller_features(ls, np.array([0, 1]), one, np.zeros(3, np.int64), vmap,
+    >>> got = caller_features(ls, np.array([0, 1]), np.zeros(3, np.int64), vmap,
     ...                       (np.array([0]), np.array([1])),
     ...                       (np.array([1], np.int8), np.array([2]), np.array([0])), 1)
     >>> got[0].tolist(), got[1].tolist()
@@ -477,13 +477,13 @@ def caller_features(ls, lo, nl, lmap, vmap, pairs, rows, chunks):
     for c in prange(chunks):
         for k in range(n * c // chunks, n * (c + 1) // chunks):
             own, other = (pi[k], pj[k]) if rows[0][k] == 0 else (pj[k], pi[k])
-            _numbered(ls, lo, nl, lmap, vmap, own, rows[1][k], 0, vertices[k])
-            _numbered(ls, lo, nl, lmap, vmap, other, rows[2][k], 1, edges[k])
+            _numbered(ls, lo, lmap, vmap, own, rows[1][k], 0, vertices[k])
+            _numbered(ls, lo, lmap, vmap, other, rows[2][k], 1, edges[k])
     return vertices, edges
 
 
 @njit(cache=True, nogil=True)
-def _numbered(ls, lo, nl, lmap, vmap, b, row, column, out):
+def _numbered(ls, lo, lmap, vmap, b, row, column, out):
     """``out`` = ``(loop, index)`` in the caller's numbering of row ``row`` of body
     ``b`` (see :func:`caller_features`); left as it is for a row -1 or a repair's."""
     if row < 0:
