@@ -319,19 +319,33 @@ APART_ULPS = 64.0
 
 
 @njit(cache=True, nogil=True)
+def rounding_allowance(ca, cb, reach, travel):
+    """What the rounding may take off a test that two bodies about the centres ``ca``
+    and ``cb`` stay apart: :data:`APART_ULPS` of the terms the test adds up, the
+    centres' coordinates, ``travel`` (what motions add to them) and ``reach`` (the
+    bodies' extent along the test, such as the sum of their radii).
+
+    >>> import numpy as np
+    >>> float(rounding_allowance(np.zeros(2), np.array([3.0, 0.0]), 2.0, 0.0)) / 2.0**-52
+    320.0
+    """
+    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + reach
+    return APART_ULPS * 2.0**-52 * terms
+
+
+@njit(cache=True, nogil=True)
 def circles_reach(ca, la, cb, lb, travel, inflate):
     """The distance of the centres ``ca`` and ``cb`` beyond which the bounding circles
     of radii ``la`` and ``lb`` are provably apart: their sum inflated by twice the
-    relative ``inflate``, and :data:`APART_ULPS` of the terms of the centres' paths
-    (``travel``: what motions add to them) for the rounding.
+    relative ``inflate``, and the :func:`rounding_allowance` of the centres' paths
+    (``travel``: what motions add to them).
 
     >>> import numpy as np
     >>> float(circles_reach(np.zeros(2), 1.0, np.array([3.0, 0.0]), 1.0, 0.0, 0.0)) > 2.0
     True
     """
     big = la + lb
-    terms = abs(ca[0]) + abs(ca[1]) + abs(cb[0]) + abs(cb[1]) + travel + big
-    return big * (1.0 + 2.0 * inflate) + APART_ULPS * 2.0**-52 * terms
+    return big * (1.0 + 2.0 * inflate) + rounding_allowance(ca, cb, big, travel)
 
 
 @njit(cache=True, nogil=True)

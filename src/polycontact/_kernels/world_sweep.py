@@ -43,7 +43,7 @@ from .impact import HIT, INITIALLY_PENETRATING, LAM_PER_EPS, place, query_interv
     query_search, state_at, tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
-from .world import body_view, circles_apart, circles_reach
+from .world import body_view, circles_apart, circles_reach, rounding_allowance
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -259,7 +259,7 @@ def _turned_support(r, rl, ux, uy, m, t_max):
 @njit(cache=True, nogil=True)
 def _axis_apart(a, ma, b, mb, t_max, margin):
     """Whether two bodies provably stay more than ``margin`` apart over [0, ``t_max``],
-    beyond the rounding (:func:`polycontact._kernels.world.circles_reach`'s allowance):
+    beyond the rounding (:func:`polycontact._kernels.world.rounding_allowance`):
     along the line of their centres at t = 0, the centres' distance less what the
     motions take off it and the bodies' :func:`_turned_support` on either side. ``a``,
     ``b`` = ``(r, lengths, centre, radius)``; ``ma``, ``mb``: motion rows.
@@ -291,8 +291,7 @@ def _axis_apart(a, ma, b, mb, t_max, margin):
     travel = (math.sqrt(vx * vx + vy * vy) + 0.5 * math.sqrt(ax * ax + ay * ay) * t_max
               + (abs(ma[4]) + 0.5 * abs(ma[5]) * t_max) * rad_a
               + (abs(mb[4]) + 0.5 * abs(mb[5]) * t_max) * rad_b) * t_max
-    # (the rounding allowance of the circles' test, over the same terms)
-    gap -= margin + (circles_reach(ca, rad_a, cb, rad_b, travel, 0.0) - (rad_a + rad_b))
+    gap -= margin + rounding_allowance(ca, cb, rad_a + rad_b, travel)
     return gap > _turned_support(ra, la, ux, uy, ma, t_max) \
         + _turned_support(rb, lb, -ux, -uy, mb, t_max)
 
