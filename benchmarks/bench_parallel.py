@@ -42,7 +42,10 @@ brackets), and every answer is compared, entry by entry, with the one-thread ans
 calls (the smallest and largest in brackets): the time outside the parallel regions
 over the total, where the parallel regions are the calls of the
 compiled parallel kernels and of the thread pool's chunk maps (timed by wrappers
-installed for the measurement only); Amdahl's prediction for 16 cores is
+installed for the measurement only); for the Dask rows, measured on one worker of one
+thread, the parallel region is the time the worker computes tasks (Dask's task stream),
+so that the calling process's preparation, the data's transfer and the waits between
+tasks are the serial part. Amdahl's prediction for 16 cores is
 ``1 / (s + (1 - s) / 16)``. On a machine shared with other jobs the speed-ups are noisy;
 the serial fractions much less.
 
@@ -455,7 +458,7 @@ def dask_rows(workers: list[int], quick: bool, repeat: int,
     1, 2, ... worker processes (one thread each); ``report(rows)`` after each cluster,
     with the rows measured so far."""
     try:
-        from distributed import Client, LocalCluster
+        from distributed import Client, LocalCluster, get_task_stream
     except ImportError:
         print("\nDask rows skipped: distributed is not installed (pip install "
               "'polycontact[dask]')")
@@ -499,13 +502,23 @@ def dask_rows(workers: list[int], quick: bool, repeat: int,
                 got = answer(call(client))
                 want.setdefault(name, got)
                 times = []
+                serial = []
                 for _ in range(repeat):
-                    t0 = time.perf_counter()
-                    call(client)
-                    times.append(time.perf_counter() - t0)
+                    with get_task_stream(client) as stream:
+                        t0 = time.perf_counter()
+                        call(client)
+                        total = time.perf_counter() - t0
+                    times.append(total)
+                    busy = sum(s["stop"] - s["start"] for task in stream.data
+                               for s in task["startstops"] if s["action"] == "compute")
+                    serial.append(max(0.0, total - busy) / total)
                 rows[name]["threads"][w] = {"median": statistics.median(times),
                                             "min": min(times), "max": max(times),
                                             "same": same(want[name], got)}
+                if w == 1:  # (one worker of one thread: its tasks never overlap)
+                    s = rows[name]["serial_fraction"] = statistics.median(serial)
+                    rows[name]["serial_spread"] = [min(serial), max(serial)]
+                    rows[name]["amdahl16"] = 1.0 / (s + (1.0 - s) / 16.0)
         report(speedups())
     return speedups()
 
@@ -520,7 +533,7 @@ def show(row: dict[str, Any]) -> None:
               + f"{up:>9} {str(r['same']):>5}")
     if row["serial_fraction"] is not None:
         low, high = row["serial_spread"]
-        print(f"  serial fraction at one thread: {100 * row['serial_fraction']:.1f} % "
+        print(f"  serial fraction at one {unit[:-1]}: {100 * row['serial_fraction']:.1f} % "
               f"[{100 * low:.1f}, {100 * high:.1f}]; Amdahl for 16 cores: "
               f"{row['amdahl16']:.1f}×")
 
