@@ -113,7 +113,9 @@ def run_spans(
     cluster; yield ``(p0, p1, result)`` for each span as its task finishes.
 
     ``tasks_of(spans)`` gives ``(shared, tasks)``: what every task of those spans needs
-    (sent to every worker once) and each span's own task. With ``chunk_size`` the spans
+    (sent to every worker once) and each span's own task (sent to one worker, straight
+    from here rather than through the scheduler, then the task that reads it submitted:
+    the first tasks run while the next ones' data is sent). With ``chunk_size`` the spans
     have that many items; else a first task of :data:`PROBE_ITEMS` items measures the
     work per item and :func:`task_size` sizes the others. With a ``family`` (a name),
     every worker runs that first task once when it starts or joins (:func:`warm`), so
@@ -151,28 +153,33 @@ def run_spans(
         shared, tasks = tasks_of(spans)
         [shared_future] = client.scatter([shared], broadcast=True, hash=False)
         futures.append(shared_future)
-        submitted = [client.submit(fn, shared_future, t, *args, pure=False) for t in tasks]
-        futures.extend(submitted)
-        index = {f.key: k for k, f in enumerate(submitted)}
+
+        def submit(k: int) -> Any:
+            [data] = client.scatter([tasks[k]], hash=False)
+            task = client.submit(fn, shared_future, data, *args, pure=False)
+            futures.extend((data, task))
+            index[task.key] = k, data
+            return task
+
+        index: dict[Any, tuple[int, Any]] = {}
         tries = [0] * len(tasks)
-        done = as_completed(submitted)
+        done = as_completed([submit(k) for k in range(len(tasks))])
         for f in done:
-            k = index[f.key]
+            k, data = index.pop(f.key)
             try:
                 result = f.result()
             except CancelledError:  # (distributed's FutureCancelledError is one)
                 # The scheduler forgot the task: a worker that died took with it what
-                # the task needed. Run it again, the shared data sent again.
+                # the task needed. Run it again, its data and the shared data sent again.
                 tries[k] += 1
                 if tries[k] > RESUBMITS:
                     raise
                 [shared_future] = client.scatter([shared], broadcast=True, hash=False)
-                again = client.submit(fn, shared_future, tasks[k], *args, pure=False)
-                futures.extend((shared_future, again))
-                index[again.key] = k
-                done.add(again)
+                futures.append(shared_future)
+                done.add(submit(k))
                 continue
             f.release()
+            data.release()
             yield *spans[k], result
     finally:
         client.cancel(futures)

@@ -308,18 +308,21 @@ def test_a_task_the_scheduler_forgets_is_run_again(client, tmp_path):
     pieces = [turned(p, 0) for p in PIECES]
     local = here(lambda: pc.nfp_table(pieces, ANGLES, progress=False))
     cancelled = []
+    submit = client.submit
 
-    def cancel_one(done, total):
-        if not cancelled:
-            keys = [key for key, state in list(client.futures.items())
-                    if str(key).startswith("_compute_chunk") and state.status == "pending"]
-            if keys:
-                client.cancel([distributed.Future(keys[-1], client)])
-                cancelled.append(keys[-1])
+    def submit_and_cancel_the_third(fn, *args, **kwargs):
+        future = submit(fn, *args, **kwargs)
+        if fn.__name__ == "_compute_chunk" and len(cancelled) < 3:
+            cancelled.append(future.key)
+            if len(cancelled) == 3:
+                client.cancel([future])
+        return future
 
-    remote = pc.nfp_table(pieces, ANGLES, client=client, progress=cancel_one, chunk_size=5,
-                          cache=tmp_path)
-    assert cancelled
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(client, "submit", submit_and_cancel_the_third)
+        remote = pc.nfp_table(pieces, ANGLES, client=client, progress=False, chunk_size=5,
+                              cache=tmp_path)
+    assert len(cancelled) == 3
     for key in local:
         assert same_entry(local[key], remote[key])
 
