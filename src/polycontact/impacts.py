@@ -913,12 +913,15 @@ def _impact_tasks(uniq: list[bytes], sa: np.ndarray, sb: np.ndarray, rows_a: np.
     shared_ids = np.flatnonzero(first < last)
     number = np.full(len(uniq), -1, np.int64)
     number[shared_ids] = np.arange(len(shared_ids))
+    # the shapes of one task only, grouped by task (ascending within each)
+    alone = np.flatnonzero(first == last)
+    alone = alone[np.argsort(first[alone], kind="stable")]
+    bounds = np.searchsorted(first[alone], np.arange(len(spans) + 1))
     tasks = []
-    for p0, p1 in spans:
-        ta, tb = sa[p0:p1], sb[p0:p1]
-        own = np.unique(np.concatenate([ta, tb]))
-        own = own[number[own] < 0]
+    for k, (p0, p1) in enumerate(spans):
+        own = alone[bounds[k]:bounds[k + 1]]
         number[own] = len(shared_ids) + np.arange(len(own))
+        ta, tb = sa[p0:p1], sb[p0:p1]
         tasks.append((number[ta], number[tb], _ShapePack([uniq[u] for u in own]),
                       rows_a[p0:p1], rows_b[p0:p1], eps_rel[p0:p1]))
         number[own] = -1
