@@ -307,22 +307,28 @@ def test_a_task_the_scheduler_forgets_is_run_again(client, tmp_path):
     # a task cancelled on the scheduler (as when a dead worker held what it needed)
     pieces = [turned(p, 0) for p in PIECES]
     local = here(lambda: pc.nfp_table(pieces, ANGLES, progress=False))
-    cancelled = []
     submit = client.submit
 
-    def submit_and_cancel_the_third(fn, *args, **kwargs):
-        future = submit(fn, *args, **kwargs)
-        if fn.__name__ == "_compute_chunk" and len(cancelled) < 3:
-            cancelled.append(future.key)
-            if len(cancelled) == 3:
-                client.cancel([future])
-        return future
+    def build(cancel_third: bool, cache) -> tuple[pc.NfpTable, int]:
+        submitted = []
 
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(client, "submit", submit_and_cancel_the_third)
-        remote = pc.nfp_table(pieces, ANGLES, client=client, progress=False, chunk_size=5,
-                              cache=tmp_path)
-    assert len(cancelled) == 3
+        def submitting(fn, *args, **kwargs):
+            future = submit(fn, *args, **kwargs)
+            if fn.__name__ == "_compute_chunk":
+                submitted.append(future.key)
+                if cancel_third and len(submitted) == 3:
+                    client.cancel([future])
+            return future
+
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(client, "submit", submitting)
+            table = pc.nfp_table(pieces, ANGLES, client=client, progress=False, chunk_size=5,
+                                 cache=cache)
+        return table, len(submitted)
+
+    _, tasks = build(False, tmp_path / "plain")
+    remote, submitted = build(True, tmp_path / "cancelled")
+    assert submitted == tasks + 1  # the third task run again
     for key in local:
         assert same_entry(local[key], remote[key])
 
