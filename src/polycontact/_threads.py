@@ -70,8 +70,8 @@ def useful(threads: int, seconds: float) -> int:
 def chunks(count: int, work: float = 1.0) -> int:
     """Chunks of a compiled parallel pass over ``count`` items of ``work`` pair
     classifications each (:data:`PAIR_SECONDS`): 1 (serial, no thread start) when the
-    work needs one thread, else four per useful thread (so that threads that finish
-    early take no more than a quarter of their share of waiting)."""
+    work needs one thread, else four per useful thread, each taking its blocks spread
+    over the items (:mod:`polycontact._kernels.spread`)."""
     seconds = count * work * PAIR_SECONDS
     if seconds < 2.0 * THREAD_WORK:  # (one thread, however many there are)
         return 1

@@ -134,6 +134,41 @@ def test_contacts_of_chunks_that_find_more_pairs_than_their_buffer(monkeypatch):
     assert same(one.pairs, many.pairs) and same(one.states, many.states)
 
 
+@pytest.mark.parametrize("n, chunks", [(0, 2), (5, 2), (64, 2), (1000, 3), (100_003, 64)])
+def test_parallel_blocks_cover_every_item_once_and_interleave_the_chunks(n, chunks):
+    from polycontact._kernels.spread import SPREAD, block
+
+    spans = [block(n, chunks, b) for b in range(SPREAD * chunks)]
+    assert spans[0][0] == 0 and spans[-1][1] == n
+    assert all(spans[b][1] == spans[b + 1][0] for b in range(len(spans) - 1))
+    owners = [b % chunks for b in range(SPREAD * chunks)]  # chunk c: blocks c, c + chunks, ...
+    assert owners[:chunks] == list(range(chunks)) and owners[-chunks:] == list(range(chunks))
+
+
+def test_a_crowd_in_the_first_bodies_is_shared_among_the_chunks():
+    # the first half of the bodies meet their neighbours, the second half stand apart:
+    # each of two chunks (so each thread) gets a share of the crowd's pairs
+    rng = np.random.default_rng(3)
+    rings = stars(rng, 400)
+    centres = rings[200:].mean(axis=1, keepdims=True)
+    rings[200:] += 2.0 * centres + 1000.0
+    world = pc.World()
+    world.add_many(rings)
+    alive = world._alive()
+    settings = (-1.0, float(world._eps[alive].max()), 0.0, world._next, kw.TOUCHING)
+    cap = 8 * len(alive)
+    counts = []
+    for c in range(2):
+        out = (np.empty(cap, np.int64), np.empty(cap, np.int64), np.empty(cap, np.int8),
+               np.empty(cap))
+        counts.append(kw._chunk_pairs(world._grid(), world._bodies(), (world._pos, world._rad),
+                                      settings, alive, c, 2, out, cap, world._vmax,
+                                      world._lmax))
+    total = len(world.contacts())
+    assert total > 200 and sum(counts) == total
+    assert min(counts) > 0.3 * total
+
+
 def test_sorted_pairs_in_buckets_equal_one_sort():
     rng = np.random.default_rng(2)
     n_ids = 1000

@@ -40,6 +40,7 @@ from .overlap import overlap_moments, overlap_of_tables, overlap_scratch
 from .packs import scratch_floats
 from .primitives import bbox, closest_on_segment, edge_rows, grow_rows, loop_next
 from .relation import NO_WITNESS, moved_state
+from .spread import SPREAD, block
 from .world import body_view
 
 SEPARATE = 0
@@ -406,7 +407,9 @@ def pair_geometry(rows, pairs, vmax, lmax, chunks):
         _geometry_range(rows, pairs, vmax, lmax, 0, n, out)
         return out
     for c in prange(chunks):
-        _geometry_range(rows, pairs, vmax, lmax, n * c // chunks, n * (c + 1) // chunks, out)
+        for b in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(n, chunks, b)
+            _geometry_range(rows, pairs, vmax, lmax, k0, k1, out)
     return out
 
 
@@ -420,7 +423,9 @@ def boundary_gaps(rows, pi, pj, lmax, chunks):
         _gaps_range(rows, pi, pj, lmax, 0, n, out)
         return out
     for c in prange(chunks):
-        _gaps_range(rows, pi, pj, lmax, n * c // chunks, n * (c + 1) // chunks, out)
+        for b in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(n, chunks, b)
+            _gaps_range(rows, pi, pj, lmax, k0, k1, out)
     return out
 
 

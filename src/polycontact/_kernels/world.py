@@ -36,6 +36,7 @@ from .jit import njit
 from .packs import state_scratch
 from .primitives import bbox
 from .relation import state_in
+from .spread import SPREAD, block
 
 
 #: Levels L = idx - 512, idx in [0, 1024): cells from 2**-512 to 2**511.
@@ -431,12 +432,23 @@ def _pairs_into(grid, bodies, circles, settings, alive, k0, k1, out, cap, buffer
 
 
 @njit(cache=True, nogil=True)
-def _chunk_pairs(grid, bodies, circles, settings, alive, k0, k1, out, cap, vmax, lmax):
-    """:func:`_pairs_into` with its buffers, for bodies of up to ``vmax`` vertices and
-    ``lmax`` loops."""
+def _chunk_pairs(grid, bodies, circles, settings, alive, c, chunks, out, cap, vmax, lmax):
+    """:func:`_pairs_into` of chunk ``c`` of ``chunks`` with its buffers, for bodies of
+    up to ``vmax`` vertices and ``lmax`` loops: its blocks of ``alive``
+    (:mod:`polycontact._kernels.spread`), their pairs one after another."""
     buffers = (np.empty(settings[3], np.int64), state_scratch(2 * vmax),
                np.empty(lmax + 1, np.int64), np.empty(lmax + 1, np.int64))
-    return _pairs_into(grid, bodies, circles, settings, alive, k0, k1, out, cap, buffers)
+    n = alive.shape[0]
+    if chunks == 1:
+        return _pairs_into(grid, bodies, circles, settings, alive, 0, n, out, cap, buffers)
+    oi, oj, ost, oe = out
+    m = 0
+    for b in range(c, SPREAD * chunks, chunks):
+        k0, k1 = block(n, chunks, b)
+        w = min(m, cap)
+        m += _pairs_into(grid, bodies, circles, settings, alive, k0, k1,
+                         (oi[w:], oj[w:], ost[w:], oe[w:]), cap - w, buffers)
+    return m
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -475,18 +487,17 @@ def contact_pairs(grid, bodies, circles, tol, alive, n_ids, margin, mode, vmax, 
     be = np.empty((chunks, cap))
     count = np.zeros(chunks, np.int64)
     if chunks == 1:
-        m = _chunk_pairs(grid, bodies, circles, settings, alive, 0, n,
+        m = _chunk_pairs(grid, bodies, circles, settings, alive, 0, 1,
                          (bi[0], bj[0], bs[0], be[0]), cap, vmax, lmax)
         if m <= cap:
             return sorted_pairs(bi[0, :m], bj[0, :m], bs[0, :m], be[0, :m], n_ids, 1)
         out = (np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
                np.empty(m))
-        _chunk_pairs(grid, bodies, circles, settings, alive, 0, n, out, m, vmax, lmax)
+        _chunk_pairs(grid, bodies, circles, settings, alive, 0, 1, out, m, vmax, lmax)
         return sorted_pairs(out[0], out[1], out[2], out[3], n_ids, 1)
     for c in prange(chunks):
-        count[c] = _chunk_pairs(grid, bodies, circles, settings, alive, n * c // chunks,
-                                n * (c + 1) // chunks, (bi[c], bj[c], bs[c], be[c]), cap,
-                                vmax, lmax)
+        count[c] = _chunk_pairs(grid, bodies, circles, settings, alive, c, chunks,
+                                (bi[c], bj[c], bs[c], be[c]), cap, vmax, lmax)
     start = np.zeros(chunks + 1, np.int64)
     for c in range(chunks):
         start[c + 1] = start[c] + count[c]
@@ -504,8 +515,7 @@ def contact_pairs(grid, bodies, circles, tol, alive, n_ids, margin, mode, vmax, 
             states[s0:s1] = bs[c, : s1 - s0]
             used[s0:s1] = be[c, : s1 - s0]
         else:
-            _chunk_pairs(grid, bodies, circles, settings, alive, n * c // chunks,
-                         n * (c + 1) // chunks,
+            _chunk_pairs(grid, bodies, circles, settings, alive, c, chunks,
                          (pi[s0:s1], pj[s0:s1], states[s0:s1], used[s0:s1]), s1 - s0,
                          vmax, lmax)
     return sorted_pairs(pi, pj, states, used, n_ids, chunks)
@@ -628,12 +638,14 @@ def container_states(bodies, tol, alive, hazards, vmax, lmax, hmax, chunks):
         scratch = state_scratch(vmax + hmax)
         ba = np.empty(lmax + 1, np.int64)
         hb = np.empty(hnl.max() + 1, np.int64)
-        for k in range(n * c // chunks, n * (c + 1) // chunks):
-            b = alive[k]
-            ya, sa = body_view(xy, ls, lo, nl, b, ba)
-            e = tol if tol >= 0.0 else max(eps[b], ceps)
-            out[k] = _container_state(ya, sa, (box[b, 0], box[b, 1], box[b, 2], box[b, 3]),
-                                      e, hazards, hb, scratch)
+        for q in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(n, chunks, q)
+            for k in range(k0, k1):
+                b = alive[k]
+                ya, sa = body_view(xy, ls, lo, nl, b, ba)
+                e = tol if tol >= 0.0 else max(eps[b], ceps)
+                out[k] = _container_state(ya, sa, (box[b, 0], box[b, 1], box[b, 2],
+                                                   box[b, 3]), e, hazards, hb, scratch)
     return out
 
 
@@ -772,6 +784,7 @@ def query_many(shape, poses, grid, bodies, hazards, settings, scan, chunks):
         _query_range(shape, poses, grid, bodies, hazards, settings, scan, 0, p_count, out)
         return out
     for c in prange(chunks):
-        _query_range(shape, poses, grid, bodies, hazards, settings, scan,
-                     p_count * c // chunks, p_count * (c + 1) // chunks, out)
+        for b in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(p_count, chunks, b)
+            _query_range(shape, poses, grid, bodies, hazards, settings, scan, k0, k1, out)
     return out

@@ -43,6 +43,7 @@ from .impact import HIT, INITIALLY_PENETRATING, LAM_PER_EPS, place, query_interv
     query_search, state_at, tolerance_at, work_floats
 from .packs import scratch_floats, state_scratch_views, vector, view
 from .relation import PENETRATING, state_in
+from .spread import SPREAD, block
 from .world import body_view, circles_apart, circles_reach, rounding_allowance
 
 
@@ -401,8 +402,11 @@ def sweep_search(pi, pj, movers, base, tables, frames, rows, settings, vmax, lma
                       _search_buffers(vmax, lmax), 0, n, out)
         return out
     for c in prange(chunks):
-        _search_range(pi, pj, movers, (base, tables, frames, rows), settings,
-                      _search_buffers(vmax, lmax), n * c // chunks, n * (c + 1) // chunks, out)
+        buffers = _search_buffers(vmax, lmax)
+        for b in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(n, chunks, b)
+            _search_range(pi, pj, movers, (base, tables, frames, rows), settings, buffers,
+                          k0, k1, out)
     return out
 
 
@@ -520,6 +524,8 @@ def event_geometry(events, movers, base, tables, frames, vmax, lmax, ulps, chunk
                      normal)
         return point, normal
     for c in prange(chunks):
-        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps,
-                     n * c // chunks, n * (c + 1) // chunks, point, normal)
+        for b in range(c, SPREAD * chunks, chunks):
+            k0, k1 = block(n, chunks, b)
+            _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, k0, k1,
+                         point, normal)
     return point, normal
