@@ -5,6 +5,9 @@ Paths (size, then the ``--quick`` size):
 
 - ``contacts``: ``World.contacts()`` of concave 12-gons packed densely (bench_world's
   stars: each meets a few neighbours), 2·10⁵ bodies (2·10⁴);
+- ``contacts_pile``: the same for a World as crowded as a pile at the bottom of a
+  hopper: the first half of the bodies (in the order added) packed as there, the
+  second half standing apart, so that all the work lies in the first half;
 - ``set_poses``: ``World.set_poses`` of every body of that World (a small move each
   call, each body staying in or leaving its grid cell);
 - ``geometry``: the contact geometry of that World's contacts (``Contacts.distances``:
@@ -221,6 +224,26 @@ class Contacts(WorldPath):
 
     def run(self, threads: int) -> tuple[np.ndarray, ...]:
         c = self.w.world.contacts()
+        return c.pairs, c.states
+
+
+class ContactsPile(Path):
+    """``World.contacts()`` of a World whose first half of bodies is packed as in
+    :class:`WorldPaths` and whose second half stands apart (a pile: the work all in the
+    first half of the bodies)."""
+
+    name = "contacts_pile"
+
+    def __init__(self, count: int) -> None:
+        rings = stars(np.random.default_rng(1), count)
+        apart = rings[count // 2:]
+        apart += 2.0 * apart.mean(axis=1, keepdims=True) + 1e3  # centres spread 3 times
+        self.world = pc.World()
+        self.world.add_many(rings)
+        self.size = f"{count} bodies, half of them apart"
+
+    def run(self, threads: int) -> tuple[np.ndarray, ...]:
+        c = self.world.contacts()
         return c.pairs, c.states
 
 
@@ -548,7 +571,7 @@ def main() -> None:
                          "--quick)")
     ap.add_argument("--repeat", type=int, default=None, help="calls per figure (5; 3 quick)")
     ap.add_argument("--paths", default=None, help="comma-separated paths (default all): "
-                    "contacts,time_of_impact_many,time_of_impact_many_rows,"
+                    "contacts,contacts_pile,time_of_impact_many,time_of_impact_many_rows,"
                     "time_of_impact_many_arrays,nfp_table,"
                     "nfp_table_workers,classify_many,set_poses,first_impacts,distances,"
                     "geometry,sweep,dask")
@@ -568,7 +591,7 @@ def main() -> None:
     repeat = args.repeat or (3 if args.quick else 5)
     q = int(args.quick)
     chosen = (args.paths.split(",") if args.paths else
-              ["contacts", "time_of_impact_many", "time_of_impact_many_rows",
+              ["contacts", "contacts_pile", "time_of_impact_many", "time_of_impact_many_rows",
                "time_of_impact_many_arrays", "nfp_table", "nfp_table_workers",
                "classify_many", "set_poses", "first_impacts",
                "distances", "geometry", "sweep", "dask"])
@@ -593,6 +616,8 @@ def main() -> None:
             world = world or WorldPaths(SIZES["contacts"][q])
             path: Path = {"contacts": Contacts, "set_poses": SetPoses,
                           "geometry": Geometry, "sweep": Sweep}[name](world)
+        elif name == "contacts_pile":
+            path = ContactsPile(SIZES["contacts"][q])
         elif name in ("classify_many", "distances"):
             path = ClassifyMany(SIZES[name][q], name == "distances")
         elif name in ("time_of_impact_many", "time_of_impact_many_rows"):
