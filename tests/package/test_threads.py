@@ -201,6 +201,34 @@ def test_set_poses_on_two_threads_equal_one_thread(share_everything):
     assert same(on(1, one.contacts).pairs, on(2, two.contacts).pairs)
 
 
+def test_sweep_and_its_points_on_two_threads_equal_one_thread(share_everything):
+    rng = np.random.default_rng(5)
+    world = pc.World()
+    world.add_many(stars(rng, 400))
+    vel = rng.normal(0.0, 12.0, (400, 2))
+    spin = rng.uniform(-20.0, 20.0, 400)
+    one = on(1, lambda: world.sweep(0.01, vel, spin))
+    two = on(2, lambda: world.sweep(0.01, vel, spin))
+    assert len(one) > 300 and np.any(one.times > 0.0)
+    for name in ("pairs", "times", "states"):
+        assert same(getattr(one, name), getattr(two, name)), name
+    points = [on(t, lambda s=s: (s.points, s.normals)) for t, s in ((1, one), (2, two))]
+    assert same(points[0][0], points[1][0]) and same(points[0][1], points[1][1])
+
+
+def test_query_many_on_two_threads_equals_one_thread(share_everything):
+    rng = np.random.default_rng(6)
+    world = pc.World(container=pc.Shape([(-2, -2), (22, -2), (22, 22), (-2, 22)]))
+    world.add_many(stars(rng, 300))
+    poses = rng.uniform(-3.0, 23.0, (2000, 2))
+    angles = rng.uniform(0.0, 6.3, 2000)
+    star = stars(rng, 1)[0]
+    one = on(1, lambda: world.query_many(star, poses, angles))
+    two = on(2, lambda: world.query_many(star, poses, angles))
+    assert {0, 2} <= set(one.tolist())  # free places and blocked ones
+    assert same(one, two)
+
+
 GRID = ("_keys", "_heads", "_nxt", "_prv", "_slot", "_level", "_lvl_count")
 
 

@@ -362,16 +362,18 @@ def grown_buffers(buffers, status, vmax):
 
 
 @njit(cache=True, nogil=True)
-def _geometry_range(rows, pairs, vmax, lmax, k0, k1, out):
-    """:func:`pair_geometry` for the pairs ``k0:k1``, into ``out``."""
+def _geometry_range(rows, pairs, vmax, lmax, c, chunks, out):
+    """:func:`pair_geometry` for the pairs of chunk ``c`` of ``chunks`` (its blocks,
+    :mod:`polycontact._kernels.spread`), into ``out``, with one set of buffers."""
     buffers = geometry_buffers(vmax)
     ba = np.empty(lmax + 1, np.int64)
     bb = np.empty(lmax + 1, np.int64)
-    k = k0
-    while k < k1:
-        k, status = geometry_into(rows, pairs, k, k1, out, buffers, ba, bb)
-        if k < k1:
-            buffers = grown_buffers(buffers, status, vmax)
+    for b in range(c, SPREAD * chunks, chunks):
+        k, k1 = block(pairs[0].shape[0], chunks, b)
+        while k < k1:
+            k, status = geometry_into(rows, pairs, k, k1, out, buffers, ba, bb)
+            if k < k1:
+                buffers = grown_buffers(buffers, status, vmax)
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -404,12 +406,10 @@ def pair_geometry(rows, pairs, vmax, lmax, chunks):
     out = (np.empty(n), np.empty((n, 2)), np.empty((n, 2)), np.empty(n), np.empty((n, 2)),
            np.empty(n, np.int8), np.empty(n, np.int64), np.empty(n, np.int64))
     if chunks == 1:
-        _geometry_range(rows, pairs, vmax, lmax, 0, n, out)
+        _geometry_range(rows, pairs, vmax, lmax, 0, 1, out)
         return out
     for c in prange(chunks):
-        for b in range(c, SPREAD * chunks, chunks):
-            k0, k1 = block(n, chunks, b)
-            _geometry_range(rows, pairs, vmax, lmax, k0, k1, out)
+        _geometry_range(rows, pairs, vmax, lmax, c, chunks, out)
     return out
 
 
@@ -420,25 +420,26 @@ def boundary_gaps(rows, pi, pj, lmax, chunks):
     n = pi.shape[0]
     out = np.empty(n)
     if chunks == 1:
-        _gaps_range(rows, pi, pj, lmax, 0, n, out)
+        _gaps_range(rows, pi, pj, lmax, 0, 1, out)
         return out
     for c in prange(chunks):
-        for b in range(c, SPREAD * chunks, chunks):
-            k0, k1 = block(n, chunks, b)
-            _gaps_range(rows, pi, pj, lmax, k0, k1, out)
+        _gaps_range(rows, pi, pj, lmax, c, chunks, out)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _gaps_range(rows, pi, pj, lmax, k0, k1, out):
-    """:func:`boundary_gaps` for the pairs ``k0:k1``, into ``out``."""
+def _gaps_range(rows, pi, pj, lmax, c, chunks, out):
+    """:func:`boundary_gaps` for the pairs of chunk ``c`` of ``chunks`` (its blocks,
+    :mod:`polycontact._kernels.spread`), into ``out``."""
     xy, ls, lo, nl = rows
     ba = np.empty(lmax + 1, np.int64)
     bb = np.empty(lmax + 1, np.int64)
-    for k in range(k0, k1):
-        ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
-        yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
-        out[k] = closest_features(ya, sa, yb, sb)[0]
+    for b in range(c, SPREAD * chunks, chunks):
+        k0, k1 = block(pi.shape[0], chunks, b)
+        for k in range(k0, k1):
+            ya, sa = body_view(xy, ls, lo, nl, pi[k], ba)
+            yb, sb = body_view(xy, ls, lo, nl, pj[k], bb)
+            out[k] = closest_features(ya, sa, yb, sb)[0]
 
 
 @njit(cache=True, nogil=True)

@@ -706,9 +706,10 @@ def query_container(query, tol, hazards):
 
 
 @njit(cache=True, nogil=True)
-def _query_range(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out):
-    """:func:`query_many` for the poses ``p0:p1``, into ``out``: the buffers, then
-    :func:`_query_into`."""
+def _query_range(shape, poses, grid, bodies, hazards, settings, scan, c, chunks, out):
+    """:func:`query_many` for the poses of chunk ``c`` of ``chunks`` (its blocks,
+    :mod:`polycontact._kernels.spread`), into ``out``: the buffers, then
+    :func:`_query_into` for each block."""
     ss = shape[1]
     n_ids, vmax, lmax, hmax = settings[4], settings[5], settings[6], settings[8]
     hnl = hazards[3]
@@ -716,7 +717,9 @@ def _query_range(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, ou
     buffers = (np.empty((n, 2)), np.empty(n_ids, np.int64), state_scratch(n + max(vmax, hmax)),
                np.empty(lmax + 1, np.int64),
                np.empty(hnl.max() + 1 if hnl.shape[0] else 1, np.int64))
-    _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers)
+    for b in range(c, SPREAD * chunks, chunks):
+        p0, p1 = block(poses[0].shape[0], chunks, b)
+        _query_into(shape, poses, grid, bodies, hazards, settings, scan, p0, p1, out, buffers)
 
 
 # Compiled without Numba's reference counting (``_nrt=False``): per placement and
@@ -781,10 +784,8 @@ def query_many(shape, poses, grid, bodies, hazards, settings, scan, chunks):
     p_count = poses[0].shape[0]
     out = np.empty(p_count, np.int8)
     if chunks == 1:
-        _query_range(shape, poses, grid, bodies, hazards, settings, scan, 0, p_count, out)
+        _query_range(shape, poses, grid, bodies, hazards, settings, scan, 0, 1, out)
         return out
     for c in prange(chunks):
-        for b in range(c, SPREAD * chunks, chunks):
-            k0, k1 = block(p_count, chunks, b)
-            _query_range(shape, poses, grid, bodies, hazards, settings, scan, k0, k1, out)
+        _query_range(shape, poses, grid, bodies, hazards, settings, scan, c, chunks, out)
     return out

@@ -445,8 +445,10 @@ def sweep_events(order, pi, pj, ids, found, chunks):
 
 
 @njit(cache=True, nogil=True)
-def _event_range(events, movers, world, vmax, lmax, ulps, k0, k1, point, normal):
-    """:func:`event_geometry` for the events ``k0:k1``, into ``point`` and ``normal``.
+def _event_range(events, movers, world, vmax, lmax, ulps, c, chunks, point, normal):
+    """:func:`event_geometry` for the events of chunk ``c`` of ``chunks`` (its blocks,
+    :mod:`polycontact._kernels.spread`), into ``point`` and ``normal``, with one set of
+    buffers.
     The two bodies of an event are placed side by side as the rows of a World of two
     (``rows``, one pair), for :func:`polycontact._kernels.contact_geometry.geometry_into`."""
     ei, ej, times, at_start = events
@@ -467,40 +469,42 @@ def _event_range(events, movers, world, vmax, lmax, ulps, k0, k1, point, normal)
     dist = np.empty(1)
     rest = (np.empty(1), np.empty((1, 2)), np.empty(1, np.int8), np.empty(1, np.int64),
             np.empty(1, np.int64))
-    for k in range(k0, k1):
-        i = ei[k]
-        j = ej[k]
-        r1, s1, _ = _turned(ids[i], base, tables, frames, fa)
-        r2, s2, _ = _turned(ids[j], base, tables, frames, fb)
-        n1 = r1.shape[0]
-        n2 = r2.shape[0]
-        nl[0] = s1.shape[0] - 1
-        nl[1] = s2.shape[0] - 1
-        lo[1] = nl[0]
-        ls[:nl[0] + 1] = s1
-        ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
-        t = times[k]
-        eps_rel = rel * max(extent[i], extent[j])
-        eps = tolerance_at(pos[i], motion[i], rad[i], pos[j], motion[j], rad[j], t, eps_rel,
-                           ulps)
-        if at_start[k]:  # penetrating at t = 0, as the search classified the stored rows
-            place(r1, pos[i], motion[i], t, xy[:n1])
-            place(r2, pos[j], motion[j], t, xy[n1:n1 + n2])
-            pair[2][0] = PENETRATING
-        else:
-            pair[2][0] = state_at((r1, s1, pos[i], rad[i]), motion[i],
-                                  (r2, s2, pos[j], rad[j]), motion[j], t, eps,
-                                  (xy[:n1], xy[n1:n1 + n2], scratch))
-        pair[3][0] = eps
-        out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
-        while True:
-            done, status = geometry_into(rows, pair, 0, 1, out, buffers, ba, bb)
-            if done == 1:
-                break
-            buffers = grown_buffers(buffers, status, vmax)
-        if not dist[0] == dist[0]:  # a depth left undecided: for the caller
-            normal[k, 0] = np.nan
-            normal[k, 1] = np.nan
+    for b in range(c, SPREAD * chunks, chunks):
+        k0, k1 = block(ei.shape[0], chunks, b)
+        for k in range(k0, k1):
+            i = ei[k]
+            j = ej[k]
+            r1, s1, _ = _turned(ids[i], base, tables, frames, fa)
+            r2, s2, _ = _turned(ids[j], base, tables, frames, fb)
+            n1 = r1.shape[0]
+            n2 = r2.shape[0]
+            nl[0] = s1.shape[0] - 1
+            nl[1] = s2.shape[0] - 1
+            lo[1] = nl[0]
+            ls[:nl[0] + 1] = s1
+            ls[nl[0]:nl[0] + nl[1] + 1] = s2 + n1
+            t = times[k]
+            eps_rel = rel * max(extent[i], extent[j])
+            eps = tolerance_at(pos[i], motion[i], rad[i], pos[j], motion[j], rad[j], t, eps_rel,
+                               ulps)
+            if at_start[k]:  # penetrating at t = 0, as the search classified the stored rows
+                place(r1, pos[i], motion[i], t, xy[:n1])
+                place(r2, pos[j], motion[j], t, xy[n1:n1 + n2])
+                pair[2][0] = PENETRATING
+            else:
+                pair[2][0] = state_at((r1, s1, pos[i], rad[i]), motion[i],
+                                      (r2, s2, pos[j], rad[j]), motion[j], t, eps,
+                                      (xy[:n1], xy[n1:n1 + n2], scratch))
+            pair[3][0] = eps
+            out = (dist, normal[k:k + 1], point[k:k + 1]) + rest
+            while True:
+                done, status = geometry_into(rows, pair, 0, 1, out, buffers, ba, bb)
+                if done == 1:
+                    break
+                buffers = grown_buffers(buffers, status, vmax)
+            if not dist[0] == dist[0]:  # a depth left undecided: for the caller
+                normal[k, 0] = np.nan
+                normal[k, 1] = np.nan
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -520,12 +524,10 @@ def event_geometry(events, movers, base, tables, frames, vmax, lmax, ulps, chunk
     point = np.full((n, 2), np.nan)
     normal = np.full((n, 2), np.nan)
     if chunks == 1:
-        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, 0, n, point,
+        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, 0, 1, point,
                      normal)
         return point, normal
     for c in prange(chunks):
-        for b in range(c, SPREAD * chunks, chunks):
-            k0, k1 = block(n, chunks, b)
-            _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, k0, k1,
-                         point, normal)
+        _event_range(events, movers, (base, tables, frames), vmax, lmax, ulps, c, chunks,
+                     point, normal)
     return point, normal
